@@ -1,0 +1,3 @@
+//! Acceleration structures: the bounding volume hierarchy over all shapes.
+
+pub mod bvh;

@@ -1,0 +1,239 @@
+//! Vectors, rays, bounding boxes and orthonormal frames.
+//!
+//! caustica computes in `f32` (glam's `Vec3`); positions, directions and normals share that type.
+
+pub use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+
+/// A ray `origin + t · dir`; `dir` need not be unit length unless a caller says so.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ray {
+    /// Start point.
+    pub origin: Vec3,
+    /// Direction.
+    pub dir: Vec3,
+}
+
+impl Ray {
+    /// Creates a ray.
+    #[inline]
+    pub fn new(origin: Vec3, dir: Vec3) -> Ray {
+        Ray { origin, dir }
+    }
+
+    /// The point at parameter `t`.
+    #[inline]
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// An axis-aligned bounding box; the empty box has `min > max`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    /// Lower corner.
+    pub min: Vec3,
+    /// Upper corner.
+    pub max: Vec3,
+}
+
+impl Default for Aabb {
+    fn default() -> Self {
+        Aabb::EMPTY
+    }
+}
+
+impl Aabb {
+    /// The box that contains nothing; growing it by a point gives that point.
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    /// The box spanned by two corners.
+    #[inline]
+    pub fn new(a: Vec3, b: Vec3) -> Aabb {
+        Aabb {
+            min: a.min(b),
+            max: a.max(b),
+        }
+    }
+
+    /// Whether the box contains no point.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
+    }
+
+    /// The box grown to contain `p`.
+    #[inline]
+    pub fn with_point(self, p: Vec3) -> Aabb {
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    /// The smallest box containing both boxes.
+    #[inline]
+    pub fn union(self, other: Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    /// Centre point.
+    #[inline]
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    /// Edge lengths (zero for an empty box).
+    #[inline]
+    pub fn extent(&self) -> Vec3 {
+        (self.max - self.min).max(Vec3::ZERO)
+    }
+
+    /// Surface area (zero for an empty box).
+    #[inline]
+    pub fn surface_area(&self) -> f32 {
+        if self.is_empty() {
+            return 0.0;
+        }
+        let e = self.extent();
+        2.0 * (e.x * e.y + e.y * e.z + e.z * e.x)
+    }
+
+    /// The box of the eight transformed corners.
+    pub fn transformed(&self, m: &Mat4) -> Aabb {
+        if self.is_empty() {
+            return *self;
+        }
+        let mut out = Aabb::EMPTY;
+        for i in 0..8 {
+            let corner = Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            );
+            out = out.with_point(m.transform_point3(corner));
+        }
+        out
+    }
+
+    /// The ray's entry and exit parameters, if it meets the box within `[t_min, t_max]`.
+    #[inline]
+    pub fn intersect(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
+        let t0 = (self.min - origin) * inv_dir;
+        let t1 = (self.max - origin) * inv_dir;
+        let near = t0.min(t1).max_element().max(t_min);
+        let far = t0.max(t1).min_element().min(t_max);
+        (near <= far).then_some((near, far))
+    }
+}
+
+/// An orthonormal frame; `z` is the normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    /// First tangent.
+    pub x: Vec3,
+    /// Second tangent.
+    pub y: Vec3,
+    /// Normal.
+    pub z: Vec3,
+}
+
+impl Frame {
+    /// A frame around the unit vector `n` (Duff et al. 2017, branchless).
+    pub fn from_normal(n: Vec3) -> Frame {
+        let sign = 1.0f32.copysign(n.z);
+        let a = -1.0 / (sign + n.z);
+        let b = n.x * n.y * a;
+        let x = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let y = Vec3::new(b, sign + n.y * n.y * a, -n.y);
+        Frame { x, y, z: n }
+    }
+
+    /// World vector expressed in this frame.
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.x), v.dot(self.y), v.dot(self.z))
+    }
+
+    /// Local vector expressed in world coordinates.
+    #[inline]
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.x * v.x + self.y * v.y + self.z * v.z
+    }
+}
+
+/// Mirror reflection of `d` (pointing towards the surface) about the unit normal `n`.
+#[inline]
+pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+    d - 2.0 * d.dot(n) * n
+}
+
+/// Refraction of the unit direction `d` through a surface with unit normal `n` facing against `d`,
+/// with `eta` = n_from / n_to; `None` on total internal reflection.
+#[inline]
+pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
+    let cos_i = -d.dot(n);
+    let sin2_t = eta * eta * (1.0 - cos_i * cos_i).max(0.0);
+    if sin2_t > 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((eta * d + (eta * cos_i - cos_t) * n).normalize())
+}
+
+/// Moves `p` off a surface with geometric normal `ng` to the side `dir` points to, by an amount
+/// scaled to the magnitude of `p`, so that a ray leaving `p` along `dir` does not hit the surface
+/// it starts on (no fixed epsilon: the offset follows the floating-point error of `p`).
+#[inline]
+pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
+    let scale = 1e-4 * (1.0 + p.abs().max_element()) * 0.0625;
+    let n = if ng.dot(dir) >= 0.0 { ng } else { -ng };
+    p + n * scale
+}
+
+/// Luminance with the skeleton's weights (0.299, 0.587, 0.114).
+#[inline]
+pub fn luminance(c: Vec3) -> f32 {
+    0.299 * c.x + 0.587 * c.y + 0.114 * c.z
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_is_orthonormal() {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.4, 0.866).normalize()] {
+            let f = Frame::from_normal(n);
+            assert!((f.x.length() - 1.0).abs() < 1e-5);
+            assert!((f.y.length() - 1.0).abs() < 1e-5);
+            assert!(f.x.dot(f.y).abs() < 1e-5 && f.x.dot(n).abs() < 1e-5 && f.y.dot(n).abs() < 1e-5);
+            let v = Vec3::new(0.2, 0.5, -0.7);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn refraction_obeys_snell_and_total_internal_reflection() {
+        let d = Vec3::new(0.5f32.sin(), 0.0, -0.5f32.cos());
+        let t = refract(d, Vec3::Z, 1.0 / 1.5).unwrap();
+        assert!((t.x - 0.5f32.sin() / 1.5).abs() < 1e-6);
+        let steep = Vec3::new(0.9f32.sin(), 0.0, -0.9f32.cos());
+        assert!(refract(steep, Vec3::Z, 1.5).is_none());
+    }
+
+    #[test]
+    fn box_transform_and_slab_test() {
+        let b = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+        let hit = b.intersect(Vec3::new(-5.0, 0.0, 0.0), Vec3::new(1.0, f32::INFINITY, f32::INFINITY), 0.0, 100.0);
+        assert_eq!(hit, Some((4.0, 6.0)));
+        let moved = b.transformed(&Mat4::from_translation(Vec3::new(2.0, 0.0, 0.0)));
+        assert_eq!(moved.min, Vec3::new(1.0, -1.0, -1.0));
+        assert!(Aabb::EMPTY.is_empty());
+    }
+}

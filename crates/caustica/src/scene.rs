@@ -1,0 +1,3 @@
+//! Scenes: the `.ray` reader and the renderable scene built from it.
+
+pub mod ray_file;

@@ -1,0 +1,3 @@
+//! The SBT-raytracer `.ray` format: lexer, both dialects' parsers, and the plain description.
+
+pub mod ast;

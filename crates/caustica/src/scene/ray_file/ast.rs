@@ -1,0 +1,216 @@
+//! The plain description a `.ray` file parses into: no rendering types, only data and source spans.
+//!
+//! Transforms are already flattened: every object carries its `world_from_object` matrix (the
+//! product of the enclosing transforms, outermost first). Materials are already resolved: the
+//! current-default inheritance of dialect T and the named materials of both dialects are applied,
+//! so each object holds the finished material it will render with.
+
+use glam::{Mat4, Vec2, Vec3};
+use std::ops::Range;
+use std::path::PathBuf;
+
+/// A byte range into the scene file's text.
+pub type Span = Range<usize>;
+
+/// Which of the two course readers the file was written for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Dialect {
+    /// The tokenizer-based reader (UT CS 384G 2012–2019, UW CSE 457 2009+), §1–§9.
+    Tokenizer,
+    /// The older object/dictionary reader (UW ≤ 2008, UT ≤ 2010, HKUST), §10.
+    Dictionary,
+}
+
+/// Everything a `.ray` file describes.
+#[derive(Clone, Debug)]
+pub struct SceneDescription {
+    /// The dialect that was detected.
+    pub dialect: Dialect,
+    /// The camera, if the file has one.
+    pub camera: Option<CameraDesc>,
+    /// Point and directional lights, in file order.
+    pub lights: Vec<LightDesc>,
+    /// Sum of all `ambient_light` colours (Ia).
+    pub ambient: Vec3,
+    /// Every primitive, in file order, with its world transform and material.
+    pub objects: Vec<ObjectDesc>,
+    /// Non-fatal remarks (ignored dictionary keys, etc.), each with a span.
+    pub warnings: Vec<(String, Span)>,
+}
+
+/// How the camera basis is formed from `viewdir` and `updir`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CameraBasis {
+    /// UT skeleton: vectors used as given (not normalised, not orthogonalised).
+    AsGiven,
+    /// Dialect O: each vector normalised separately, not orthogonalised.
+    Normalized,
+    /// UW 2013 and `look_at`: orthonormalised.
+    Orthonormal,
+}
+
+/// The camera block.
+#[derive(Clone, Debug)]
+pub struct CameraDesc {
+    /// Eye position (default origin).
+    pub position: Vec3,
+    /// View direction; `None` means the default orientation (−z) or the quaternion.
+    pub viewdir: Option<Vec3>,
+    /// Up direction, given together with `viewdir`.
+    pub updir: Option<Vec3>,
+    /// `look_at` target point (UW), turned into a view direction by the builder.
+    pub look_at: Option<Vec3>,
+    /// Quaternion (x, y, z, w) applied to the default frame, if given.
+    pub quaternion: Option<[f32; 4]>,
+    /// Vertical field of view in degrees; `None` gives the skeleton's normalised height 1.
+    pub fov_degrees: Option<f32>,
+    /// Width / height; `None` means 1.
+    pub aspect_ratio: Option<f32>,
+    /// How to form the basis.
+    pub basis: CameraBasis,
+    /// Where the camera block is.
+    pub span: Span,
+}
+
+/// A light statement.
+#[derive(Clone, Debug)]
+pub enum LightDesc {
+    /// `point_light`.
+    Point {
+        /// Position in world space.
+        position: Vec3,
+        /// Colour (intensity), not clamped.
+        color: Vec3,
+        /// Attenuation (constant a, linear b, quadratic c); parser default (0, 0, 1).
+        attenuation: [f32; 3],
+        /// Where the block is.
+        span: Span,
+    },
+    /// `directional_light`.
+    Directional {
+        /// The direction the light travels, as written (not normalised).
+        direction: Vec3,
+        /// Colour, not clamped.
+        color: Vec3,
+        /// Where the block is.
+        span: Span,
+    },
+}
+
+/// A material parameter: a constant or a texture map.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Param {
+    /// A constant colour (scalars are stored as grey triples).
+    Constant(Vec3),
+    /// `map("file")`: the path resolved against the scene file's directory.
+    Texture {
+        /// Resolved path of the image file.
+        path: PathBuf,
+        /// Where `map(...)` is written, for error reporting when the file cannot be read.
+        span: Span,
+    },
+}
+
+impl Param {
+    /// A constant grey parameter.
+    pub fn grey(value: f32) -> Param {
+        Param::Constant(Vec3::splat(value))
+    }
+}
+
+/// A finished material (all fields present; defaults and inheritance applied).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MaterialDesc {
+    /// ke
+    pub emissive: Param,
+    /// ka
+    pub ambient: Param,
+    /// ks
+    pub specular: Param,
+    /// kr
+    pub reflective: Param,
+    /// kd
+    pub diffuse: Param,
+    /// kt
+    pub transmissive: Param,
+    /// Phong exponent (a constant is a grey triple; a texture is luminance × 128, §6.1).
+    pub shininess: Param,
+    /// Index of refraction (grey triple).
+    pub index: Param,
+    /// Name registered with `name`, if any.
+    pub name: Option<String>,
+}
+
+impl Default for MaterialDesc {
+    /// The all-default material of §6.1: colours zero, shininess 0, index 1.
+    fn default() -> Self {
+        MaterialDesc {
+            emissive: Param::grey(0.0),
+            ambient: Param::grey(0.0),
+            specular: Param::grey(0.0),
+            reflective: Param::grey(0.0),
+            diffuse: Param::grey(0.0),
+            transmissive: Param::grey(0.0),
+            shininess: Param::grey(0.0),
+            index: Param::grey(1.0),
+            name: None,
+        }
+    }
+}
+
+/// A primitive placed in the world.
+#[derive(Clone, Debug)]
+pub struct ObjectDesc {
+    /// The object-space shape.
+    pub shape: ShapeDesc,
+    /// Object-space to world-space matrix (column-vector convention).
+    pub world_from_object: Mat4,
+    /// The object's material (for a trimesh with per-vertex materials, the base material).
+    pub material: MaterialDesc,
+    /// Where the primitive's keyword is.
+    pub span: Span,
+}
+
+/// Object-space shapes of §7.
+#[derive(Clone, Debug)]
+pub enum ShapeDesc {
+    /// Unit sphere at the origin.
+    Sphere,
+    /// Cube [-0.5, 0.5]³.
+    Box,
+    /// Square [-0.5, 0.5]² in the z = 0 plane.
+    Square,
+    /// Radius 1 about +z, z ∈ [0, 1].
+    Cylinder {
+        /// End caps (always true in the UT dialect; UW `capped`).
+        capped: bool,
+    },
+    /// Cone about +z from z = 0 to z = height.
+    Cone {
+        /// Height (default 1).
+        height: f32,
+        /// Radius at z = 0 (default 1).
+        bottom_radius: f32,
+        /// Radius at z = height (default 0).
+        top_radius: f32,
+        /// End discs (default true).
+        capped: bool,
+    },
+    /// Triangle mesh (polygons already fan-triangulated, indices validated).
+    Trimesh(Box<TrimeshDesc>),
+}
+
+/// A triangle mesh in object space.
+#[derive(Clone, Debug, Default)]
+pub struct TrimeshDesc {
+    /// Vertex positions.
+    pub points: Vec<Vec3>,
+    /// Triangles as 0-based vertex indices, all < `points.len()`.
+    pub triangles: Vec<[u32; 3]>,
+    /// Per-vertex normals (same length as `points`) if given or generated.
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex materials (same length as `points`) if given.
+    pub materials: Option<Vec<MaterialDesc>>,
+    /// Per-vertex texture coordinates (UW `texture_uv`), same length as `points`.
+    pub uvs: Option<Vec<Vec2>>,
+}
