@@ -9,7 +9,9 @@
 
 pub mod accel;
 pub mod error;
+pub mod geometry;
 pub mod math;
+pub mod photon;
 pub mod scene;
 
 pub use error::{Error, ParseError, Result};

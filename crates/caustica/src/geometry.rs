@@ -1,0 +1,3 @@
+//! Shapes in world space and their ray intersections.
+
+pub mod triangle;
