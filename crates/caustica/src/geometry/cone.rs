@@ -1,0 +1,128 @@
+//! The cone: a surface of revolution about +z from z = 0 (bottom radius) to z = height (top
+//! radius), with optional end discs. A cylinder is the cone with equal radii.
+
+use super::{solve_quadratic_half_b, LocalHit};
+use crate::math::{Aabb, Ray, Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// Cone parameters after the course's clamps (if enabled).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Cone {
+    /// Radius at z = 0.
+    pub bottom_radius: f32,
+    /// Radius at z = height.
+    pub top_radius: f32,
+    /// Height (> 0).
+    pub height: f32,
+    /// End discs present.
+    pub capped: bool,
+    /// Reproduce the skeleton's side normal, whose z component is twice the true one (§7).
+    pub doubled_normal_z: bool,
+}
+
+impl Cone {
+    /// A cone as the file describes it. With `course_quirks`, radii are clamped to ≥ 1e-4 and
+    /// the slope to magnitude ≥ 0.001, and the side normal has the skeleton's doubled z (§7).
+    pub fn new(height: f32, bottom_radius: f32, top_radius: f32, capped: bool, course_quirks: bool) -> Cone {
+        let (mut bottom, mut top) = (bottom_radius.abs(), top_radius.abs());
+        if course_quirks {
+            bottom = bottom.max(1e-4);
+            top = top.max(1e-4);
+            let slope = (top - bottom) / height;
+            if slope.abs() < 1e-3 {
+                top = bottom + 1e-3 * height;
+            }
+        }
+        Cone {
+            bottom_radius: bottom,
+            top_radius: top,
+            height,
+            capped,
+            doubled_normal_z: course_quirks,
+        }
+    }
+
+    /// Object-space bounds.
+    pub fn bounds(&self) -> Aabb {
+        let r = self.bottom_radius.max(self.top_radius);
+        Aabb::new(Vec3::new(-r, -r, 0.0), Vec3::new(r, r, self.height))
+    }
+
+    fn slope(&self) -> f32 {
+        (self.top_radius - self.bottom_radius) / self.height
+    }
+
+    /// Nearest hit in `(0, t_max)`. Side normals point outward, except on an uncapped cone hit
+    /// from inside, where they face the ray; cap normals are −z at the bottom and +z at the top.
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<LocalHit> {
+        let mut best: Option<LocalHit> = None;
+        let mut t_best = t_max;
+        if let Some(hit) = self.intersect_side(ray, t_best) {
+            t_best = hit.t;
+            best = Some(hit);
+        }
+        if self.capped {
+            for (z, radius, nz) in [(0.0, self.bottom_radius, -1.0), (self.height, self.top_radius, 1.0)] {
+                if let Some(hit) = intersect_disc(ray, z, radius, nz, t_best) {
+                    t_best = hit.t;
+                    best = Some(hit);
+                }
+            }
+        }
+        best
+    }
+
+    fn intersect_side(&self, ray: &Ray, t_max: f32) -> Option<LocalHit> {
+        let (o, d) = (ray.origin, ray.dir);
+        let s = self.slope();
+        let r0 = self.bottom_radius;
+        // x² + y² = (r0 + s z)²
+        let r_o = r0 + s * o.z;
+        let a = d.x * d.x + d.y * d.y - s * s * d.z * d.z;
+        let half_b = o.x * d.x + o.y * d.y - s * d.z * r_o;
+        let c = o.x * o.x + o.y * o.y - r_o * r_o;
+        let (t0, t1) = solve_quadratic_half_b(a, half_b, c)?;
+        for t in [t0, t1] {
+            if !(t > 0.0 && t < t_max) {
+                continue;
+            }
+            let p = ray.at(t);
+            let radius = r0 + s * p.z;
+            if p.z < 0.0 || p.z > self.height || radius < 0.0 {
+                continue;
+            }
+            let z_scale = if self.doubled_normal_z { 2.0 } else { 1.0 };
+            let mut normal = Vec3::new(p.x, p.y, -z_scale * s * radius);
+            if !self.capped && normal.dot(d) > 0.0 {
+                normal = -normal;
+            }
+            let phi = p.y.atan2(p.x);
+            let u = if phi < 0.0 { phi + 2.0 * PI } else { phi } / (2.0 * PI);
+            return Some(LocalHit {
+                t,
+                normal,
+                uv: Vec2::new(u, p.z / self.height),
+            });
+        }
+        None
+    }
+}
+
+fn intersect_disc(ray: &Ray, z: f32, radius: f32, nz: f32, t_max: f32) -> Option<LocalHit> {
+    if ray.dir.z == 0.0 || radius <= 0.0 {
+        return None;
+    }
+    let t = (z - ray.origin.z) / ray.dir.z;
+    if !(t > 0.0 && t < t_max) {
+        return None;
+    }
+    let p = ray.at(t);
+    if p.x * p.x + p.y * p.y > radius * radius {
+        return None;
+    }
+    Some(LocalHit {
+        t,
+        normal: Vec3::new(0.0, 0.0, nz),
+        uv: Vec2::new(0.5 + 0.5 * p.x / radius, 0.5 + 0.5 * p.y / radius),
+    })
+}

@@ -1,0 +1,212 @@
+//! An analytic shape placed in the world by a transform.
+
+use super::{cone::Cone, cube, cylinder, sphere, square, LocalHit};
+use crate::math::{Aabb, Mat3, Mat4, Ray, Vec2, Vec3};
+
+/// The closed set of analytic shapes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShapeKind {
+    /// Unit sphere.
+    Sphere,
+    /// Cube [-0.5, 0.5]³.
+    Cube,
+    /// Square [-0.5, 0.5]² at z = 0.
+    Square,
+    /// Cone or cylinder about +z.
+    Cone(Cone),
+}
+
+/// Options for how shapes are built from a scene file.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ShapeSettings {
+    /// Reproduce the course skeleton's cone quirks (radius and slope clamps, doubled normal z).
+    pub cone_quirks: bool,
+}
+
+/// A shape with its transforms.
+#[derive(Clone, Debug)]
+pub struct Shape {
+    /// Which shape.
+    pub kind: ShapeKind,
+    /// Object space to world space.
+    pub world_from_object: Mat4,
+    /// World space to object space.
+    pub object_from_world: Mat4,
+    /// Inverse transpose of the upper 3×3, for normals.
+    pub normal_to_world: Mat3,
+    /// World-space bounds.
+    pub bounds: Aabb,
+}
+
+/// A hit on a shape, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeHit {
+    /// Ray parameter.
+    pub t: f32,
+    /// Unit world normal, oriented as the shape defines it (§7).
+    pub normal: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+}
+
+impl Shape {
+    /// Places `kind` by `world_from_object`; `None` if the matrix cannot be inverted.
+    pub fn new(kind: ShapeKind, world_from_object: Mat4) -> Option<Shape> {
+        let det = world_from_object.determinant();
+        if !det.is_finite() || det.abs() < 1e-12 {
+            return None;
+        }
+        let object_from_world = world_from_object.inverse();
+        let normal_to_world = Mat3::from_mat4(object_from_world).transpose();
+        let bounds = kind.object_bounds().transformed(&world_from_object);
+        Some(Shape {
+            kind,
+            world_from_object,
+            object_from_world,
+            normal_to_world,
+            bounds,
+        })
+    }
+
+    /// Nearest hit in `(0, t_max)` along the world ray.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        let local = Ray::new(
+            self.object_from_world.transform_point3(ray.origin),
+            self.object_from_world.transform_vector3(ray.dir),
+        );
+        let hit: LocalHit = match &self.kind {
+            ShapeKind::Sphere => sphere::intersect(&local, t_max),
+            ShapeKind::Cube => cube::intersect(&local, t_max),
+            ShapeKind::Square => square::intersect(&local, t_max),
+            ShapeKind::Cone(cone) => cone.intersect(&local, t_max),
+        }?;
+        let normal = (self.normal_to_world * hit.normal).normalize_or_zero();
+        if normal == Vec3::ZERO {
+            return None;
+        }
+        Some(ShapeHit {
+            t: hit.t,
+            normal,
+            uv: hit.uv,
+        })
+    }
+}
+
+impl ShapeKind {
+    /// A cylinder of the file (radius 1, height 1).
+    pub fn cylinder(capped: bool) -> ShapeKind {
+        ShapeKind::Cone(cylinder::cylinder(capped))
+    }
+
+    /// Object-space bounds.
+    pub fn object_bounds(&self) -> Aabb {
+        match self {
+            ShapeKind::Sphere => sphere::bounds(),
+            ShapeKind::Cube => cube::bounds(),
+            ShapeKind::Square => square::bounds(),
+            ShapeKind::Cone(cone) => cone.bounds(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f32, b: f32) -> bool {
+        (a - b).abs() < 1e-4
+    }
+
+    #[test]
+    fn sphere_hits_from_outside_and_inside() {
+        let s = Shape::new(ShapeKind::Sphere, Mat4::from_translation(Vec3::new(0.0, 0.0, -5.0))).unwrap();
+        let hit = s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), f32::INFINITY).unwrap();
+        assert!(close(hit.t, 4.0));
+        assert!((hit.normal - Vec3::Z).length() < 1e-5);
+        let inside = s.intersect(&Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::X), f32::INFINITY).unwrap();
+        assert!(close(inside.t, 1.0));
+        assert!((inside.normal - Vec3::X).length() < 1e-5, "outward from inside too");
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Y), f32::INFINITY).is_none());
+        assert!(s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), 3.9).is_none(), "t_max respected");
+    }
+
+    #[test]
+    fn scaled_sphere_keeps_world_parameter_and_normal() {
+        // An ellipsoid with semi-axes (2, 1, 1): hit at x = 2 from the right, normal +x.
+        let s = Shape::new(ShapeKind::Sphere, Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0))).unwrap();
+        let hit = s.intersect(&Ray::new(Vec3::new(10.0, 0.0, 0.0), -Vec3::X * 2.0), f32::INFINITY).unwrap();
+        assert!(close(hit.t, 4.0), "t is in units of the world direction: {}", hit.t);
+        assert!((hit.normal - Vec3::X).length() < 1e-5);
+        // On the ellipsoid at 45° the normal follows the inverse transpose, not the point.
+        let p = Vec3::new(2.0 * 0.5f32.sqrt(), 0.5f32.sqrt(), 0.0);
+        let hit = s.intersect(&Ray::new(p * 2.0, -p), f32::INFINITY).unwrap();
+        let expected = Vec3::new(p.x / 4.0, p.y, 0.0).normalize();
+        assert!((hit.normal - expected).length() < 1e-4);
+    }
+
+    #[test]
+    fn box_faces_normals_and_uv() {
+        let b = Shape::new(ShapeKind::Cube, Mat4::IDENTITY).unwrap();
+        let hit = b.intersect(&Ray::new(Vec3::new(0.2, 0.1, 3.0), -Vec3::Z), f32::INFINITY).unwrap();
+        assert!(close(hit.t, 2.5));
+        assert_eq!(hit.normal, Vec3::Z);
+        assert!(close(hit.uv.x, 0.7) && close(hit.uv.y, 0.6));
+        let back = b.intersect(&Ray::new(Vec3::new(0.2, 0.1, -3.0), Vec3::Z), f32::INFINITY).unwrap();
+        assert_eq!(back.normal, -Vec3::Z);
+        assert!(close(back.uv.x, 0.3), "−k face mirrors u");
+        let inside = b.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY).unwrap();
+        assert!(close(inside.t, 0.5));
+        assert_eq!(inside.normal, Vec3::X, "outward, not flipped, from inside");
+    }
+
+    #[test]
+    fn square_is_two_sided_and_faces_the_ray() {
+        let s = Shape::new(ShapeKind::Square, Mat4::IDENTITY).unwrap();
+        let down = s.intersect(&Ray::new(Vec3::new(0.1, -0.2, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
+        assert_eq!(down.normal, Vec3::Z);
+        assert!(close(down.uv.x, 0.6) && close(down.uv.y, 0.3));
+        let up = s.intersect(&Ray::new(Vec3::new(0.1, -0.2, -1.0), Vec3::Z), f32::INFINITY).unwrap();
+        assert_eq!(up.normal, -Vec3::Z);
+        assert!(s.intersect(&Ray::new(Vec3::new(0.6, 0.0, 1.0), -Vec3::Z), f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn cylinder_side_and_caps() {
+        let c = Shape::new(ShapeKind::cylinder(true), Mat4::IDENTITY).unwrap();
+        let side = c.intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY).unwrap();
+        assert!(close(side.t, 4.0));
+        assert!((side.normal - Vec3::X).length() < 1e-5);
+        let top = c.intersect(&Ray::new(Vec3::new(0.3, 0.0, 5.0), -Vec3::Z), f32::INFINITY).unwrap();
+        assert!(close(top.t, 4.0));
+        assert_eq!(top.normal, Vec3::Z);
+        let open = Shape::new(ShapeKind::cylinder(false), Mat4::IDENTITY).unwrap();
+        let through = open.intersect(&Ray::new(Vec3::new(0.3, 0.0, 5.0), -Vec3::Z), f32::INFINITY);
+        assert!(through.is_none(), "an open tube lets an axial ray through");
+        let from_inside = open.intersect(&Ray::new(Vec3::new(0.0, 0.0, 0.5), Vec3::X), f32::INFINITY).unwrap();
+        assert!((from_inside.normal + Vec3::X).length() < 1e-5, "faces the ray inside an open tube");
+    }
+
+    #[test]
+    fn cone_slant_normal_and_quirks() {
+        // Bottom radius 1, apex at z = 1: the side at 45°.
+        let cone = Cone::new(1.0, 1.0, 0.0, true, false);
+        let s = Shape::new(ShapeKind::Cone(cone), Mat4::IDENTITY).unwrap();
+        let hit = s.intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY).unwrap();
+        assert!(close(hit.t, 4.5));
+        let expected = Vec3::new(1.0, 0.0, 1.0).normalize();
+        assert!((hit.normal - expected).length() < 1e-4, "{:?}", hit.normal);
+        let quirky = Cone::new(2.0, 3.0, 3.0, false, true);
+        assert!(close(quirky.top_radius, 3.002), "slope clamp flares equal radii by 0.001·h");
+        let sharp = Cone::new(1.0, 1.0, 0.0, true, true);
+        assert!(close(sharp.top_radius, 1e-4));
+        let q = Shape::new(ShapeKind::Cone(sharp), Mat4::IDENTITY).unwrap();
+        let qh = q.intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY).unwrap();
+        assert!(qh.normal.z > expected.z + 0.1, "the doubled z tilts the normal: {:?}", qh.normal);
+    }
+
+    #[test]
+    fn singular_transform_is_rejected() {
+        assert!(Shape::new(ShapeKind::Sphere, Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0))).is_none());
+    }
+}
