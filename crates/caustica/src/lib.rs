@@ -8,10 +8,18 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod camera;
 pub mod error;
+pub mod film;
 pub mod geometry;
+pub mod image_io;
+pub mod integrator;
+pub mod light;
+pub mod material;
 pub mod math;
 pub mod photon;
+pub mod sampling;
 pub mod scene;
+pub mod texture;
 
 pub use error::{Error, ParseError, Result};

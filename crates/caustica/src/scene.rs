@@ -1,3 +1,299 @@
-//! Scenes: the `.ray` reader and the renderable scene built from it.
+//! The renderable scene: world-space shapes and triangles under one BVH, materials, textures,
+//! lights and the camera. Built from a parsed `.ray` description by [`build`].
 
+pub mod build;
+pub mod presets;
 pub mod ray_file;
+
+pub use build::{build, load, BuildSettings};
+
+use crate::accel::bvh::Bvh;
+use crate::camera::Camera;
+use crate::geometry::triangle::Triangle;
+use crate::geometry::Shape;
+use crate::light::Light;
+use crate::material::{Material, SurfaceParams};
+use crate::math::{Aabb, Ray, Vec2, Vec3};
+use crate::texture::Texture;
+
+/// A triangle mesh's shading data in world space; its triangles live in [`Scene::triangles`].
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    /// Vertex indices of each triangle.
+    pub indices: Vec<[u32; 3]>,
+    /// Unit per-vertex normals in world space.
+    pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates.
+    pub uvs: Option<Vec<Vec2>>,
+    /// Per-vertex material ids.
+    pub vertex_materials: Option<Vec<u32>>,
+    /// The mesh's material id.
+    pub material: u32,
+    /// World-space bounds.
+    pub bounds: Aabb,
+}
+
+/// Which object a triangle belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TriangleRef {
+    /// Mesh index.
+    pub mesh: u32,
+    /// Triangle index within the mesh.
+    pub index: u32,
+}
+
+/// One renderable object: an analytic shape or a mesh, with its material.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ObjectRef {
+    /// Index into [`Scene::shapes`].
+    Shape(u32),
+    /// Index into [`Scene::meshes`].
+    Mesh(u32),
+}
+
+/// A scene ready to render.
+pub struct Scene {
+    /// The camera.
+    pub camera: Camera,
+    /// Lights.
+    pub lights: Vec<Light>,
+    /// Summed ambient light Ia.
+    pub ambient: Vec3,
+    /// Materials, indexed by id.
+    pub materials: Vec<Material>,
+    /// Textures, indexed by id.
+    pub textures: Vec<Texture>,
+    /// Analytic shapes.
+    pub shapes: Vec<Shape>,
+    /// Material id of each shape.
+    pub shape_materials: Vec<u32>,
+    /// Meshes.
+    pub meshes: Vec<Mesh>,
+    /// All triangles of all meshes, in world space.
+    pub triangles: Vec<Triangle>,
+    /// The mesh and index of each triangle.
+    pub triangle_refs: Vec<TriangleRef>,
+    /// Remarks made while reading and building (dropped triangles, ignored keys, …).
+    pub warnings: Vec<String>,
+    bvh: Bvh,
+}
+
+/// The minimal record of a closest hit: enough to build a [`SurfaceHit`] when needed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Intersection {
+    /// Ray parameter.
+    pub t: f32,
+    /// Primitive index: shapes first, then triangles.
+    pub prim: u32,
+    /// Unit normal for shapes; barycentric (u, v, 0) for triangles.
+    normal_or_bary: Vec3,
+    uv: Vec2,
+}
+
+/// Everything shading needs at a surface point.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceHit {
+    /// Ray parameter.
+    pub t: f32,
+    /// World position.
+    pub point: Vec3,
+    /// Unit geometric normal as the shape defines it (outward for closed shapes, §7).
+    pub geometric_normal: Vec3,
+    /// Unit shading normal (interpolated for meshes), on the geometric normal's side.
+    pub shading_normal: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Material values here.
+    pub params: SurfaceParams,
+    /// The object hit.
+    pub object: ObjectRef,
+}
+
+impl Scene {
+    /// Assembles a scene and builds its BVH.
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn assemble(
+        camera: Camera,
+        lights: Vec<Light>,
+        ambient: Vec3,
+        materials: Vec<Material>,
+        textures: Vec<Texture>,
+        shapes: Vec<Shape>,
+        shape_materials: Vec<u32>,
+        meshes: Vec<Mesh>,
+        triangles: Vec<Triangle>,
+        triangle_refs: Vec<TriangleRef>,
+        warnings: Vec<String>,
+    ) -> Scene {
+        let prim_bounds: Vec<Aabb> = shapes.iter().map(|s| s.bounds).chain(triangles.iter().map(|t| t.bounds())).collect();
+        let bvh = Bvh::build(&prim_bounds);
+        Scene {
+            camera,
+            lights,
+            ambient,
+            materials,
+            textures,
+            shapes,
+            shape_materials,
+            meshes,
+            triangles,
+            triangle_refs,
+            warnings,
+            bvh,
+        }
+    }
+
+    /// World bounds of everything.
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
+    /// The BVH over all primitives.
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+
+    /// Number of primitives (shapes plus triangles).
+    pub fn primitive_count(&self) -> usize {
+        self.shapes.len() + self.triangles.len()
+    }
+
+    /// The closest hit in `(0, t_max)`.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Intersection> {
+        let n_shapes = self.shapes.len() as u32;
+        let mut best: Option<Intersection> = None;
+        self.bvh.closest_hit(ray, t_max, |prim, t_max| {
+            if prim < n_shapes {
+                let hit = self.shapes[prim as usize].intersect(ray, t_max)?;
+                best = Some(Intersection {
+                    t: hit.t,
+                    prim,
+                    normal_or_bary: hit.normal,
+                    uv: hit.uv,
+                });
+                Some(hit.t)
+            } else {
+                let hit = self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max)?;
+                best = Some(Intersection {
+                    t: hit.t,
+                    prim,
+                    normal_or_bary: Vec3::new(hit.u, hit.v, 0.0),
+                    uv: Vec2::ZERO,
+                });
+                Some(hit.t)
+            }
+        })?;
+        best
+    }
+
+    /// Calls `visit(hit)` for each primitive the segment `(0, t_max)` meets (its nearest hit
+    /// within the segment), until `visit` returns true; returns whether it did.
+    pub fn any_hit(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&Intersection) -> bool) -> bool {
+        let n_shapes = self.shapes.len() as u32;
+        self.bvh.any_hit(ray, t_max, |prim, t_max| {
+            let hit = if prim < n_shapes {
+                self.shapes[prim as usize].intersect(ray, t_max).map(|h| Intersection {
+                    t: h.t,
+                    prim,
+                    normal_or_bary: h.normal,
+                    uv: h.uv,
+                })
+            } else {
+                self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max).map(|h| Intersection {
+                    t: h.t,
+                    prim,
+                    normal_or_bary: Vec3::new(h.u, h.v, 0.0),
+                    uv: Vec2::ZERO,
+                })
+            };
+            hit.is_some_and(|h| visit(&h))
+        })
+    }
+
+    /// Full shading data for an intersection found along `ray`.
+    pub fn surface(&self, ray: &Ray, hit: &Intersection) -> SurfaceHit {
+        let point = ray.at(hit.t);
+        let n_shapes = self.shapes.len() as u32;
+        if hit.prim < n_shapes {
+            let material = &self.materials[self.shape_materials[hit.prim as usize] as usize];
+            return SurfaceHit {
+                t: hit.t,
+                point,
+                geometric_normal: hit.normal_or_bary,
+                shading_normal: hit.normal_or_bary,
+                uv: hit.uv,
+                params: material.eval(&self.textures, hit.uv),
+                object: ObjectRef::Shape(hit.prim),
+            };
+        }
+        let tri_index = (hit.prim - n_shapes) as usize;
+        let tri_ref = self.triangle_refs[tri_index];
+        let mesh = &self.meshes[tri_ref.mesh as usize];
+        let [i0, i1, i2] = mesh.indices[tri_ref.index as usize].map(|i| i as usize);
+        let (b1, b2) = (hit.normal_or_bary.x, hit.normal_or_bary.y);
+        let w = [1.0 - b1 - b2, b1, b2];
+        let uv = mesh.uvs.as_ref().map_or(Vec2::new(b1, b2), |uvs| uvs[i0] * w[0] + uvs[i1] * w[1] + uvs[i2] * w[2]);
+        let mut geometric_normal = self.triangles[tri_index].geometric_normal();
+        let shading_normal = match &mesh.normals {
+            Some(n) => {
+                let s = (n[i0] * w[0] + n[i1] * w[1] + n[i2] * w[2]).normalize_or_zero();
+                if s == Vec3::ZERO {
+                    geometric_normal
+                } else {
+                    // Trust the file's normals for which side is outside.
+                    if s.dot(geometric_normal) < 0.0 {
+                        geometric_normal = -geometric_normal;
+                    }
+                    s
+                }
+            }
+            None => geometric_normal,
+        };
+        let params = match &mesh.vertex_materials {
+            Some(ids) => {
+                let p = [ids[i0], ids[i1], ids[i2]].map(|id| self.materials[id as usize].eval(&self.textures, uv));
+                SurfaceParams::blend([&p[0], &p[1], &p[2]], w)
+            }
+            None => self.materials[mesh.material as usize].eval(&self.textures, uv),
+        };
+        SurfaceHit {
+            t: hit.t,
+            point,
+            geometric_normal,
+            shading_normal,
+            uv,
+            params,
+            object: ObjectRef::Mesh(tri_ref.mesh),
+        }
+    }
+
+    /// The material id of an object (a mesh's base material).
+    pub fn object_material(&self, object: ObjectRef) -> u32 {
+        match object {
+            ObjectRef::Shape(i) => self.shape_materials[i as usize],
+            ObjectRef::Mesh(i) => self.meshes[i as usize].material,
+        }
+    }
+
+    /// Every object with its world bounds, shapes first.
+    pub fn objects(&self) -> impl Iterator<Item = (ObjectRef, Aabb)> + '_ {
+        let shapes = self.shapes.iter().enumerate().map(|(i, s)| (ObjectRef::Shape(i as u32), s.bounds));
+        let meshes = self.meshes.iter().enumerate().map(|(i, m)| (ObjectRef::Mesh(i as u32), m.bounds));
+        shapes.chain(meshes)
+    }
+
+    /// Whether an object can reflect or refract specularly (anywhere on it).
+    pub fn object_is_specular(&self, object: ObjectRef) -> bool {
+        match object {
+            ObjectRef::Mesh(i) => {
+                let mesh = &self.meshes[i as usize];
+                match &mesh.vertex_materials {
+                    Some(ids) => ids.iter().any(|&id| self.materials[id as usize].is_specular()),
+                    None => self.materials[mesh.material as usize].is_specular(),
+                }
+            }
+            ObjectRef::Shape(_) => self.materials[self.object_material(object) as usize].is_specular(),
+        }
+    }
+}

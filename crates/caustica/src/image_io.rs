@@ -1,0 +1,128 @@
+//! Reading textures and writing images. Every output is written to a temporary file beside the
+//! target and renamed over it, so a reader never sees a half-written image.
+
+use crate::error::{Error, Result};
+use crate::math::Vec3;
+use crate::texture::Texture;
+use std::path::{Path, PathBuf};
+
+/// Loads a PNG or BMP texture (8 or 16 bits per channel; alpha ignored).
+pub fn load_texture(path: &Path) -> Result<Texture> {
+    let img = image::open(path).map_err(|e| Error::Image {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let rgb = img.to_rgb32f();
+    let (w, h) = (rgb.width() as usize, rgb.height() as usize);
+    let texels = rgb.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+    Texture::new(w, h, texels).ok_or_else(|| Error::Image {
+        path: path.to_path_buf(),
+        message: "the image is empty".into(),
+    })
+}
+
+/// The formats caustica writes, chosen by the output file's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ImageFormat {
+    /// 8-bit PNG.
+    Png,
+    /// Linear 32-bit float OpenEXR.
+    Exr,
+}
+
+impl ImageFormat {
+    /// The format for `path`'s extension, or an error naming the accepted ones.
+    pub fn from_path(path: &Path) -> Result<ImageFormat> {
+        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+            Some(e) if e == "png" => Ok(ImageFormat::Png),
+            Some(e) if e == "exr" => Ok(ImageFormat::Exr),
+            _ => Err(Error::InvalidSettings(format!(
+                "cannot tell the image format of `{}`: use a .png or .exr extension",
+                path.display()
+            ))),
+        }
+    }
+}
+
+/// Writes 8-bit RGB rows (top to bottom) as PNG, atomically.
+pub fn write_png(path: &Path, width: usize, height: usize, rgb8: &[u8]) -> Result<()> {
+    write_atomically(path, |tmp| {
+        image::save_buffer_with_format(tmp, rgb8, width as u32, height as u32, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
+            .map_err(|e| e.to_string())
+    })
+}
+
+/// Writes linear float RGB rows (top to bottom) as OpenEXR, atomically.
+pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[Vec3]) -> Result<()> {
+    let data: Vec<f32> = pixels.iter().flat_map(|p| p.to_array()).collect();
+    let buffer = image::Rgb32FImage::from_raw(width as u32, height as u32, data).ok_or_else(|| Error::Image {
+        path: path.to_path_buf(),
+        message: "pixel count does not match the image size".into(),
+    })?;
+    write_atomically(path, |tmp| {
+        image::DynamicImage::ImageRgb32F(buffer).save_with_format(tmp, image::ImageFormat::OpenExr).map_err(|e| e.to_string())
+    })
+}
+
+/// Reads an OpenEXR file as linear RGB rows (top to bottom).
+pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
+    let img = image::open(path).map_err(|e| Error::Image {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    })?;
+    let rgb = img.to_rgb32f();
+    let pixels = rgb.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
+    Ok((rgb.width() as usize, rgb.height() as usize, pixels))
+}
+
+/// Runs `write` on a temporary path in the target's directory, then renames it over `path`.
+pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> std::result::Result<(), String>) -> Result<()> {
+    let tmp = temporary_path(path);
+    if let Err(message) = write(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::Image {
+            path: path.to_path_buf(),
+            message,
+        });
+    }
+    std::fs::rename(&tmp, path).map_err(|source| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    })
+}
+
+fn temporary_path(path: &Path) -> PathBuf {
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    // Keep the real extension last: the encoders pick the format from it.
+    let ext = path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+    path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn png_and_exr_round_trip_and_leave_no_temporary_file() {
+        let dir = std::env::temp_dir().join(format!("caustica-io-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let png = dir.join("a.png");
+        write_png(&png, 2, 1, &[255, 0, 0, 0, 128, 255]).unwrap();
+        let tex = load_texture(&png).unwrap();
+        assert_eq!((tex.width(), tex.height()), (2, 1));
+        let exr = dir.join("a.exr");
+        let pixels = [Vec3::new(0.25, 2.5, 100.0), Vec3::new(0.0, 1e-3, 1.0)];
+        write_exr(&exr, 2, 1, &pixels).unwrap();
+        let (w, h, back) = read_exr(&exr).unwrap();
+        assert_eq!((w, h), (2, 1));
+        assert_eq!(back, pixels.to_vec());
+        let leftovers = std::fs::read_dir(&dir).unwrap().filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains(".tmp")).count();
+        assert_eq!(leftovers, 0);
+        assert!(ImageFormat::from_path(Path::new("x.jpg")).is_err());
+        assert!(load_texture(&dir.join("missing.png")).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}

@@ -1,0 +1,125 @@
+//! Integrators turn camera rays into pixel values. The image is cut into tiles rendered in
+//! parallel; each pixel draws from its own random stream (seed, pixel index), so the picture does
+//! not depend on the thread count.
+
+pub mod whitted;
+
+use crate::camera::Camera;
+use crate::film::Film;
+use crate::sampling::Rng;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+/// Receives progress reports; the library never prints.
+pub trait Progress: Sync {
+    /// A phase begins with `total` units of work.
+    fn start(&self, phase: &str, total: u64);
+    /// `n` more units are done.
+    fn advance(&self, n: u64);
+    /// The phase is over.
+    fn finish(&self);
+}
+
+/// Progress that goes nowhere.
+pub struct NoProgress;
+
+impl Progress for NoProgress {
+    fn start(&self, _: &str, _: u64) {}
+    fn advance(&self, _: u64) {}
+    fn finish(&self) {}
+}
+
+/// Progress reporting and cancellation for a long computation.
+#[derive(Clone, Copy)]
+pub struct Control<'a> {
+    /// Where progress goes.
+    pub progress: &'a dyn Progress,
+    /// Set to stop early; the work done so far is kept.
+    pub cancel: &'a AtomicBool,
+}
+
+impl Control<'_> {
+    /// Whether the computation should stop.
+    #[inline]
+    pub fn cancelled(&self) -> bool {
+        self.cancel.load(Ordering::Relaxed)
+    }
+}
+
+/// Image size and sampling.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageSettings {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// N for N×N stratified, jittered samples per pixel (1 samples the pixel centre).
+    pub aa: u32,
+    /// Seed of all random streams.
+    pub seed: u64,
+}
+
+const TILE: usize = 16;
+
+/// Renders every pixel with `sample(camera ray's screen point, rng)`, averaging N×N stratified
+/// samples. Returns the film and whether it is complete (false when cancelled).
+pub fn render_tiles<F>(settings: &ImageSettings, control: Control, phase: &str, sample: F) -> (Film, bool)
+where
+    F: Fn(f32, f32, &mut Rng) -> crate::math::Vec3 + Sync,
+{
+    let (w, h) = (settings.width, settings.height);
+    let tiles_x = w.div_ceil(TILE);
+    let tiles_y = h.div_ceil(TILE);
+    control.progress.start(phase, (w * h) as u64);
+    let aa = settings.aa.max(1);
+    let inv_samples = 1.0 / (aa * aa) as f32;
+    let tiles: Vec<Option<Vec<crate::math::Vec3>>> = (0..tiles_x * tiles_y)
+        .into_par_iter()
+        .map(|tile| {
+            if control.cancelled() {
+                return None;
+            }
+            let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
+            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+            let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let mut rng = Rng::new(settings.seed, (y * w + x) as u64);
+                    let mut sum = crate::math::Vec3::ZERO;
+                    for sy in 0..aa {
+                        for sx in 0..aa {
+                            let (jx, jy) = if aa == 1 { (0.5, 0.5) } else { (rng.uniform(), rng.uniform()) };
+                            let px = x as f32 + (sx as f32 + jx) / aa as f32;
+                            let py = y as f32 + (sy as f32 + jy) / aa as f32;
+                            // Screen y runs upwards; film rows run downwards.
+                            sum += sample(px / w as f32, 1.0 - py / h as f32, &mut rng);
+                        }
+                    }
+                    out.push(sum * inv_samples);
+                }
+            }
+            control.progress.advance(out.len() as u64);
+            Some(out)
+        })
+        .collect();
+    control.progress.finish();
+    let mut film = Film::new(w, h);
+    let mut complete = true;
+    for (tile, pixels) in tiles.into_iter().enumerate() {
+        let Some(pixels) = pixels else {
+            complete = false;
+            continue;
+        };
+        let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
+        let tw = (x0 + TILE).min(w) - x0;
+        for (i, p) in pixels.into_iter().enumerate() {
+            film.pixels[(y0 + i / tw) * w + x0 + i % tw] = p;
+        }
+    }
+    (film, complete)
+}
+
+/// The image size for a camera: `width` as given, height from the aspect ratio unless given.
+pub fn image_size(camera: &Camera, width: usize, height: Option<usize>) -> (usize, usize) {
+    (width, height.unwrap_or_else(|| camera.height_for_width(width)))
+}

@@ -1,0 +1,141 @@
+//! The course's Whitted ray tracer (§9): emission, ambient, Phong per light with the course's
+//! attenuation and shadows filtered by each occluder's `transmissive`, recursive mirror
+//! reflection and refraction (no Fresnel), plus an optional caustic term from the photon map.
+
+use crate::material::SurfaceParams;
+use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
+use crate::scene::{Scene, SurfaceHit};
+
+/// Settings of the Whitted integrator.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WhittedSettings {
+    /// Maximum number of recursive reflection/refraction bounces.
+    pub max_depth: u32,
+    /// Spawn reflection rays for rays travelling inside a transmissive object (the 2019 skeleton's
+    /// expected behaviour is false).
+    pub internal_reflection: bool,
+    /// Add highlights where a transmissive surface is seen from its back (expected: false).
+    pub backface_specular: bool,
+}
+
+impl Default for WhittedSettings {
+    fn default() -> Self {
+        WhittedSettings {
+            max_depth: 5,
+            internal_reflection: false,
+            backface_specular: false,
+        }
+    }
+}
+
+/// Recursion stops once a path's weight falls below this: it could not change an 8-bit pixel.
+const MIN_PATH_WEIGHT: f32 = 1.0 / 1024.0;
+
+/// Radiance along `ray` (unit direction). `caustic(hit, wo, n)` adds light estimated from photons
+/// at a surface point, given the direction to the viewer and the normal facing it.
+pub fn radiance<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, caustic: &C) -> Vec3
+where
+    C: Fn(&SurfaceHit, Vec3, Vec3) -> Vec3,
+{
+    trace(scene, settings, ray, 0, Vec3::ONE, caustic)
+}
+
+fn trace<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, depth: u32, weight: Vec3, caustic: &C) -> Vec3
+where
+    C: Fn(&SurfaceHit, Vec3, Vec3) -> Vec3,
+{
+    let Some(isect) = scene.intersect(ray, f32::INFINITY) else {
+        return Vec3::ZERO;
+    };
+    let hit = scene.surface(ray, &isect);
+    let p = &hit.params;
+    let d = ray.dir;
+    let wo = -d;
+    // Rays meeting the outward normal from behind are inside the object.
+    let entering = d.dot(hit.geometric_normal) < 0.0;
+    let n = if d.dot(hit.shading_normal) > 0.0 { -hit.shading_normal } else { hit.shading_normal };
+    let inside_transmissive = !entering && p.transmissive != Vec3::ZERO;
+
+    let mut color = p.emissive + p.ambient * scene.ambient;
+    let shade_specular = settings.backface_specular || !inside_transmissive;
+    let local = SurfaceParams {
+        specular: if shade_specular { p.specular } else { Vec3::ZERO },
+        ..*p
+    };
+    if local.diffuse != Vec3::ZERO || local.specular != Vec3::ZERO {
+        color += direct_light(scene, &hit, &local, n, wo);
+        color += caustic(&hit, wo, n);
+    }
+
+    if depth >= settings.max_depth {
+        return color;
+    }
+    if p.reflective != Vec3::ZERO && (settings.internal_reflection || !inside_transmissive) {
+        let w = weight * p.reflective;
+        if w.max_element() >= MIN_PATH_WEIGHT {
+            let dir = reflect(d, n);
+            let origin = offset_origin(hit.point, hit.geometric_normal, dir);
+            color += p.reflective * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w, caustic);
+        }
+    }
+    if p.transmissive != Vec3::ZERO {
+        let w = weight * p.transmissive;
+        if w.max_element() >= MIN_PATH_WEIGHT {
+            let (eta, n_in) = refraction_geometry(p.index, entering, hit.shading_normal);
+            if let Some(dir) = refract(d, n_in, eta) {
+                let origin = offset_origin(hit.point, hit.geometric_normal, dir);
+                color += p.transmissive * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w, caustic);
+            }
+        }
+    }
+    color
+}
+
+/// §9's refraction convention: entering, η = 1/index with the outward normal; leaving,
+/// η = index with the inward normal. Returns (η, normal facing the incoming ray).
+#[inline]
+pub fn refraction_geometry(index: f32, entering: bool, outward_normal: Vec3) -> (f32, Vec3) {
+    let index = if index > 0.0 { index } else { 1.0 };
+    if entering {
+        (1.0 / index, outward_normal)
+    } else {
+        (index, -outward_normal)
+    }
+}
+
+/// Σ over lights of f(d)·S·I ⊙ [kd (N·L) + ks (V·R)^ns].
+fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3, wo: Vec3) -> Vec3 {
+    let mut sum = Vec3::ZERO;
+    for light in &scene.lights {
+        let Some(ls) = light.sample_li(hit.point) else { continue };
+        let cos = n.dot(ls.wi);
+        if cos <= 0.0 {
+            continue;
+        }
+        let shadow = transmittance(scene, hit.point, hit.geometric_normal, ls.wi, ls.distance);
+        if shadow == Vec3::ZERO {
+            continue;
+        }
+        sum += ls.intensity * shadow * params.phong_reflectance(n, wo, ls.wi) * cos;
+    }
+    sum
+}
+
+/// The product of the `transmissive` colours of everything between `point` and a light at
+/// `distance` along `wi` (zero when an opaque object is in the way).
+pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec3, distance: f32) -> Vec3 {
+    let origin = offset_origin(point, geometric_normal, wi);
+    let ray = Ray::new(origin, wi);
+    let t_max = if distance.is_finite() { (distance - (origin - point).length()) * (1.0 - 1e-5) } else { f32::INFINITY };
+    let mut filter = Vec3::ONE;
+    let blocked = scene.any_hit(&ray, t_max, |isect| {
+        let kt = scene.surface(&ray, isect).params.transmissive;
+        filter *= kt;
+        filter == Vec3::ZERO
+    });
+    if blocked {
+        Vec3::ZERO
+    } else {
+        filter
+    }
+}

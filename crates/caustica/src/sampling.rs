@@ -1,0 +1,172 @@
+//! Random numbers and sample warps, each warp beside its pdf.
+//!
+//! Every pixel and every photon draws from its own stream, derived from (seed, index), so images
+//! and photon maps do not depend on the number of threads.
+
+use crate::math::{Frame, Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// A small, fast generator (PCG-XSH-RR 64/32) with an independent stream per index.
+#[derive(Clone, Debug)]
+pub struct Rng {
+    state: u64,
+    inc: u64,
+}
+
+const MULTIPLIER: u64 = 6364136223846793005;
+
+impl Rng {
+    /// The stream for `index` under `seed`.
+    pub fn new(seed: u64, index: u64) -> Rng {
+        let mut rng = Rng {
+            state: 0,
+            inc: (mix64(seed ^ 0x9e37_79b9_7f4a_7c15) << 1) | 1,
+        };
+        rng.next_u32();
+        rng.state = rng.state.wrapping_add(mix64(index.wrapping_add(seed.rotate_left(32))));
+        rng.next_u32();
+        rng
+    }
+
+    /// Next 32 random bits.
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = old.wrapping_mul(MULTIPLIER).wrapping_add(self.inc);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
+    }
+
+    /// Uniform in [0, 1).
+    #[inline]
+    pub fn uniform(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
+    }
+
+    /// Two uniforms in [0, 1).
+    #[inline]
+    pub fn uniform2(&mut self) -> Vec2 {
+        Vec2::new(self.uniform(), self.uniform())
+    }
+}
+
+/// SplitMix64's finaliser: a bijective mix of 64 bits.
+#[inline]
+pub fn mix64(mut z: u64) -> u64 {
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    z ^ (z >> 31)
+}
+
+/// A uniformly distributed unit vector.
+#[inline]
+pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Solid-angle pdf of [`sample_uniform_sphere`].
+#[inline]
+pub fn uniform_sphere_pdf() -> f32 {
+    1.0 / (4.0 * PI)
+}
+
+/// A direction in the cone of half-angle `acos(cos_max)` around `axis`, uniform in solid angle.
+#[inline]
+pub fn sample_uniform_cone(u: Vec2, axis: Vec3, cos_max: f32) -> Vec3 {
+    let cos_theta = 1.0 - u.x * (1.0 - cos_max);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Frame::from_normal(axis).to_world(Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta))
+}
+
+/// Solid-angle pdf of [`sample_uniform_cone`] inside the cone.
+#[inline]
+pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
+    1.0 / (2.0 * PI * (1.0 - cos_max))
+}
+
+/// A point on the unit disc, uniform in area (concentric mapping).
+#[inline]
+pub fn sample_uniform_disc(u: Vec2) -> Vec2 {
+    let a = 2.0 * u - Vec2::ONE;
+    if a.x == 0.0 && a.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if a.x.abs() > a.y.abs() {
+        (a.x, PI / 4.0 * (a.y / a.x))
+    } else {
+        (a.y, PI / 2.0 - PI / 4.0 * (a.x / a.y))
+    };
+    Vec2::new(r * theta.cos(), r * theta.sin())
+}
+
+/// A cosine-weighted direction about +z.
+#[inline]
+pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = sample_uniform_disc(u);
+    Vec3::new(d.x, d.y, (1.0 - d.length_squared()).max(0.0).sqrt())
+}
+
+/// Solid-angle pdf of [`sample_cosine_hemisphere`] for a direction with `cos_theta` to +z.
+#[inline]
+pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
+    cos_theta.max(0.0) / PI
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn streams_differ_and_repeat() {
+        let a: Vec<u32> = (0..4).map(|_| Rng::new(1, 7).next_u32()).collect();
+        assert!(a.windows(2).all(|w| w[0] == w[1]), "same stream, same numbers");
+        let mut x = Rng::new(1, 7);
+        let mut y = Rng::new(1, 8);
+        let same = (0..64).filter(|_| x.next_u32() == y.next_u32()).count();
+        assert!(same < 2);
+    }
+
+    #[test]
+    fn uniform_mean_and_range() {
+        let mut rng = Rng::new(3, 0);
+        let n = 100_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            let u = rng.uniform();
+            assert!((0.0..1.0).contains(&u));
+            sum += u as f64;
+        }
+        assert!((sum / n as f64 - 0.5).abs() < 0.005);
+    }
+
+    #[test]
+    fn cone_samples_stay_in_cone_and_cover_its_solid_angle() {
+        let mut rng = Rng::new(5, 0);
+        let axis = Vec3::new(1.0, 2.0, -0.5).normalize();
+        let cos_max = 0.9;
+        let mut mean = Vec3::ZERO;
+        for _ in 0..20_000 {
+            let d = sample_uniform_cone(rng.uniform2(), axis, cos_max);
+            assert!(d.dot(axis) >= cos_max - 1e-5);
+            assert!((d.length() - 1.0).abs() < 1e-4);
+            mean += d;
+        }
+        // The mean direction of a uniform cone is the axis scaled by (1 + cos_max) / 2.
+        let m = mean / 20_000.0;
+        assert!((m.dot(axis) - 0.95).abs() < 0.002);
+        assert!((uniform_cone_pdf(-1.0) - uniform_sphere_pdf()).abs() < 1e-7);
+    }
+
+    #[test]
+    fn cosine_hemisphere_mean_cosine_is_two_thirds() {
+        let mut rng = Rng::new(9, 1);
+        let n = 50_000;
+        let s: f32 = (0..n).map(|_| sample_cosine_hemisphere(rng.uniform2()).z).sum();
+        assert!((s / n as f32 - 2.0 / 3.0).abs() < 0.005);
+    }
+}

@@ -1,0 +1,265 @@
+//! From a parsed description to a renderable [`Scene`]: textures loaded once per path, shapes
+//! placed, meshes moved to world space, and the BVH built.
+
+use super::ray_file::ast::{LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span};
+use super::ray_file::{self, ParseOptions};
+use super::{Mesh, Scene, TriangleRef};
+use crate::camera::Camera;
+use crate::error::{Error, ParseError, Result};
+use crate::geometry::cone::Cone;
+use crate::geometry::triangle::Triangle;
+use crate::geometry::{Shape, ShapeKind, ShapeSettings};
+use crate::image_io;
+use crate::light::Light;
+use crate::material::{Channel, Material};
+use crate::math::{Aabb, Mat3, Vec3};
+use crate::texture::Texture;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Options for building a scene.
+#[derive(Clone, Debug, Default)]
+pub struct BuildSettings {
+    /// How shapes are built.
+    pub shapes: ShapeSettings,
+    /// How the file is read.
+    pub parse: ParseOptions,
+}
+
+/// Reads, parses and builds the scene file at `path`.
+pub fn load(path: &Path, settings: &BuildSettings) -> Result<Scene> {
+    let bytes = std::fs::read(path).map_err(|source| Error::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let text = match String::from_utf8(bytes) {
+        Ok(text) => text,
+        Err(e) => {
+            let offset = e.utf8_error().valid_up_to();
+            let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
+            return Err(Error::Scene {
+                path: path.to_path_buf(),
+                text,
+                error: ParseError::new("the file is not valid UTF-8 text", offset..offset + 1),
+            });
+        }
+    };
+    let dir = path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
+    from_text(&text, &dir, settings).map_err(|error| Error::Scene {
+        path: path.to_path_buf(),
+        text,
+        error,
+    })
+}
+
+/// Parses and builds scene text; textures resolve against `scene_dir`.
+pub fn from_text(text: &str, scene_dir: &Path, settings: &BuildSettings) -> Result<Scene, ParseError> {
+    let desc = ray_file::parse(text, scene_dir, &settings.parse)?;
+    build(&desc, settings)
+}
+
+/// Builds a scene from its description.
+pub fn build(desc: &SceneDescription, settings: &BuildSettings) -> Result<Scene, ParseError> {
+    let mut builder = Builder::default();
+    let camera = desc.camera.as_ref().map(Camera::from_desc).unwrap_or_default();
+    let lights = desc.lights.iter().filter_map(convert_light).collect();
+    let mut warnings: Vec<String> = desc.warnings.iter().map(|(w, _)| w.clone()).collect();
+    if desc.camera.is_none() {
+        warnings.push("the scene has no camera: using the default one at the origin looking down −z".into());
+    }
+    if desc.lights.is_empty() && desc.ambient == Vec3::ZERO && !desc.objects.iter().any(|o| material_is_emissive(&o.material)) {
+        warnings.push("the scene has no lights: the image will be black".into());
+    }
+    for object in &desc.objects {
+        builder.add_object(object, &settings.shapes, &mut warnings)?;
+    }
+    Ok(Scene::assemble(
+        camera,
+        lights,
+        desc.ambient,
+        builder.materials,
+        builder.textures,
+        builder.shapes,
+        builder.shape_materials,
+        builder.meshes,
+        builder.triangles,
+        builder.triangle_refs,
+        warnings,
+    ))
+}
+
+fn material_is_emissive(m: &MaterialDesc) -> bool {
+    !matches!(m.emissive, Param::Constant(c) if c == Vec3::ZERO)
+}
+
+fn convert_light(light: &LightDesc) -> Option<Light> {
+    match light {
+        LightDesc::Point { position, color, attenuation, .. } => Some(Light::Point {
+            position: *position,
+            color: *color,
+            attenuation: *attenuation,
+        }),
+        LightDesc::Directional { direction, color, .. } => {
+            let direction = direction.normalize_or_zero();
+            (direction != Vec3::ZERO).then_some(Light::Directional { direction, color: *color })
+        }
+    }
+}
+
+#[derive(Default)]
+struct Builder {
+    materials: Vec<Material>,
+    material_ids: HashMap<MaterialKey, u32>,
+    textures: Vec<Texture>,
+    texture_ids: HashMap<PathBuf, u32>,
+    shapes: Vec<Shape>,
+    shape_materials: Vec<u32>,
+    meshes: Vec<Mesh>,
+    triangles: Vec<Triangle>,
+    triangle_refs: Vec<TriangleRef>,
+}
+
+/// Materials are deduplicated by their exact bits.
+#[derive(Clone, PartialEq, Eq, Hash)]
+struct MaterialKey(Vec<u32>);
+
+impl Builder {
+    fn add_object(&mut self, object: &ObjectDesc, settings: &ShapeSettings, warnings: &mut Vec<String>) -> Result<(), ParseError> {
+        let material = self.material(&object.material)?;
+        let m = object.world_from_object;
+        let kind = match &object.shape {
+            ShapeDesc::Sphere => ShapeKind::Sphere,
+            ShapeDesc::Box => ShapeKind::Cube,
+            ShapeDesc::Square => ShapeKind::Square,
+            ShapeDesc::Cylinder { capped } => ShapeKind::cylinder(*capped),
+            ShapeDesc::Cone { height, bottom_radius, top_radius, capped } => {
+                if !(*height > 0.0 && height.is_finite()) {
+                    return Err(ParseError::new(format!("a cone needs a positive height, not {height}"), object.span.clone()));
+                }
+                ShapeKind::Cone(Cone::new(*height, *bottom_radius, *top_radius, *capped, settings.cone_quirks))
+            }
+            ShapeDesc::Trimesh(mesh) => return self.add_mesh(object, mesh, material, warnings),
+        };
+        let shape = Shape::new(kind, m).ok_or_else(|| singular(&object.span))?;
+        self.shapes.push(shape);
+        self.shape_materials.push(material);
+        Ok(())
+    }
+
+    fn add_mesh(
+        &mut self,
+        object: &ObjectDesc,
+        desc: &super::ray_file::ast::TrimeshDesc,
+        material: u32,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), ParseError> {
+        let m = object.world_from_object;
+        let det = m.determinant();
+        if !det.is_finite() || det.abs() < 1e-12 {
+            return Err(singular(&object.span));
+        }
+        let normal_to_world = Mat3::from_mat4(m.inverse()).transpose();
+        let points: Vec<Vec3> = desc.points.iter().map(|p| m.transform_point3(*p)).collect();
+        let normals = desc.normals.as_ref().map(|ns| ns.iter().map(|n| (normal_to_world * *n).normalize_or_zero()).collect());
+        let vertex_materials = match &desc.materials {
+            Some(ms) => Some(ms.iter().map(|md| self.material(md)).collect::<Result<Vec<u32>, ParseError>>()?),
+            None => None,
+        };
+        let mesh_index = self.meshes.len() as u32;
+        let mut indices = Vec::with_capacity(desc.triangles.len());
+        let mut bounds = Aabb::EMPTY;
+        let mut dropped = 0usize;
+        for tri in &desc.triangles {
+            let [a, b, c] = tri.map(|i| points[i as usize]);
+            let t = Triangle::new(a, b, c);
+            if t.geometric_normal() == Vec3::ZERO || !t.bounds().min.is_finite() || !t.bounds().max.is_finite() {
+                dropped += 1;
+                continue;
+            }
+            bounds = bounds.union(t.bounds());
+            self.triangle_refs.push(TriangleRef {
+                mesh: mesh_index,
+                index: indices.len() as u32,
+            });
+            self.triangles.push(t);
+            indices.push(*tri);
+        }
+        if dropped > 0 {
+            warnings.push(format!("dropped {dropped} degenerate triangle(s) of a mesh after its transform"));
+        }
+        self.meshes.push(Mesh {
+            indices,
+            normals,
+            uvs: desc.uvs.clone(),
+            vertex_materials,
+            material,
+            bounds,
+        });
+        Ok(())
+    }
+
+    fn material(&mut self, desc: &MaterialDesc) -> Result<u32, ParseError> {
+        let material = Material {
+            emissive: self.channel(&desc.emissive)?,
+            ambient: self.channel(&desc.ambient)?,
+            specular: self.channel(&desc.specular)?,
+            reflective: self.channel(&desc.reflective)?,
+            diffuse: self.channel(&desc.diffuse)?,
+            transmissive: self.channel(&desc.transmissive)?,
+            shininess: self.channel(&desc.shininess)?,
+            index: self.channel(&desc.index)?,
+        };
+        let key = MaterialKey(
+            [
+                material.emissive,
+                material.ambient,
+                material.specular,
+                material.reflective,
+                material.diffuse,
+                material.transmissive,
+                material.shininess,
+                material.index,
+            ]
+            .iter()
+            .flat_map(|c| match c {
+                Channel::Constant(v) => [0, v.x.to_bits(), v.y.to_bits(), v.z.to_bits()],
+                Channel::Texture(i) => [1, *i, 0, 0],
+            })
+            .collect(),
+        );
+        if let Some(&id) = self.material_ids.get(&key) {
+            return Ok(id);
+        }
+        let id = self.materials.len() as u32;
+        self.materials.push(material);
+        self.material_ids.insert(key, id);
+        Ok(id)
+    }
+
+    fn channel(&mut self, param: &Param) -> Result<Channel, ParseError> {
+        match param {
+            Param::Constant(c) => Ok(Channel::Constant(*c)),
+            Param::Texture { path, span } => {
+                if let Some(&id) = self.texture_ids.get(path) {
+                    return Ok(Channel::Texture(id));
+                }
+                let texture = image_io::load_texture(path).map_err(|e| {
+                    let reason = match e {
+                        Error::Image { message, .. } => message,
+                        other => other.to_string(),
+                    };
+                    ParseError::new(format!("cannot read the texture `{}`: {reason}", path.display()), span.clone())
+                        .with_help("texture paths are resolved against the scene file's folder; PNG and BMP are supported")
+                })?;
+                let id = self.textures.len() as u32;
+                self.textures.push(texture);
+                self.texture_ids.insert(path.clone(), id);
+                Ok(Channel::Texture(id))
+            }
+        }
+    }
+}
+
+fn singular(span: &Span) -> ParseError {
+    ParseError::new("this object's transform is singular (a zero scale or a degenerate matrix)", span.clone())
+}
