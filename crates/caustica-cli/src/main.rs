@@ -1,1 +1,37 @@
-fn main() {}
+//! The `caustica` command: a thin layer over the library that parses arguments, shows progress,
+//! prints diagnostics and maps failures to exit codes (0 ok, 1 internal, 2 bad input, 130
+//! interrupted).
+
+mod cli;
+mod commands;
+mod diagnostics;
+mod interrupt;
+mod progress;
+
+use clap::Parser;
+use std::process::ExitCode;
+
+/// Exit code for a malformed scene, a bad option or an unreadable file.
+pub const EXIT_BAD_INPUT: u8 = 2;
+/// Exit code after Ctrl-C.
+pub const EXIT_INTERRUPTED: u8 = 130;
+/// Exit code for a failure that is caustica's fault.
+pub const EXIT_INTERNAL: u8 = 1;
+
+fn main() -> ExitCode {
+    let cli = cli::Cli::parse();
+    let cancel = interrupt::install();
+    let result = match cli.command {
+        cli::Command::Render(args) => commands::render::run(args, cancel),
+        cli::Command::Info(args) => commands::info::run(args),
+        cli::Command::Photons(args) => commands::photons::run(args, cancel),
+    };
+    match result {
+        Ok(code) => ExitCode::from(code),
+        Err(error) => {
+            let code = if error.is_bad_input() { EXIT_BAD_INPUT } else { EXIT_INTERNAL };
+            eprintln!("{:?}", diagnostics::report(error));
+            ExitCode::from(code)
+        }
+    }
+}

@@ -1,3 +1,168 @@
-//! Photons: emission from lights, specular paths, the photon map and the radiance estimate.
+//! Photons: emission from lights, specular paths, the photon map and the radiance estimate
+//! (Jensen, "Rendering Caustics on Non-Lambertian Surfaces", GI 1996).
+//!
+//! A photon is stored compactly in 24 bytes: position (3 × f32), power in Ward's shared-exponent
+//! RGBE (4 bytes, as in Jensen's own photon map), the incoming direction in 32-bit octahedral
+//! form, the receiver's normal in 16-bit octahedral form, and path flags.
 
+pub mod emit;
 pub mod kd_tree;
+pub mod map;
+pub mod picture;
+pub mod trace;
+
+pub use map::{EstimateSettings, PhotonMap};
+pub use trace::{PhotonSettings, PhotonStats};
+
+use crate::math::{Vec2, Vec3};
+
+/// The path reached the surface by at least one specular reflection.
+pub const REFLECTED: u8 = 1;
+/// The path reached the surface by at least one refraction.
+pub const REFRACTED: u8 = 2;
+
+/// A stored photon.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Photon {
+    /// Where it landed.
+    pub position: Vec3,
+    power: [u8; 4],
+    direction: [u16; 2],
+    normal: [u8; 2],
+    /// [`REFLECTED`] and/or [`REFRACTED`].
+    pub flags: u8,
+    /// The light that emitted it.
+    pub light: u8,
+}
+
+impl Photon {
+    /// Packs a photon; `direction` is the unit direction it travelled, `normal` the unit surface
+    /// normal on the side it arrived from.
+    pub fn new(position: Vec3, power: Vec3, direction: Vec3, normal: Vec3, flags: u8, light: u8) -> Photon {
+        Photon {
+            position,
+            power: encode_rgbe(power),
+            direction: encode_oct16(direction),
+            normal: encode_oct8(normal),
+            flags,
+            light,
+        }
+    }
+
+    /// Power (flux).
+    #[inline]
+    pub fn power(&self) -> Vec3 {
+        decode_rgbe(self.power)
+    }
+
+    /// Replaces the power.
+    pub fn set_power(&mut self, power: Vec3) {
+        self.power = encode_rgbe(power);
+    }
+
+    /// Unit direction of travel.
+    #[inline]
+    pub fn direction(&self) -> Vec3 {
+        decode_oct(Vec2::new(self.direction[0] as f32, self.direction[1] as f32) / 65535.0)
+    }
+
+    /// Unit normal of the surface it landed on, facing where it came from (8-bit precision).
+    #[inline]
+    pub fn normal(&self) -> Vec3 {
+        decode_oct(Vec2::new(self.normal[0] as f32, self.normal[1] as f32) / 255.0)
+    }
+}
+
+impl kd_tree::KdPoint for Photon {
+    #[inline]
+    fn position(&self) -> Vec3 {
+        self.position
+    }
+}
+
+/// Ward's RGBE: three 8-bit mantissas sharing an 8-bit exponent (rounded to nearest).
+fn encode_rgbe(c: Vec3) -> [u8; 4] {
+    let c = c.max(Vec3::ZERO);
+    let m = c.max_element();
+    if !(m > 1e-32) || !m.is_finite() {
+        return [0; 4];
+    }
+    let mut e = m.log2().floor() as i32 + 1;
+    let mut scale = (-e as f32).exp2() * 256.0;
+    if (m * scale).round() >= 256.0 {
+        e += 1;
+        scale *= 0.5;
+    }
+    let q = |x: f32| (x * scale).round().min(255.0) as u8;
+    [q(c.x), q(c.y), q(c.z), (e + 128).clamp(0, 255) as u8]
+}
+
+fn decode_rgbe(c: [u8; 4]) -> Vec3 {
+    if c[3] == 0 {
+        return Vec3::ZERO;
+    }
+    let f = ((c[3] as i32 - 128 - 8) as f32).exp2();
+    Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * f
+}
+
+/// Octahedral map of a unit vector to [0, 1]².
+fn encode_oct(v: Vec3) -> Vec2 {
+    let v = v / (v.x.abs() + v.y.abs() + v.z.abs()).max(1e-30);
+    let p = if v.z >= 0.0 {
+        Vec2::new(v.x, v.y)
+    } else {
+        Vec2::new((1.0 - v.y.abs()) * v.x.signum(), (1.0 - v.x.abs()) * v.y.signum())
+    };
+    p * 0.5 + Vec2::splat(0.5)
+}
+
+fn decode_oct(e: Vec2) -> Vec3 {
+    let p = e * 2.0 - Vec2::ONE;
+    let z = 1.0 - p.x.abs() - p.y.abs();
+    let t = (-z).max(0.0);
+    let x = p.x - t.copysign(p.x);
+    let y = p.y - t.copysign(p.y);
+    Vec3::new(x, y, z).normalize_or_zero()
+}
+
+fn encode_oct16(v: Vec3) -> [u16; 2] {
+    let e = encode_oct(v);
+    [(e.x * 65535.0).round() as u16, (e.y * 65535.0).round() as u16]
+}
+
+fn encode_oct8(v: Vec3) -> [u8; 2] {
+    let e = encode_oct(v);
+    [(e.x * 255.0).round() as u8, (e.y * 255.0).round() as u8]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn photon_is_24_bytes() {
+        assert_eq!(std::mem::size_of::<Photon>(), 24);
+    }
+
+    #[test]
+    fn power_round_trips_within_rgbe_precision() {
+        for c in [Vec3::new(1.0, 0.5, 0.25), Vec3::new(3e-6, 1e-6, 0.0), Vec3::new(1234.5, 1.0, 700.0), Vec3::splat(0.999)] {
+            let back = decode_rgbe(encode_rgbe(c));
+            let tol = c.max_element() / 256.0;
+            assert!((back - c).abs().max_element() <= tol, "{c:?} -> {back:?}");
+        }
+        assert_eq!(decode_rgbe(encode_rgbe(Vec3::ZERO)), Vec3::ZERO);
+        assert_eq!(decode_rgbe(encode_rgbe(Vec3::splat(f32::NAN))), Vec3::ZERO);
+    }
+
+    #[test]
+    fn directions_round_trip() {
+        let dirs = [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.8, -0.52).normalize(), Vec3::new(-0.577, 0.577, 0.577).normalize()];
+        for d in dirs {
+            let p = Photon::new(Vec3::ZERO, Vec3::ONE, d, d, 0, 0);
+            assert!(p.direction().dot(d) > 0.99999, "{d:?} {:?}", p.direction());
+            assert!(p.normal().dot(d) > 0.995);
+        }
+    }
+}

@@ -139,3 +139,26 @@ pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec
         filter
     }
 }
+
+/// Renders the Whitted image, adding the photon map's caustics where a map is given.
+pub fn render(
+    scene: &Scene,
+    caustics: Option<(&crate::photon::PhotonMap, &crate::photon::EstimateSettings)>,
+    settings: &WhittedSettings,
+    image: &super::ImageSettings,
+    control: super::Control,
+) -> (crate::film::Film, bool) {
+    let camera = &scene.camera;
+    super::render_tiles(image, control, "render", |sx, sy, _rng| {
+        let ray = camera.generate_ray(sx, sy);
+        match caustics {
+            Some((map, estimate)) => radiance(scene, settings, &ray, &|hit: &SurfaceHit, wo: Vec3, n: Vec3| {
+                if hit.params.diffuse == Vec3::ZERO && hit.params.specular == Vec3::ZERO {
+                    return Vec3::ZERO;
+                }
+                map.radiance(hit.point, n, wo, &hit.params, estimate)
+            }),
+            None => radiance(scene, settings, &ray, &|_: &SurfaceHit, _: Vec3, _: Vec3| Vec3::ZERO),
+        }
+    })
+}

@@ -1,0 +1,93 @@
+//! One module per subcommand, plus what they share.
+
+pub mod info;
+pub mod photons;
+pub mod render;
+
+use crate::cli::{PhotonOptions, SceneArgs};
+use caustica::photon::PhotonSettings;
+use caustica::scene::ray_file::ast::Dialect;
+use caustica::scene::ray_file::ParseOptions;
+use caustica::scene::{presets, BuildSettings, Scene};
+use caustica::{Error, Result};
+use std::path::Path;
+
+/// Largest image side accepted: beyond it the film alone would not fit in memory.
+const MAX_SIDE: usize = 32_768;
+/// Largest pixel count (1 GiB of float RGB film).
+const MAX_PIXELS: usize = 1 << 26;
+/// Largest photon count accepted (24 bytes each: 2.4 GB).
+const MAX_PHOTONS: usize = 100_000_000;
+
+/// Build settings from the command line.
+pub fn build_settings(args: &SceneArgs) -> BuildSettings {
+    let mut settings = BuildSettings::default();
+    settings.shapes.cone_quirks = args.cone_quirks;
+    settings.parse = ParseOptions {
+        dialect: match args.dialect.as_deref() {
+            Some("tokenizer") => Some(Dialect::Tokenizer),
+            Some("dictionary") => Some(Dialect::Dictionary),
+            _ => None,
+        },
+    };
+    settings
+}
+
+/// Loads the scene file, or the built-in ring scene when no path is given.
+pub fn load_scene(path: Option<&Path>, args: &SceneArgs) -> Result<Scene> {
+    let settings = build_settings(args);
+    match path {
+        Some(path) => caustica::scene::load(path, &settings),
+        None => caustica::scene::build::from_text(presets::RING, Path::new("."), &settings).map_err(|error| Error::Scene {
+            path: "<built-in ring scene>".into(),
+            text: presets::RING.to_string(),
+            error,
+        }),
+    }
+}
+
+/// Makes a thread pool of `threads` workers (all cores by default).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    if threads == Some(0) || threads.is_some_and(|t| t > 1024) {
+        return Err(Error::InvalidSettings("--threads must be between 1 and 1024".into()));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| Error::InvalidSettings(format!("cannot start worker threads: {e}")))
+}
+
+/// Refuses image sizes that cannot be rendered, before any memory is committed.
+pub fn check_image_size(width: usize, height: usize) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::InvalidSettings("the image needs a width and height of at least 1 pixel".into()));
+    }
+    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
+        return Err(Error::InvalidSettings(format!(
+            "{width}×{height} is too large: at most {MAX_SIDE} pixels a side and {MAX_PIXELS} pixels in all"
+        )));
+    }
+    Ok(())
+}
+
+/// Photon settings from the command line, checked.
+pub fn photon_settings(options: &PhotonOptions, seed: u64) -> Result<PhotonSettings> {
+    let total = match &options.photons_per_light {
+        Some(counts) => counts.iter().fold(0usize, |a, b| a.saturating_add(*b)),
+        None => options.photons,
+    };
+    if total > MAX_PHOTONS {
+        return Err(Error::InvalidSettings(format!(
+            "{total} photons would need {} MB; at most {MAX_PHOTONS} photons are accepted",
+            total.saturating_mul(24) / 1_000_000
+        )));
+    }
+    Ok(PhotonSettings {
+        target_stored: total,
+        max_emitted: options.max_emitted.unwrap_or(0),
+        aim: !options.no_aim,
+        seed,
+        per_light: options.photons_per_light.clone(),
+        ..PhotonSettings::default()
+    })
+}

@@ -1,0 +1,177 @@
+//! The photon map: photons in kd-tree order and Jensen's radiance estimate.
+//!
+//! L(x, ωo) ≈ Σ_p f(x, ωo, ωp) Φp / (π r²) over the k nearest photons within r (Jensen 1996,
+//! eq. 6), with the reflectance evaluated for each photon's own incoming direction, an optional
+//! cone filter (eq. 7) and a disc-shaped gather: photons whose stored normal disagrees with the
+//! receiver's, or that lie off its tangent plane, do not count — light cannot bleed through a
+//! thin wall or round a corner.
+
+use super::kd_tree::{KdTree, Neighbor};
+use super::trace::{trace_photons, PhotonSettings, PhotonStats};
+use super::Photon;
+use crate::integrator::Control;
+use crate::material::SurfaceParams;
+use crate::math::Vec3;
+use crate::scene::Scene;
+use std::cell::RefCell;
+use std::f32::consts::PI;
+
+/// How the radiance estimate gathers photons.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EstimateSettings {
+    /// Photons per estimate (k nearest).
+    pub k: usize,
+    /// Largest gather radius; `None` picks one from the photon density ([`PhotonMap::auto_radius`]).
+    pub max_radius: Option<f32>,
+    /// Cone filter constant (Jensen's k ≥ 1); `None` for a plain box (uniform) filter.
+    pub cone_filter: Option<f32>,
+    /// Least cosine between a photon's stored normal and the receiver's normal.
+    pub min_normal_cosine: f32,
+    /// Largest distance off the receiver's tangent plane, as a fraction of the gather radius.
+    pub max_plane_distance: f32,
+}
+
+impl Default for EstimateSettings {
+    fn default() -> Self {
+        EstimateSettings {
+            k: 100,
+            max_radius: None,
+            cone_filter: Some(1.1),
+            min_normal_cosine: 0.7,
+            max_plane_distance: 0.25,
+        }
+    }
+}
+
+/// Stored photons and the tree over them.
+pub struct PhotonMap {
+    photons: Vec<Photon>,
+    tree: KdTree,
+    auto_radius: f32,
+    /// What the photon pass did.
+    pub stats: PhotonStats,
+}
+
+thread_local! {
+    static NEIGHBORS: RefCell<Vec<Neighbor>> = const { RefCell::new(Vec::new()) };
+}
+
+impl PhotonMap {
+    /// Traces photons through `scene` and builds the map.
+    pub fn trace(scene: &Scene, settings: &PhotonSettings, estimate_k: usize, control: Control) -> PhotonMap {
+        let (photons, stats) = trace_photons(scene, settings, control);
+        PhotonMap::from_photons(photons, stats, estimate_k)
+    }
+
+    /// Builds the map over photons (reordering them); the automatic radius is chosen for `k`.
+    pub fn from_photons(mut photons: Vec<Photon>, stats: PhotonStats, k: usize) -> PhotonMap {
+        let tree = KdTree::build(&mut photons);
+        let mut map = PhotonMap {
+            photons,
+            tree,
+            auto_radius: 0.0,
+            stats,
+        };
+        map.auto_radius = map.density_radius(k);
+        map
+    }
+
+    /// The photons, in tree order.
+    pub fn photons(&self) -> &[Photon] {
+        &self.photons
+    }
+
+    /// Number of photons.
+    pub fn len(&self) -> usize {
+        self.photons.len()
+    }
+
+    /// Whether the map holds no photon.
+    pub fn is_empty(&self) -> bool {
+        self.photons.is_empty()
+    }
+
+    /// The automatic largest gather radius: twice the median distance to the k-th nearest
+    /// photon, measured around 256 photons spread through the map. Where photons are dense the
+    /// k nearest lie well inside it; where they are sparse it stops the gather from reaching
+    /// across the scene.
+    pub fn auto_radius(&self) -> f32 {
+        self.auto_radius
+    }
+
+    fn density_radius(&self, k: usize) -> f32 {
+        let n = self.photons.len();
+        if n < 2 {
+            return 0.0;
+        }
+        let samples = 256.min(n);
+        let mut out = Vec::new();
+        let mut radii: Vec<f32> = (0..samples)
+            .map(|i| {
+                let p = self.photons[i * n / samples].position;
+                self.tree.k_nearest(&self.photons, p, k.max(1), f32::INFINITY, &mut out).sqrt()
+            })
+            .filter(|r| r.is_finite())
+            .collect();
+        if radii.is_empty() {
+            return 0.0;
+        }
+        radii.sort_by(f32::total_cmp);
+        2.0 * radii[radii.len() / 2]
+    }
+
+    /// Reflected radiance at `point` towards `wo` from the photons nearby; `n` is the unit
+    /// normal facing `wo`, `params` the material there.
+    pub fn radiance(&self, point: Vec3, n: Vec3, wo: Vec3, params: &SurfaceParams, settings: &EstimateSettings) -> Vec3 {
+        if self.photons.is_empty() || settings.k == 0 {
+            return Vec3::ZERO;
+        }
+        let max_r = settings.max_radius.unwrap_or(self.auto_radius);
+        if !(max_r > 0.0) {
+            return Vec3::ZERO;
+        }
+        NEIGHBORS.with(|cell| {
+            let mut neighbors = cell.borrow_mut();
+            let r2 = self.tree.k_nearest(&self.photons, point, settings.k, max_r * max_r, &mut neighbors);
+            if neighbors.is_empty() || !(r2 > 0.0) {
+                return Vec3::ZERO;
+            }
+            let r = r2.sqrt();
+            let mut sum = Vec3::ZERO;
+            for nb in neighbors.iter() {
+                let photon = &self.photons[nb.slot as usize];
+                let offset = photon.position - point;
+                if offset.dot(n).abs() > settings.max_plane_distance * r {
+                    continue;
+                }
+                if photon.normal().dot(n) < settings.min_normal_cosine {
+                    continue;
+                }
+                let wi = -photon.direction();
+                let f = params.phong_reflectance(n, wo, wi);
+                if f == Vec3::ZERO {
+                    continue;
+                }
+                let weight = match settings.cone_filter {
+                    Some(k) => (1.0 - nb.dist2.sqrt() / (k * r)).max(0.0),
+                    None => 1.0,
+                };
+                sum += f * photon.power() * weight;
+            }
+            let normalisation = match settings.cone_filter {
+                Some(k) => 1.0 - 2.0 / (3.0 * k),
+                None => 1.0,
+            };
+            sum / (PI * r2 * normalisation)
+        })
+    }
+
+    /// Irradiance-like flux density at `point` (Σ Φ / π r², no reflectance): for checks.
+    pub fn flux_density(&self, point: Vec3, n: Vec3, settings: &EstimateSettings) -> Vec3 {
+        let lambert = SurfaceParams {
+            diffuse: Vec3::ONE,
+            ..SurfaceParams::default()
+        };
+        self.radiance(point, n, n, &lambert, settings)
+    }
+}

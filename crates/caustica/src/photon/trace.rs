@@ -1,0 +1,283 @@
+//! Photon paths: lights emit, photons follow mirrors (`reflective`) and glass (`transmissive`,
+//! `index`, total internal reflection), pick up the colour of what they meet, and are stored
+//! where they land on a diffuse or glossy surface after at least one specular bounce (L S+ D).
+//!
+//! Russian roulette chooses reflection, refraction or absorption with probabilities from the
+//! surface's colours and divides the power by the probability taken, so the estimate stays
+//! unbiased. Photons from a point light are scaled by d²·f(d) for their path length d (the
+//! course's falloff f, §5), which is exactly 1 when f = 1/d²: caustics then fall off the same way
+//! as the course's direct light (docs/radiometry.md).
+
+use super::emit::{Emitter, Target};
+use super::{Photon, REFLECTED, REFRACTED};
+use crate::integrator::whitted::refraction_geometry;
+use crate::integrator::Control;
+use crate::light::{distance_attenuation, Light};
+use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
+use crate::sampling::Rng;
+use crate::scene::Scene;
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// How photons are shot and stored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhotonSettings {
+    /// Photons to store (shared between lights by power unless `per_light` is set).
+    pub target_stored: usize,
+    /// Stop emitting after this many photons in all, stored or not.
+    pub max_emitted: u64,
+    /// Aim photons at the bounding spheres of reflective and transmissive objects.
+    pub aim: bool,
+    /// Seed of the photon streams.
+    pub seed: u64,
+    /// Longest specular chain followed.
+    pub max_bounces: u32,
+    /// Store every photon at its first surface instead (a map of direct light, for checks).
+    pub first_hit: bool,
+    /// Photons to store for each light, overriding the shared budget.
+    pub per_light: Option<Vec<usize>>,
+}
+
+impl Default for PhotonSettings {
+    fn default() -> Self {
+        PhotonSettings {
+            target_stored: 200_000,
+            max_emitted: 0,
+            aim: true,
+            seed: 0,
+            max_bounces: 32,
+            first_hit: false,
+            per_light: None,
+        }
+    }
+}
+
+impl PhotonSettings {
+    /// The emission cap in force: the set one, or 200 photons per photon to store.
+    pub fn emission_cap(&self) -> u64 {
+        if self.max_emitted > 0 {
+            self.max_emitted
+        } else {
+            (self.target_stored as u64).saturating_mul(200).max(1_000_000)
+        }
+    }
+}
+
+/// What the photon pass did, per light and in all.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PhotonStats {
+    /// Photons emitted.
+    pub emitted: u64,
+    /// Photons stored.
+    pub stored: u64,
+    /// Whether some light stopped at the emission cap before storing its share.
+    pub cap_reached: bool,
+    /// Per light: (emitted, stored).
+    pub per_light: Vec<(u64, u64)>,
+    /// Wall-clock seconds of the pass.
+    pub seconds: f64,
+}
+
+impl PhotonStats {
+    /// Stored photons per emitted photon.
+    pub fn useful_fraction(&self) -> f64 {
+        if self.emitted == 0 {
+            0.0
+        } else {
+            self.stored as f64 / self.emitted as f64
+        }
+    }
+}
+
+/// The bounding spheres photons are aimed at: one per reflective or transmissive object.
+pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
+    scene
+        .objects()
+        .filter(|(object, bounds)| scene.object_is_specular(*object) && !bounds.is_empty())
+        .map(|(_, bounds)| Target::around(&bounds))
+        .collect()
+}
+
+const BATCH: u64 = 4096;
+
+/// Traces photons from every light until the budget is stored or the cap is reached.
+pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control) -> (Vec<Photon>, PhotonStats) {
+    let start = Instant::now();
+    let targets = caustic_targets(scene);
+    let aim = settings.aim && !settings.first_hit;
+    let bounds = scene.bounds();
+    let emitters: Vec<Option<Emitter>> = scene
+        .lights
+        .iter()
+        .map(|light| {
+            if !settings.first_hit && targets.is_empty() {
+                return None;
+            }
+            Emitter::new(light, aim.then_some(&targets[..]), &bounds)
+        })
+        .collect();
+    let total_power: f32 = emitters.iter().flatten().map(Emitter::power).sum();
+    let shares: Vec<usize> = match &settings.per_light {
+        Some(counts) => (0..scene.lights.len()).map(|i| counts.get(i).copied().unwrap_or(0)).collect(),
+        None => emitters
+            .iter()
+            .map(|e| match e {
+                Some(e) if total_power > 0.0 => ((settings.target_stored as f64) * (e.power() / total_power) as f64).round() as usize,
+                _ => 0,
+            })
+            .collect(),
+    };
+    let total_share: usize = shares.iter().sum::<usize>().max(1);
+    let cap = settings.emission_cap();
+    control.progress.start("photons", shares.iter().sum::<usize>() as u64);
+    let mut photons = Vec::new();
+    let mut stats = PhotonStats::default();
+    for (index, (emitter, &share)) in emitters.iter().zip(&shares).enumerate() {
+        let Some(emitter) = emitter else {
+            stats.per_light.push((0, 0));
+            continue;
+        };
+        let light_cap = ((cap as f64) * share as f64 / total_share as f64).ceil().max(1.0) as u64;
+        let run = trace_light(scene, &scene.lights[index], emitter, index, share, light_cap, settings, control);
+        stats.emitted += run.emitted;
+        stats.stored += run.photons.len() as u64;
+        stats.cap_reached |= run.cap_reached;
+        stats.per_light.push((run.emitted, run.photons.len() as u64));
+        photons.extend(run.photons);
+    }
+    control.progress.finish();
+    stats.seconds = start.elapsed().as_secs_f64();
+    (photons, stats)
+}
+
+struct LightRun {
+    photons: Vec<Photon>,
+    emitted: u64,
+    cap_reached: bool,
+}
+
+/// Emits from one light in deterministic batches; the result is the shortest prefix of emitted
+/// photons (by index) that stores `share` photons, so it does not depend on the thread count.
+#[allow(clippy::too_many_arguments)]
+fn trace_light(
+    scene: &Scene,
+    light: &Light,
+    emitter: &Emitter,
+    light_index: usize,
+    share: usize,
+    cap: u64,
+    settings: &PhotonSettings,
+    control: Control,
+) -> LightRun {
+    let mut photons: Vec<Photon> = Vec::new();
+    let mut emitted = 0u64;
+    let stream = (light_index as u64) << 40;
+    let mut reported = 0u64;
+    while photons.len() < share && emitted < cap && !control.cancelled() {
+        // Size the round from the yield so far: enough to finish, never absurdly many batches.
+        let yield_so_far = if emitted > 0 { photons.len() as f64 / emitted as f64 } else { 0.0 };
+        let needed = if yield_so_far > 0.0 { ((share - photons.len()) as f64 / yield_so_far * 1.1) as u64 } else { BATCH * 8 };
+        let batches = needed.div_ceil(BATCH).clamp(1, 256).min((cap - emitted).div_ceil(BATCH));
+        let results: Vec<(Vec<Photon>, Vec<u32>)> = (0..batches)
+            .into_par_iter()
+            .map(|b| {
+                let first = emitted + b * BATCH;
+                let count = BATCH.min(cap - first.min(cap));
+                let mut out = Vec::new();
+                let mut ends = Vec::with_capacity(count as usize);
+                for i in first..first + count {
+                    let mut rng = Rng::new(settings.seed, stream | i);
+                    if let Some((ray, power)) = emitter.sample(&mut rng) {
+                        trace_path(scene, light, ray, power, light_index, settings, &mut rng, &mut out);
+                    }
+                    ends.push(out.len() as u32);
+                }
+                (out, ends)
+            })
+            .collect();
+        for (batch, ends) in results {
+            let needed = share - photons.len();
+            if batch.len() >= needed {
+                let last = ends.iter().position(|&e| e as usize >= needed).unwrap_or(ends.len() - 1);
+                photons.extend_from_slice(&batch[..ends[last] as usize]);
+                emitted += last as u64 + 1;
+                break;
+            }
+            photons.extend_from_slice(&batch);
+            emitted += ends.len() as u64;
+        }
+        let done = photons.len().min(share) as u64;
+        control.progress.advance(done - reported);
+        reported = done;
+    }
+    let scale = if emitted > 0 { 1.0 / emitted as f32 } else { 0.0 };
+    photons.par_iter_mut().for_each(|p| {
+        let power = p.power() * scale;
+        p.set_power(power);
+    });
+    LightRun {
+        cap_reached: photons.len() < share && emitted >= cap,
+        photons,
+        emitted,
+    }
+}
+
+/// Follows one photon; pushes what it stores to `out`.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_path(
+    scene: &Scene,
+    light: &Light,
+    mut ray: Ray,
+    mut power: Vec3,
+    light_index: usize,
+    settings: &PhotonSettings,
+    rng: &mut Rng,
+    out: &mut Vec<Photon>,
+) {
+    let mut flags = 0u8;
+    let mut length = 0.0f32;
+    for _ in 0..=settings.max_bounces {
+        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else { return };
+        let hit = scene.surface(&ray, &isect);
+        length += isect.t * ray.dir.length();
+        let p = &hit.params;
+        let d = ray.dir;
+        let entering = d.dot(hit.geometric_normal) < 0.0;
+        let facing = if d.dot(hit.shading_normal) > 0.0 { -hit.shading_normal } else { hit.shading_normal };
+        let receives = p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO;
+        if receives && (flags != 0 || settings.first_hit) {
+            let stored = power * falloff_scale(light, length);
+            out.push(Photon::new(hit.point, stored, d, facing, flags, light_index.min(255) as u8));
+        }
+        if settings.first_hit {
+            return;
+        }
+        let pr = p.reflective.max_element().max(0.0);
+        let pt = p.transmissive.max_element().max(0.0);
+        let norm = (pr + pt).max(1.0);
+        let (pr, pt) = (pr / norm, pt / norm);
+        let u = rng.uniform();
+        let dir = if u < pr {
+            power *= p.reflective / pr;
+            flags |= REFLECTED;
+            reflect(d, facing)
+        } else if u < pr + pt {
+            power *= p.transmissive / pt;
+            flags |= REFRACTED;
+            let (eta, n_in) = refraction_geometry(p.index, entering, hit.shading_normal);
+            refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in))
+        } else {
+            return;
+        };
+        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, dir), dir);
+    }
+}
+
+/// d²·f(d) for a point light's course falloff f; 1 for directional lights.
+#[inline]
+pub fn falloff_scale(light: &Light, path_length: f32) -> f32 {
+    match light {
+        Light::Point { attenuation, .. } => path_length * path_length * distance_attenuation(*attenuation, path_length),
+        Light::Directional { .. } => 1.0,
+    }
+}
