@@ -107,6 +107,8 @@ pub struct SurfaceHit {
     pub params: SurfaceParams,
     /// The object hit.
     pub object: ObjectRef,
+    /// The primitive hit (shapes first, then triangles).
+    pub prim: u32,
 }
 
 impl Scene {
@@ -211,6 +213,29 @@ impl Scene {
         })
     }
 
+    /// The next crossing of the same primitive beyond `hit` (a closed shape is crossed twice),
+    /// as an intersection along the same `ray` with `t < t_max`. Triangles are crossed once.
+    pub fn next_crossing(&self, ray: &Ray, hit: &Intersection, t_max: f32) -> Option<Intersection> {
+        if hit.prim as usize >= self.shapes.len() {
+            return None;
+        }
+        let shape = &self.shapes[hit.prim as usize];
+        // Restart just past the hit, by a step relative to the hit's magnitude.
+        let point = ray.at(hit.t);
+        let step = 1e-4 * (1.0 + point.abs().max_element()) / ray.dir.length().max(1e-30);
+        let t0 = hit.t + step;
+        if t0 >= t_max {
+            return None;
+        }
+        let next = shape.intersect(&Ray::new(ray.at(t0), ray.dir), t_max - t0)?;
+        Some(Intersection {
+            t: t0 + next.t,
+            prim: hit.prim,
+            normal_or_bary: next.normal,
+            uv: next.uv,
+        })
+    }
+
     /// Full shading data for an intersection found along `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Intersection) -> SurfaceHit {
         let point = ray.at(hit.t);
@@ -225,6 +250,7 @@ impl Scene {
                 uv: hit.uv,
                 params: material.eval(&self.textures, hit.uv),
                 object: ObjectRef::Shape(hit.prim),
+                prim: hit.prim,
             };
         }
         let tri_index = (hit.prim - n_shapes) as usize;
@@ -265,7 +291,28 @@ impl Scene {
             uv,
             params,
             object: ObjectRef::Mesh(tri_ref.mesh),
+            prim: hit.prim,
         }
+    }
+
+    /// Whether any primitive other than `except` comes within the cube of half-size `r` around
+    /// `point`: only then can something stand between the point and photons gathered nearby.
+    pub fn has_geometry_near(&self, point: Vec3, r: f32, except: u32) -> bool {
+        let query = Aabb::new(point - Vec3::splat(r), point + Vec3::splat(r));
+        self.bvh.any_overlap(&query, |prim| prim != except)
+    }
+
+    /// Whether the straight segment between two surface points is free of geometry; each end is
+    /// moved off its surface along the given normal.
+    pub fn segment_clear(&self, a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> bool {
+        let from = crate::math::offset_origin(a, a_normal, b - a);
+        let to = crate::math::offset_origin(b, b_normal, a - b);
+        let d = to - from;
+        let len = d.length();
+        if len <= 0.0 {
+            return true;
+        }
+        !self.any_hit(&Ray::new(from, d / len), len, |_| true)
     }
 
     /// The material id of an object (a mesh's base material).

@@ -33,4 +33,10 @@ impl Bvh {
     pub fn any_hit<F: FnMut(u32, f32) -> bool>(&self, _ray: &Ray, t_max: f32, mut visit: F) -> bool {
         (0..self.bounds.len() as u32).any(|i| visit(i, t_max))
     }
+    pub fn any_overlap<F: FnMut(u32) -> bool>(&self, query: &Aabb, mut f: F) -> bool {
+        (0..self.bounds.len() as u32).any(|i| {
+            let b = self.bounds[i as usize];
+            b.min.cmple(query.max).all() && b.max.cmpge(query.min).all() && f(i)
+        })
+    }
 }

@@ -28,6 +28,9 @@ impl Default for WhittedSettings {
     }
 }
 
+/// A ray crosses a sphere, box, cylinder or cone at most this many times.
+const MAX_CROSSINGS_PER_SHAPE: usize = 4;
+
 /// Recursion stops once a path's weight falls below this: it could not change an 8-bit pixel.
 const MIN_PATH_WEIGHT: f32 = 1.0 / 1024.0;
 
@@ -82,10 +85,10 @@ where
         let w = weight * p.transmissive;
         if w.max_element() >= MIN_PATH_WEIGHT {
             let (eta, n_in) = refraction_geometry(p.index, entering, hit.shading_normal);
-            if let Some(dir) = refract(d, n_in, eta) {
-                let origin = offset_origin(hit.point, hit.geometric_normal, dir);
-                color += p.transmissive * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w, caustic);
-            }
+            // Total internal reflection turns the transmitted ray back inside (as photons do).
+            let dir = refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in));
+            let origin = offset_origin(hit.point, hit.geometric_normal, dir);
+            color += p.transmissive * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w, caustic);
         }
     }
     color
@@ -128,10 +131,18 @@ pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec
     let ray = Ray::new(origin, wi);
     let t_max = if distance.is_finite() { (distance - (origin - point).length()) * (1.0 - 1e-5) } else { f32::INFINITY };
     let mut filter = Vec3::ONE;
+    // Every crossing of a surface filters by its kt: a closed glass object filters twice.
     let blocked = scene.any_hit(&ray, t_max, |isect| {
-        let kt = scene.surface(&ray, isect).params.transmissive;
-        filter *= kt;
-        filter == Vec3::ZERO
+        let mut crossing = Some(*isect);
+        for _ in 0..MAX_CROSSINGS_PER_SHAPE {
+            let Some(hit) = crossing else { break };
+            filter *= scene.surface(&ray, &hit).params.transmissive;
+            if filter == Vec3::ZERO {
+                return true;
+            }
+            crossing = scene.next_crossing(&ray, &hit, t_max);
+        }
+        false
     });
     if blocked {
         Vec3::ZERO
@@ -156,7 +167,7 @@ pub fn render(
                 if hit.params.diffuse == Vec3::ZERO && hit.params.specular == Vec3::ZERO {
                     return Vec3::ZERO;
                 }
-                map.radiance(hit.point, n, wo, &hit.params, estimate)
+                map.radiance(scene, hit, n, wo, estimate)
             }),
             None => radiance(scene, settings, &ray, &|_: &SurfaceHit, _: Vec3, _: Vec3| Vec3::ZERO),
         }

@@ -12,7 +12,7 @@ use super::Photon;
 use crate::integrator::Control;
 use crate::material::SurfaceParams;
 use crate::math::Vec3;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceHit};
 use std::cell::RefCell;
 use std::f32::consts::PI;
 
@@ -120,9 +120,12 @@ impl PhotonMap {
         2.0 * radii[radii.len() / 2]
     }
 
-    /// Reflected radiance at `point` towards `wo` from the photons nearby; `n` is the unit
-    /// normal facing `wo`, `params` the material there.
-    pub fn radiance(&self, point: Vec3, n: Vec3, wo: Vec3, params: &SurfaceParams, settings: &EstimateSettings) -> Vec3 {
+    /// Reflected radiance at a surface point towards `wo` from the photons nearby; `n` is the
+    /// unit normal facing `wo`. Where other geometry comes within the gather radius, photons the
+    /// point cannot see in a straight line (behind a wall, across a ring's rim) are left out.
+    pub fn radiance(&self, scene: &Scene, hit: &SurfaceHit, n: Vec3, wo: Vec3, settings: &EstimateSettings) -> Vec3 {
+        let point = hit.point;
+        let params = &hit.params;
         if self.photons.is_empty() || settings.k == 0 {
             return Vec3::ZERO;
         }
@@ -137,6 +140,7 @@ impl PhotonMap {
                 return Vec3::ZERO;
             }
             let r = r2.sqrt();
+            let check_visibility = scene.has_geometry_near(point, r, hit.prim);
             let mut sum = Vec3::ZERO;
             for nb in neighbors.iter() {
                 let photon = &self.photons[nb.slot as usize];
@@ -150,6 +154,9 @@ impl PhotonMap {
                 let wi = -photon.direction();
                 let f = params.phong_reflectance(n, wo, wi);
                 if f == Vec3::ZERO {
+                    continue;
+                }
+                if check_visibility && !scene.segment_clear(point, n, photon.position, photon.normal()) {
                     continue;
                 }
                 let weight = match settings.cone_filter {
@@ -166,12 +173,18 @@ impl PhotonMap {
         })
     }
 
-    /// Irradiance-like flux density at `point` (Σ Φ / π r², no reflectance): for checks.
-    pub fn flux_density(&self, point: Vec3, n: Vec3, settings: &EstimateSettings) -> Vec3 {
-        let lambert = SurfaceParams {
+    /// Flux per area arriving at the surface point seen straight down `-n` from just above
+    /// `point` (Σ Φ / π r², the irradiance of a white Lambertian receiver): for checks.
+    pub fn flux_density(&self, scene: &Scene, point: Vec3, n: Vec3, settings: &EstimateSettings) -> Vec3 {
+        let ray = crate::math::Ray::new(point + n * 1e-3, -n);
+        let Some(isect) = scene.intersect(&ray, 2e-3) else {
+            return Vec3::ZERO;
+        };
+        let mut hit = scene.surface(&ray, &isect);
+        hit.params = SurfaceParams {
             diffuse: Vec3::ONE,
             ..SurfaceParams::default()
         };
-        self.radiance(point, n, n, &lambert, settings)
+        self.radiance(scene, &hit, n, n, settings)
     }
 }

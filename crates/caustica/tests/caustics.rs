@@ -1,0 +1,201 @@
+//! Caustic photon maps against analytic answers.
+
+mod common;
+
+use caustica::integrator::whitted::transmittance;
+use caustica::light::distance_attenuation;
+use caustica::math::Vec3;
+use caustica::photon::{EstimateSettings, PhotonMap, PhotonSettings};
+
+fn trace(scene: &caustica::scene::Scene, settings: PhotonSettings, k: usize) -> PhotonMap {
+    PhotonMap::trace(scene, &settings, k, common::control())
+}
+
+fn photons(n: usize) -> PhotonSettings {
+    PhotonSettings { target_stored: n, seed: 7, ..PhotonSettings::default() }
+}
+
+/// A vertical mirror wall at x = 0 and a point light at (2, 0, 3) above a diffuse floor: on the
+/// floor the reflected light is that of the light's mirror image at (−2, 0, 3).
+const MIRROR: &str = "SBT-raytracer 1.0
+point_light { position = (2, 0, 3); color = (1, 1, 1);
+  constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
+translate(0, 0, 2, rotate(0, 1, 0, 1.5707963, scale(4, 8, 1, square { material = { reflective = (1, 1, 1); } })))
+scale(20, square { material = { diffuse = (1, 1, 1); } })
+";
+
+#[test]
+fn flat_mirror_caustic_is_the_mirror_image_of_the_light() {
+    let scene = common::scene(MIRROR);
+    let map = trace(&scene, photons(400_000), 200);
+    let settings = EstimateSettings { k: 400, ..EstimateSettings::default() };
+    let image = Vec3::new(-2.0, 0.0, 3.0);
+    for p in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 0.5, 0.0), Vec3::new(3.0, -1.0, 0.0), Vec3::new(1.5, 1.5, 0.0)] {
+        let to = image - p;
+        let d = to.length();
+        let want = (to.z / d) / (d * d);
+        let got = map.flux_density(&scene, p, Vec3::Z, &settings).x;
+        assert!(common::rel(got, want) < 0.05, "at {p:?}: photons {got}, mirror image {want}");
+    }
+    // Behind the mirror (x < 0) the floor receives no reflected light.
+    let behind = map.flux_density(&scene, Vec3::new(-1.5, 0.0, 0.0), Vec3::Z, &settings).x;
+    assert!(behind < 1e-4, "{behind}");
+}
+
+/// A glass slab (kt = 0.8, two interfaces) under a directional light of irradiance 1.
+const SLAB: &str = "SBT-raytracer 1.0
+directional_light { direction = (0, 0, -1); color = (1, 1, 1); }
+translate(0, 0, 2, scale(2, 2, 0.5, box { material = { transmissive = (0.8, 0.8, 0.8); index = 1.5; } }))
+scale(20, square { material = { diffuse = (1, 1, 1); } })
+";
+
+#[test]
+fn glass_slab_passes_exactly_the_transmitted_power() {
+    let scene = common::scene(SLAB);
+    let map = trace(&scene, photons(200_000), 100);
+    let settings = EstimateSettings { k: 200, ..EstimateSettings::default() };
+    for p in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.5, -0.3, 0.0), Vec3::new(-0.6, 0.6, 0.0)] {
+        let got = map.flux_density(&scene, p, Vec3::Z, &settings).x;
+        assert!(common::rel(got, 0.64) < 0.03, "under the slab at {p:?}: {got}");
+    }
+    // Total stored power equals irradiance × slab area × kt² (the slab is 2 × 2).
+    let total: f64 = map.photons().iter().map(|p| p.power().x as f64).sum();
+    assert!((total / (4.0 * 0.64) - 1.0).abs() < 0.02, "transmitted power {total}");
+    // Shadow rays agree: the direct light under the slab is filtered by kt at both faces.
+    let t = transmittance(&scene, Vec3::ZERO, Vec3::Z, Vec3::Z, f32::INFINITY);
+    assert!((t.x - 0.64).abs() < 1e-5, "{t:?}");
+}
+
+#[test]
+fn stored_flux_never_exceeds_emitted_flux() {
+    // Glass and mirror over diffuse receivers, inverse-square light: each photon's power only falls.
+    let text = "SBT-raytracer 1.0
+point_light { position = (0, 0, 4); color = (1, 1, 1);
+  constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
+translate(0, 0, 1.5, sphere { material = { transmissive = (0.9, 0.9, 0.9); reflective = (0.1, 0.1, 0.1); index = 1.5; } })
+translate(2.5, 0, 1, sphere { material = { reflective = (0.8, 0.6, 0.4); } })
+scale(30, square { material = { diffuse = (0.7, 0.7, 0.7); } })
+";
+    let scene = common::scene(text);
+    let settings = PhotonSettings { aim: false, ..photons(50_000) };
+    let map = trace(&scene, settings, 50);
+    let stored: Vec3 = map.photons().iter().map(|p| p.power()).sum();
+    // Emitted flux in the course convention: 4π × intensity (photon powers sum to it).
+    let emitted = 4.0 * std::f32::consts::PI;
+    assert!(map.len() > 10_000);
+    assert!(stored.max_element() <= emitted * 1.001, "stored {stored:?} > emitted {emitted}");
+    assert!(stored.max_element() > 0.05 * emitted, "the caustics carry real power: {stored:?}");
+    assert!(stored.z < stored.x, "photons take the mirror's colour");
+}
+
+fn direct_light_at(scene: &caustica::scene::Scene, p: Vec3) -> f32 {
+    scene
+        .lights
+        .iter()
+        .map(|l| {
+            let s = l.sample_li(p).unwrap();
+            let shadow = transmittance(scene, p, Vec3::Z, s.wi, s.distance);
+            (s.intensity * shadow * s.wi.dot(Vec3::Z).max(0.0)).x
+        })
+        .sum()
+}
+
+#[test]
+fn first_hit_photons_reproduce_direct_light_from_point_and_directional_lights() {
+    let text = "SBT-raytracer 1.0
+point_light { position = (1, -1, 4); color = (1, 1, 1);
+  constant_attenuation_coeff = 0.25; linear_attenuation_coeff = 0.003372407; quadratic_attenuation_coeff = 0.000045492; }
+directional_light { direction = (-1, 0.5, -2); color = (0.4, 0.4, 0.4); }
+scale(12, square { material = { diffuse = (1, 1, 1); } })
+";
+    let scene = common::scene(text);
+    let settings = PhotonSettings { first_hit: true, aim: false, ..photons(1_000_000) };
+    let map = trace(&scene, settings, 300);
+    let estimate = EstimateSettings { k: 300, cone_filter: None, ..EstimateSettings::default() };
+    for p in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, -1.0, 0.0), Vec3::new(-2.5, 2.0, 0.0), Vec3::new(1.0, 3.0, 0.0)] {
+        let want = direct_light_at(&scene, p);
+        let got = map.flux_density(&scene, p, Vec3::Z, &estimate).x;
+        assert!(common::rel(got, want) < 0.04, "at {p:?}: photons {got}, shadow rays {want}");
+    }
+    // The course's falloff is carried by the photons: check it is far from inverse-square here.
+    let d = (Vec3::new(1.0, -1.0, 4.0)).length();
+    assert!(distance_attenuation([0.25, 0.003372407, 0.000045492], d) > 2.0 / (d * d));
+}
+
+#[test]
+fn no_light_bleeds_through_a_thin_wall() {
+    // A mirror throws light onto the floor on the +x side of a thin wall at x = 0; the floor just
+    // behind the wall (−x side) is in shadow and must stay dark.
+    let text = "SBT-raytracer 1.0
+point_light { position = (3, 0, 5); color = (1, 1, 1);
+  constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
+translate(4, 0, 2.5, rotate(0, 1, 0, 1.2, scale(3, 3, 1, square { material = { reflective = (1, 1, 1); } })))
+translate(0, 0, 1, scale(0.02, 6, 2, box { material = { diffuse = (1, 1, 1); } }))
+scale(20, square { material = { diffuse = (1, 1, 1); } })
+";
+    let scene = common::scene(text);
+    let map = trace(&scene, photons(100_000), 100);
+    let estimate = EstimateSettings { k: 100, max_radius: Some(0.5), ..EstimateSettings::default() };
+    let lit = map.flux_density(&scene, Vec3::new(0.1, 0.0, 0.0), Vec3::Z, &estimate).x;
+    let behind = map.flux_density(&scene, Vec3::new(-0.1, 0.0, 0.0), Vec3::Z, &estimate).x;
+    assert!(lit > 0.01, "the lit side receives the mirror's light: {lit}");
+    assert!(behind < 0.01 * lit, "light bled through the wall: {behind} vs {lit}");
+}
+
+#[test]
+fn aimed_and_uniform_emission_give_the_same_caustic() {
+    let scene = common::scene(SLAB);
+    let aimed = trace(&scene, photons(100_000), 100);
+    let uniform = trace(&scene, PhotonSettings { aim: false, ..photons(100_000) }, 100);
+    assert!(aimed.stats.useful_fraction() > 2.0 * uniform.stats.useful_fraction(), "aiming wastes fewer photons");
+    let settings = EstimateSettings { k: 200, ..EstimateSettings::default() };
+    for p in [Vec3::new(0.2, 0.1, 0.0), Vec3::new(-0.5, 0.5, 0.0)] {
+        let a = aimed.flux_density(&scene, p, Vec3::Z, &settings).x;
+        let u = uniform.flux_density(&scene, p, Vec3::Z, &settings).x;
+        assert!(common::rel(a, u) < 0.04, "aimed {a} vs uniform {u}");
+    }
+}
+
+#[test]
+fn photon_map_is_identical_with_one_and_two_threads() {
+    let scene = common::scene(MIRROR);
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| trace(&scene, photons(30_000), 50))
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one.stats.emitted, two.stats.emitted);
+    assert_eq!(one.photons(), two.photons());
+}
+
+#[test]
+fn a_blue_mirror_throws_a_blue_caustic() {
+    let text = "SBT-raytracer 1.0
+point_light { position = (0, 0, 6); color = (1, 1, 1); }
+translate(0, 0, 2, scale(1.5, box { material = { reflective = (0.1, 0.2, 0.9); } }))
+translate(0, 0, 8, scale(30, square { material = { diffuse = (1, 1, 1); } }))
+scale(30, square { material = { diffuse = (1, 1, 1); } })
+";
+    let scene = common::scene(text);
+    let map = trace(&scene, photons(20_000), 50);
+    assert!(map.len() >= 20_000);
+    for p in map.photons() {
+        let c = p.power();
+        assert!(c.z > 4.0 * c.x && c.z > 2.0 * c.y, "{c:?}");
+    }
+}
+
+#[test]
+fn emission_cap_stops_a_hopeless_pass() {
+    // The light faces away from the mirror's side of the scene: hardly anything is stored.
+    let text = "SBT-raytracer 1.0
+point_light { position = (0, 0, 1); color = (1, 1, 1); }
+translate(0, 0, 3, scale(0.01, sphere { material = { reflective = (1, 1, 1); } }))
+translate(0, 0, 2, scale(30, square { material = { diffuse = (1, 1, 1); } }))
+";
+    let scene = common::scene(text);
+    let settings = PhotonSettings { max_emitted: 50_000, ..photons(10_000) };
+    let map = trace(&scene, settings, 10);
+    assert!(map.stats.cap_reached);
+    assert!(map.stats.emitted <= 50_000);
+}
