@@ -32,6 +32,33 @@ Examples:
   caustica photons scenes/ring.ray -o ring-photons.png
   caustica photons scenes/lens.ray -o lens-map.png --ply lens.ply --photons 50000")]
     Photons(PhotonArgs),
+    /// Time whole renders of the project's scenes and print a table (for BENCHMARKS.md).
+    #[command(after_help = "Each render runs in a child `caustica render --json` process, so peak memory is per render.
+
+Examples:
+  caustica bench                          # the full table, run from the repository root
+  caustica bench --quick                  # small images, for a smoke test
+  caustica bench --corpus ../shared/scenes/sbt-corpus   # adds the original project's ring scene")]
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Folder holding caustica's scenes.
+    #[arg(long, default_value = "scenes")]
+    pub scenes: PathBuf,
+    /// Folder of the course corpus; adds the original project's ring scene at its worst-case settings.
+    #[arg(long)]
+    pub corpus: Option<PathBuf>,
+    /// Small images and photon counts: checks the harness, not the speed.
+    #[arg(long)]
+    pub quick: bool,
+    /// Worker threads for each render (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Repetitions of each render; the table shows the fastest.
+    #[arg(long, default_value_t = 1)]
+    pub repeat: usize,
 }
 
 /// Options shared by every command that reads a scene.

@@ -1,5 +1,6 @@
 //! One module per subcommand, plus what they share.
 
+pub mod bench;
 pub mod info;
 pub mod photons;
 pub mod render;
@@ -90,4 +91,12 @@ pub fn photon_settings(options: &PhotonOptions, seed: u64) -> Result<PhotonSetti
         per_light: options.photons_per_light.clone(),
         ..PhotonSettings::default()
     })
+}
+
+/// Peak resident memory of this process in bytes (Linux), if known.
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024)
 }

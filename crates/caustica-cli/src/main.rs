@@ -25,6 +25,7 @@ fn main() -> ExitCode {
         cli::Command::Render(args) => commands::render::run(args, cancel),
         cli::Command::Info(args) => commands::info::run(args),
         cli::Command::Photons(args) => commands::photons::run(args, cancel),
+        cli::Command::Bench(args) => commands::bench::run(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

@@ -96,10 +96,11 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let stored = map.as_ref().map_or(0, |m| m.stats.stored);
     if args.json {
         println!(
-            "{{\"output\":{:?},\"width\":{width},\"height\":{height},\"samples_per_pixel\":{},\"photons_stored\":{stored},\"photons_emitted\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"photons\":{photon_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}}}}",
+            "{{\"output\":{:?},\"width\":{width},\"height\":{height},\"samples_per_pixel\":{},\"photons_stored\":{stored},\"photons_emitted\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"photons\":{photon_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
             args.output.display().to_string(),
             args.aa * args.aa,
             map.as_ref().map_or(0, |m| m.stats.emitted),
+            super::peak_memory_bytes().map_or("null".to_string(), |b| b.to_string()),
         );
     } else if !args.quiet {
         eprintln!(

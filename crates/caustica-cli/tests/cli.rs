@@ -1,0 +1,144 @@
+//! The real `caustica` binary: outputs, exit codes, diagnostics.
+
+use assert_cmd::Command;
+use std::path::{Path, PathBuf};
+
+fn caustica() -> Command {
+    Command::cargo_bin("caustica").expect("the binary is built")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("caustica-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap();
+    assert_eq!(&bytes[1..4], b"PNG");
+    let w = u32::from_be_bytes(bytes[16..20].try_into().unwrap());
+    let h = u32::from_be_bytes(bytes[20..24].try_into().unwrap());
+    (w, h)
+}
+
+#[test]
+fn render_without_a_scene_writes_the_default_ring() {
+    let dir = temp_dir("default");
+    caustica()
+        .current_dir(&dir)
+        .args(["render", "--width", "64", "--photons", "20000", "--quiet"])
+        .assert()
+        .success();
+    assert_eq!(png_size(&dir.join("caustica.png")), (64, 64));
+}
+
+#[test]
+fn render_writes_exr_and_json_summary() {
+    let dir = temp_dir("exr");
+    let out = dir.join("lens.exr");
+    let assert = caustica()
+        .args(["render"])
+        .arg(scenes().join("lens.ray"))
+        .arg("-o")
+        .arg(&out)
+        .args(["--width", "40", "--photons", "5000", "--json"])
+        .assert()
+        .success();
+    let stdout = String::from_utf8(assert.get_output().stdout.clone()).unwrap();
+    assert!(stdout.contains("\"photons_stored\":5") && stdout.contains("\"complete\":true"), "{stdout}");
+    let bytes = std::fs::read(&out).unwrap();
+    assert_eq!(&bytes[..4], &[0x76, 0x2f, 0x31, 0x01], "OpenEXR magic number");
+}
+
+#[test]
+fn a_malformed_scene_names_file_line_and_column_and_exits_2() {
+    let dir = temp_dir("bad");
+    let scene = dir.join("bad.ray");
+    std::fs::write(&scene, "SBT-raytracer 1.0\ncamera {\n  position = (0, 0, 1);\n  difuse = (1, 1, 1);\n}\n").unwrap();
+    let assert = caustica().arg("render").arg(&scene).arg("-o").arg(dir.join("out.png")).assert().code(2);
+    let stderr = String::from_utf8(assert.get_output().stderr.clone()).unwrap();
+    assert!(stderr.contains("bad.ray:4:3"), "{stderr}");
+    assert!(!dir.join("out.png").exists(), "no output for a bad scene");
+}
+
+#[test]
+fn bad_options_are_refused_with_exit_2_before_any_work() {
+    let dir = temp_dir("options");
+    for args in [
+        vec!["render", "--width", "100000", "--height", "100000"],
+        vec!["render", "--aa", "0"],
+        vec!["render", "--photons", "999999999999"],
+        vec!["render", "-o", "picture.jpg"],
+        vec!["render", "--threads", "0"],
+        vec!["render", "--no-such-flag"],
+    ] {
+        let assert = caustica().current_dir(&dir).args(&args).assert().code(2);
+        let stderr = String::from_utf8(assert.get_output().stderr.clone()).unwrap();
+        assert!(!stderr.is_empty(), "{args:?} says why");
+    }
+    assert!(!dir.join("caustica.png").exists());
+}
+
+#[test]
+fn a_missing_scene_file_is_bad_input() {
+    caustica().args(["info", "/no/such/scene.ray"]).assert().code(2);
+}
+
+#[test]
+fn every_subcommand_has_help_with_examples() {
+    for sub in ["render", "info", "photons"] {
+        let assert = caustica().args([sub, "--help"]).assert().success();
+        let stdout = String::from_utf8(assert.get_output().stdout.clone()).unwrap();
+        assert!(stdout.contains("Examples:"), "{sub}: {stdout}");
+    }
+}
+
+#[test]
+fn info_reports_camera_lights_and_objects() {
+    let assert = caustica().arg("info").arg(scenes().join("ring_double.ray")).arg("--json").assert().success();
+    let stdout = String::from_utf8(assert.get_output().stdout.clone()).unwrap();
+    assert!(stdout.contains("\"lights\":[{\"type\":\"point\""), "{stdout}");
+    assert!(stdout.contains("\"shapes\":2"), "{stdout}");
+}
+
+#[test]
+fn photons_draws_a_map_and_writes_ply() {
+    let dir = temp_dir("photons");
+    caustica()
+        .arg("photons")
+        .arg(scenes().join("ring.ray"))
+        .arg("-o")
+        .arg(dir.join("map.png"))
+        .arg("--ply")
+        .arg(dir.join("map.ply"))
+        .args(["--photons", "3000", "--width", "48", "--quiet"])
+        .assert()
+        .success();
+    assert_eq!(png_size(&dir.join("map.png")), (48, 48));
+    let ply = std::fs::read(dir.join("map.ply")).unwrap();
+    let header = String::from_utf8_lossy(&ply[..200]);
+    assert!(header.starts_with("ply\n") && header.contains("element vertex 3"), "{header}");
+}
+
+#[test]
+fn the_image_does_not_depend_on_the_thread_count() {
+    let dir = temp_dir("threads");
+    for threads in ["1", "2"] {
+        caustica()
+            .arg("render")
+            .arg(scenes().join("ring.ray"))
+            .arg("-o")
+            .arg(dir.join(format!("t{threads}.png")))
+            .args(["--width", "48", "--aa", "2", "--photons", "10000", "--threads", threads, "--quiet"])
+            .assert()
+            .success();
+    }
+    let one = std::fs::read(dir.join("t1.png")).unwrap();
+    let two = std::fs::read(dir.join("t2.png")).unwrap();
+    assert!(one == two, "1 and 2 threads differ");
+}
