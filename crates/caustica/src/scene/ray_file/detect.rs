@@ -74,56 +74,54 @@ pub(crate) fn markers(text: &str) -> Markers {
 
 /// Parses `text` in whichever dialect it is written for.
 ///
-/// Dialect T is tried first unless the file has dialect-O markers and no dialect-T ones. A
-/// dialect-O fallback that only worked by ignoring unknown keys, in a file without O markers, is
-/// taken as a broken dialect-T file. When both readers fail, a student-extension error wins, then
-/// the error of the marked dialect, else the one found further into the file (T on a tie).
+/// Dialect T is tried first unless the file has dialect-O markers and no dialect-T ones. When
+/// dialect T fails, dialect O is only taken if the file has O markers, or if T stopped at a key
+/// that O ignores and that is no misspelling of a known field (e.g. `focaldistance`). When both
+/// readers fail, a student-extension error wins, then the error of the marked dialect, then the
+/// one found further into the file (dialect T on a tie).
 pub(crate) fn parse_auto(text: &str, scene_dir: &Path) -> Result<SceneDescription, ParseError> {
     let found = markers(text);
-    let run = |dialect| match dialect {
-        Dialect::Tokenizer => tokenizer_dialect::parse(text, scene_dir),
-        Dialect::Dictionary => dictionary_dialect::parse(text, scene_dir),
-    };
-    let (first, second) = if found.dictionary > 0 && found.tokenizer == 0 {
-        (Dialect::Dictionary, Dialect::Tokenizer)
-    } else {
-        (Dialect::Tokenizer, Dialect::Dictionary)
-    };
-    let first_error = match run(first) {
+    let o_first = found.dictionary > 0 && found.tokenizer == 0;
+    if o_first {
+        let o_error = match dictionary_dialect::parse(text, scene_dir) {
+            Ok(scene) => return Ok(scene),
+            Err(error) => error,
+        };
+        let t_error = match tokenizer_dialect::parse(text, scene_dir) {
+            Ok(scene) => return Ok(scene),
+            Err(error) => error,
+        };
+        return Err(choose(t_error, o_error, true));
+    }
+    let t_error = match tokenizer_dialect::parse(text, scene_dir) {
         Ok(scene) => return Ok(scene),
         Err(error) => error,
     };
-    let second_error = match run(second) {
+    match dictionary_dialect::parse(text, scene_dir) {
         Ok(scene) => {
-            let ignored_keys = scene
-                .warnings
-                .iter()
-                .any(|(message, _)| message.starts_with(IGNORED_KEY));
-            if second == Dialect::Dictionary && found.dictionary == 0 && ignored_keys {
-                return Err(first_error);
+            let stopped_at_ignored_key = t_error.help.is_none()
+                && scene.warnings.iter().any(|(message, span)| {
+                    message.starts_with(IGNORED_KEY) && *span == t_error.span
+                });
+            if found.dictionary > 0 || stopped_at_ignored_key {
+                Ok(scene)
+            } else {
+                Err(t_error)
             }
-            return Ok(scene);
         }
-        Err(error) => error,
-    };
-    let (t_error, o_error) = match first {
-        Dialect::Tokenizer => (first_error, second_error),
-        Dialect::Dictionary => (second_error, first_error),
-    };
-    // Both readers reject student extensions, so naming the extension is the most useful answer.
-    Err(if is_extension_error(&t_error) || is_extension_error(&o_error) {
-        if is_extension_error(&t_error) {
-            t_error
-        } else {
-            o_error
-        }
-    } else if found.dictionary > 0 && found.tokenizer == 0 {
-        o_error
-    } else if found.tokenizer > 0 && found.dictionary == 0 {
+        Err(o_error) if found.dictionary > 0 => Err(choose(t_error, o_error, false)),
+        Err(_) => Err(t_error),
+    }
+}
+
+/// The more useful of the two readers' errors.
+fn choose(t_error: ParseError, o_error: ParseError, o_marked: bool) -> ParseError {
+    // Both readers reject student extensions, so naming the extension is the best answer.
+    let o_wins =
+        is_extension_error(&o_error) || o_marked || o_error.span.start > t_error.span.start;
+    if is_extension_error(&t_error) || !o_wins {
         t_error
-    } else if o_error.span.start > t_error.span.start {
-        o_error
     } else {
-        t_error
-    })
+        o_error
+    }
 }

@@ -110,9 +110,18 @@ struct Node {
 
 /// A partly read container while the object tree is built.
 enum Open {
-    Named { head: Span },
-    Tuple { start: usize, items: Vec<usize> },
-    Dict { start: usize, entries: Vec<(Span, usize)>, key: Span },
+    Named {
+        head: Span,
+    },
+    Tuple {
+        start: usize,
+        items: Vec<usize>,
+    },
+    Dict {
+        start: usize,
+        entries: Vec<(Span, usize)>,
+        key: Span,
+    },
 }
 
 fn push(tree: &mut Vec<Node>, kind: Kind, span: Span, head: Option<Span>) -> usize {
@@ -224,9 +233,9 @@ fn read_object(cur: &mut Cursor<'_>, tree: &mut Vec<Node>) -> Result<usize, Pars
                         true
                     } else {
                         let key_text = &cur.text[key.clone()];
-                        return Err(cur.unexpected(&format!(
-                            "`;` or `}}` after the value of `{key_text}`"
-                        )));
+                        return Err(
+                            cur.unexpected(&format!("`;` or `}}` after the value of `{key_text}`"))
+                        );
                     };
                     if !closed {
                         break;
@@ -264,6 +273,12 @@ impl<'a> Reader<'a> {
     }
 
     fn expected(&self, what: &str, id: usize) -> ParseError {
+        let node = &self.tree[id];
+        if let Kind::Named(_) = node.kind {
+            if let Some(error) = extension_error(self.word(&node.head), &node.head) {
+                return error;
+            }
+        }
         ParseError::new(
             format!("expected {what}, found {}", self.describe(id)),
             self.tree[id].span.clone(),
@@ -282,7 +297,9 @@ impl<'a> Reader<'a> {
             "ambient_light" => {
                 for (key, value) in self.entries(child, "ambient_light")? {
                     match self.word(&key) {
-                        "color" | "colour" => self.scene.ambient += self.vec3(value, "for `color`")?,
+                        "color" | "colour" => {
+                            self.scene.ambient += self.vec3(value, "for `color`")?
+                        }
                         _ => self.ignore_key(&key, "ambient_light")?,
                     }
                 }
@@ -316,10 +333,9 @@ impl<'a> Reader<'a> {
         if let Some(error) = extension_error(word, key) {
             return Err(error);
         }
-        self.scene.warnings.push((
-            format!("{IGNORED_KEY} `{word}` in `{owner}`"),
-            key.clone(),
-        ));
+        self.scene
+            .warnings
+            .push((format!("{IGNORED_KEY} `{word}` in `{owner}`"), key.clone()));
         Ok(())
     }
 
@@ -377,8 +393,12 @@ impl<'a> Reader<'a> {
                 "viewdir" => viewdir = Some(self.vec3(value, "for `viewdir`")?),
                 "updir" => updir = Some(self.vec3(value, "for `updir`")?),
                 "fov" => camera.fov_degrees = Some(self.number(value, "for `fov`")?),
-                "aspectratio" => camera.aspect_ratio = Some(self.number(value, "for `aspectratio`")?),
-                "quaternion" => camera.quaternion = Some(self.tuple::<4>(value, "for `quaternion`")?),
+                "aspectratio" => {
+                    camera.aspect_ratio = Some(self.number(value, "for `aspectratio`")?)
+                }
+                "quaternion" => {
+                    camera.quaternion = Some(self.tuple::<4>(value, "for `quaternion`")?)
+                }
                 _ => self.ignore_key(&key, "camera")?,
             }
         }
@@ -412,8 +432,15 @@ impl<'a> Reader<'a> {
         }
         let span = head.start..self.tree[id].span.end;
         let (Some(position), Some(color)) = (position, color) else {
-            let missing = if position.is_none() { "position" } else { "color" };
-            return Err(ParseError::new(format!("`point_light` needs a `{missing}`"), span));
+            let missing = if position.is_none() {
+                "position"
+            } else {
+                "color"
+            };
+            return Err(ParseError::new(
+                format!("`point_light` needs a `{missing}`"),
+                span,
+            ));
         };
         self.scene.lights.push(LightDesc::Point {
             position,
@@ -435,7 +462,11 @@ impl<'a> Reader<'a> {
         }
         let span = head.start..self.tree[id].span.end;
         let (Some(direction), Some(color)) = (direction, color) else {
-            let missing = if direction.is_none() { "direction" } else { "color" };
+            let missing = if direction.is_none() {
+                "direction"
+            } else {
+                "color"
+            };
             return Err(ParseError::new(
                 format!("`directional_light` needs a `{missing}`"),
                 span,
@@ -549,7 +580,9 @@ impl<'a> Reader<'a> {
         let mut node = id;
         loop {
             let Kind::Named(child) = self.tree[node].kind else {
-                return Err(self.expected("an object such as `sphere { … }` or `translate(…)`", node));
+                return Err(
+                    self.expected("an object such as `sphere { … }` or `translate(…)`", node)
+                );
             };
             let head = self.tree[node].head.clone();
             let word = self.word(&head);
@@ -560,7 +593,8 @@ impl<'a> Reader<'a> {
                     (transform_stack::translation(Vec3::from_slice(&args)), obj)
                 }
                 "scale" => {
-                    let (args, obj) = self.args(child, word, "(s, object) or (x, y, z, object)", &[1, 3])?;
+                    let (args, obj) =
+                        self.args(child, word, "(s, object) or (x, y, z, object)", &[1, 3])?;
                     let factors = if args.len() == 1 {
                         Vec3::splat(args[0])
                     } else {
@@ -629,7 +663,13 @@ impl<'a> Reader<'a> {
         Ok((args, obj))
     }
 
-    fn primitive(&mut self, kind: &str, head: Span, id: usize, world: Mat4) -> Result<(), ParseError> {
+    fn primitive(
+        &mut self,
+        kind: &str,
+        head: Span,
+        id: usize,
+        world: Mat4,
+    ) -> Result<(), ParseError> {
         let mut material = None;
         let (mut height, mut bottom, mut top, mut capped) = (1.0f32, 1.0f32, 0.0f32, true);
         let mut mesh = MeshInput::default();
@@ -642,7 +682,9 @@ impl<'a> Reader<'a> {
                 "height" | "bottom_radius" | "top_radius" | "capped" if kind == "cone" => {
                     match word {
                         "height" => height = self.number(value, "for `height`")?,
-                        "bottom_radius" => bottom = self.number(value, "for `bottom_radius`")?.abs(),
+                        "bottom_radius" => {
+                            bottom = self.number(value, "for `bottom_radius`")?.abs()
+                        }
                         "top_radius" => top = self.number(value, "for `top_radius`")?.abs(),
                         _ => capped = self.boolean(value, "for `capped`")?,
                     }
@@ -669,7 +711,8 @@ impl<'a> Reader<'a> {
                                 _ => return Err(self.expected("a vertex index", index)),
                             }
                         }
-                        mesh.faces.push((first..mesh.face_indices.len(), self.tree[face].span.clone()));
+                        mesh.faces
+                            .push((first..mesh.face_indices.len(), self.tree[face].span.clone()));
                     }
                 }
                 "materials" if is_mesh => {
@@ -679,7 +722,9 @@ impl<'a> Reader<'a> {
                     }
                     mesh.materials = Some((list, self.tree[value].span.clone()));
                 }
-                "gennormals" if is_mesh => mesh.gennormals = self.boolean(value, "for `gennormals`")?,
+                "gennormals" if is_mesh => {
+                    mesh.gennormals = self.boolean(value, "for `gennormals`")?
+                }
                 _ => self.ignore_key(&key, kind)?,
             }
         }

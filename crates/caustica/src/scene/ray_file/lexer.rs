@@ -190,7 +190,9 @@ fn number_end(bytes: &[u8], mut i: usize, dialect: Dialect) -> usize {
         let ok = match b {
             b'0'..=b'9' | b'-' | b'.' | b'e' => true,
             b'E' => dialect == Dialect::Dictionary,
-            b'+' => dialect == Dialect::Dictionary && i > start && matches!(bytes[i - 1], b'e' | b'E'),
+            b'+' => {
+                dialect == Dialect::Dictionary && i > start && matches!(bytes[i - 1], b'e' | b'E')
+            }
             _ => false,
         };
         if !ok {
@@ -207,10 +209,7 @@ fn number_end(bytes: &[u8], mut i: usize, dialect: Dialect) -> usize {
 /// more useful, and no real scene writes such a token.
 fn parse_number(text: &str, span: Span) -> Result<f64, ParseError> {
     if !is_decimal(text.as_bytes()) {
-        return Err(ParseError::new(
-            format!("malformed number `{text}`"),
-            span,
-        ));
+        return Err(ParseError::new(format!("malformed number `{text}`"), span));
     }
     let value: f64 = text
         .parse()
@@ -287,7 +286,10 @@ mod tests {
 
     #[test]
     fn numbers_in_all_course_spellings() {
-        assert_eq!(numbers(".5 -.3 1e-005 1.4e-05 7 -2. 0.25"), vec![0.5, -0.3, 1e-5, 1.4e-5, 7.0, -2.0, 0.25]);
+        assert_eq!(
+            numbers(".5 -.3 1e-005 1.4e-05 7 -2. 0.25"),
+            vec![0.5, -0.3, 1e-5, 1.4e-5, 7.0, -2.0, 0.25]
+        );
     }
 
     #[test]
@@ -303,7 +305,12 @@ mod tests {
     fn upper_case_exponent_is_a_number_in_dialect_o() {
         assert_eq!(
             kinds("1E5 2.5E-1 3e+2", Dialect::Dictionary),
-            vec![Tok::Number(1e5), Tok::Number(0.25), Tok::Number(300.0), Tok::Eof]
+            vec![
+                Tok::Number(1e5),
+                Tok::Number(0.25),
+                Tok::Number(300.0),
+                Tok::Eof
+            ]
         );
     }
 
@@ -317,7 +324,10 @@ mod tests {
 
     #[test]
     fn malformed_and_huge_numbers_are_errors() {
-        assert_eq!(lex("1-2", Dialect::Tokenizer).expect_err("malformed").span, 0..3);
+        assert_eq!(
+            lex("1-2", Dialect::Tokenizer).expect_err("malformed").span,
+            0..3
+        );
         assert!(lex("-", Dialect::Tokenizer).is_err());
         assert!(lex("1.2.3", Dialect::Tokenizer).is_err());
         let err = lex("x 1e999", Dialect::Tokenizer).expect_err("overflow");
@@ -358,7 +368,10 @@ mod tests {
 
     #[test]
     fn bom_is_skipped_and_odd_characters_are_errors() {
-        assert_eq!(kinds("\u{feff}a", Dialect::Tokenizer), vec![Tok::Word, Tok::Eof]);
+        assert_eq!(
+            kinds("\u{feff}a", Dialect::Tokenizer),
+            vec![Tok::Word, Tok::Eof]
+        );
         let err = lex("a é", Dialect::Tokenizer).expect_err("non-ascii");
         assert_eq!(err.span, 2..4);
         assert!(lex("a # b", Dialect::Tokenizer).is_err());

@@ -13,7 +13,12 @@ pub(crate) struct NamedMaterials {
 
 impl NamedMaterials {
     /// Registers `material` under `name`; a name can be registered once.
-    pub fn register(&mut self, name: &str, material: MaterialDesc, span: &Span) -> Result<(), ParseError> {
+    pub fn register(
+        &mut self,
+        name: &str,
+        material: MaterialDesc,
+        span: &Span,
+    ) -> Result<(), ParseError> {
         if self.by_name.contains_key(name) {
             return Err(ParseError::new(
                 format!("material `{name}` is defined twice"),
