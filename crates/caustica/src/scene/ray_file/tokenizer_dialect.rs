@@ -1,0 +1,922 @@
+//! Dialect T: the tokenizer-based reader of UT CS 384G (2012–2019) and UW CSE 457 (2009+).
+//!
+//! Nesting of transforms and groups is handled with an explicit frame stack, so input depth never
+//! turns into call-stack depth.
+
+use super::ast::{
+    CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription,
+    ShapeDesc, Span,
+};
+use super::cursor::Cursor;
+use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS};
+use super::lexer::{self, Tok, Token};
+use super::named_materials::NamedMaterials;
+use super::suggest;
+use super::transform_stack::{self, TransformStack};
+use super::trimesh::{self, MeshInput};
+use crate::ParseError;
+use glam::{Vec2, Vec3, Vec4};
+use std::path::Path;
+
+const TOP_LEVEL: &[&str] = &[
+    "camera",
+    "point_light",
+    "directional_light",
+    "ambient_light",
+    "material",
+    "sphere",
+    "box",
+    "square",
+    "cylinder",
+    "cone",
+    "trimesh",
+    "polymesh",
+    "translate",
+    "scale",
+    "rotate",
+    "transform",
+];
+const ELEMENTS: &[&str] = &[
+    "sphere",
+    "box",
+    "square",
+    "cylinder",
+    "cone",
+    "trimesh",
+    "polymesh",
+    "translate",
+    "scale",
+    "rotate",
+    "transform",
+];
+const MATERIAL_FIELDS: &[&str] = &[
+    "emissive",
+    "ambient",
+    "specular",
+    "reflective",
+    "diffuse",
+    "transmissive",
+    "shininess",
+    "index",
+    "name",
+];
+const CAMERA_FIELDS: &[&str] = &[
+    "position",
+    "viewdir",
+    "updir",
+    "fov",
+    "aspectratio",
+    "quaternian",
+    "look_at",
+];
+const POINT_LIGHT_FIELDS: &[&str] = &[
+    "position",
+    "color",
+    "colour",
+    "constant_attenuation_coeff",
+    "linear_attenuation_coeff",
+    "quadratic_attenuation_coeff",
+];
+const DIRECTIONAL_LIGHT_FIELDS: &[&str] = &["direction", "color", "colour"];
+const MESH_FIELDS: &[&str] = &[
+    "material",
+    "name",
+    "points",
+    "faces",
+    "normals",
+    "materials",
+    "gennormals",
+    "texture_uv",
+];
+
+/// Parses a whole dialect-T file.
+pub(crate) fn parse(text: &str, scene_dir: &Path) -> Result<SceneDescription, ParseError> {
+    let tokens = lexer::lex(text, Dialect::Tokenizer)?;
+    let mut parser = Parser {
+        cur: Cursor::new(text, tokens),
+        scene_dir,
+        default_material: MaterialDesc::default(),
+        named: NamedMaterials::default(),
+        transforms: TransformStack::new(),
+        scene: SceneDescription {
+            dialect: Dialect::Tokenizer,
+            camera: None,
+            lights: Vec::new(),
+            ambient: Vec3::ZERO,
+            objects: Vec::new(),
+            warnings: Vec::new(),
+        },
+    };
+    parser.file()?;
+    Ok(parser.scene)
+}
+
+/// An open transform or group while an element is being read.
+enum Frame {
+    /// A transform whose child is being read; `)` closes it.
+    Transform { keyword: Token },
+    /// A `{ … }` group; `}` closes it.
+    Group,
+}
+
+struct Parser<'a> {
+    cur: Cursor<'a>,
+    scene_dir: &'a Path,
+    /// The current default material (§6.2).
+    default_material: MaterialDesc,
+    named: NamedMaterials,
+    transforms: TransformStack,
+    scene: SceneDescription,
+}
+
+impl<'a> Parser<'a> {
+    fn file(&mut self) -> Result<(), ParseError> {
+        if !self.cur.at_word("SBT-raytracer") {
+            return Err(self
+                .cur
+                .unexpected("the header `SBT-raytracer 1.0`")
+                .with_help("every scene file starts with `SBT-raytracer 1.0`"));
+        }
+        self.cur.next();
+        let (version, span) = self
+            .cur
+            .number("(the format version) after `SBT-raytracer`")?;
+        if version > 1.1 {
+            return Err(ParseError::new(
+                format!("format version {version} is not supported; this reader accepts versions up to 1.1"),
+                span,
+            ));
+        }
+        loop {
+            let token = self.cur.peek().clone();
+            match token.tok {
+                Tok::Eof => return Ok(()),
+                Tok::Semicolon => {
+                    self.cur.next();
+                }
+                Tok::Word => match self.cur.text_of(&token) {
+                    "camera" => self.camera()?,
+                    "point_light" => self.point_light()?,
+                    "directional_light" => self.directional_light()?,
+                    "ambient_light" => self.ambient_light()?,
+                    "material" => {
+                        let base = self.default_material.clone();
+                        self.default_material = self.material_stmt(&base)?;
+                    }
+                    _ => self.element(TOP_LEVEL)?,
+                },
+                _ => self.element(TOP_LEVEL)?,
+            }
+        }
+    }
+
+    /// The error for a word that is not allowed here: extension, misspelling or plain unexpected.
+    fn bad_word(&self, what: &str, allowed: &[&str]) -> ParseError {
+        let token = self.cur.peek();
+        if token.tok == Tok::Word {
+            let word = self.cur.text_of(token);
+            if let Some(error) = extension_error(word, &token.span) {
+                return error;
+            }
+            let error = self.cur.unexpected(what);
+            if let Some(near) = suggest::nearest(word, allowed.iter().copied()) {
+                return error.with_help(suggest::did_you_mean(near));
+            }
+            return error;
+        }
+        self.cur.unexpected(what)
+    }
+
+    /// One transformable element (object, transform or group), read without recursion.
+    fn element(&mut self, allowed: &[&str]) -> Result<(), ParseError> {
+        let mut frames: Vec<Frame> = Vec::new();
+        loop {
+            // Start of an element.
+            let token = self.cur.peek().clone();
+            let word = if token.tok == Tok::Word {
+                self.cur.text_of(&token)
+            } else {
+                ""
+            };
+            match (token.tok, word) {
+                (Tok::LBrace, _) => {
+                    self.cur.next();
+                    frames.push(Frame::Group);
+                }
+                (Tok::Word, "translate" | "scale" | "rotate" | "transform") => {
+                    self.cur.next();
+                    let local = self.transform_head(&token)?;
+                    let span = token.span.start..self.cur.prev_end();
+                    self.transforms.push(local, &span)?;
+                    frames.push(Frame::Transform { keyword: token });
+                    continue;
+                }
+                (Tok::Word, "sphere" | "box" | "square" | "cylinder" | "cone") => {
+                    self.cur.next();
+                    self.simple_primitive(&token)?;
+                }
+                (Tok::Word, "trimesh" | "polymesh") => {
+                    self.cur.next();
+                    self.trimesh(&token)?;
+                }
+                _ => {
+                    let (what, allowed) = if frames.is_empty() && allowed.len() > ELEMENTS.len() {
+                        (
+                            "a camera, light, `material`, object, transform or `{` group",
+                            allowed,
+                        )
+                    } else {
+                        ("an object, a transform or a `{` group", ELEMENTS)
+                    };
+                    let error = self.bad_word(what, allowed);
+                    return Err(if token.tok == Tok::Semicolon && !frames.is_empty() {
+                        error.with_help("a `;` may only follow a transform's closing `)`")
+                    } else {
+                        error
+                    });
+                }
+            }
+            // An element is complete or a group has just opened: close what can be closed.
+            loop {
+                match frames.last() {
+                    None => return Ok(()),
+                    Some(Frame::Transform { keyword }) => {
+                        let context = format!("to close `{}`", self.cur.text_of(keyword));
+                        self.cur.expect(Tok::RParen, &context)?;
+                        self.cur.eat(Tok::Semicolon);
+                        self.transforms.pop();
+                        frames.pop();
+                    }
+                    Some(Frame::Group) => {
+                        // Extension: `material = …` inside a group sets the default from here on.
+                        while self.cur.at_word("material") {
+                            let base = self.default_material.clone();
+                            self.default_material = self.material_stmt(&base)?;
+                        }
+                        if self.cur.eat(Tok::RBrace) {
+                            frames.pop();
+                        } else if self.cur.peek().tok == Tok::Eof {
+                            return Err(self.cur.unexpected("`}` to close the group"));
+                        } else {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// The arguments of a transform up to and including the comma before its child.
+    fn transform_head(&mut self, keyword: &Token) -> Result<glam::Mat4, ParseError> {
+        let name = self.cur.text_of(keyword);
+        self.cur.expect(Tok::LParen, &format!("after `{name}`"))?;
+        let start = keyword.span.start;
+        let ctx = format!("in `{name}`");
+        match name {
+            "translate" => {
+                let v = self.numbers_then_comma::<3>(&ctx)?;
+                Ok(transform_stack::translation(Vec3::from(v)))
+            }
+            "scale" => {
+                let (first, _) = self.cur.number(&ctx)?;
+                self.cur
+                    .expect(Tok::Comma, &format!("after the first factor {ctx}"))?;
+                // A number after the first comma means three factors (§2).
+                let factors = if matches!(self.cur.peek().tok, Tok::Number(_)) {
+                    let [y, z] = self.numbers_then_comma::<2>(&ctx)?;
+                    Vec3::new(first, y, z)
+                } else {
+                    Vec3::splat(first)
+                };
+                transform_stack::scaling(factors, &(start..self.cur.prev_end()))
+            }
+            "rotate" => {
+                let [x, y, z, angle] = self.numbers_then_comma::<4>(&ctx)?;
+                transform_stack::rotation(Vec3::new(x, y, z), angle, &(start..self.cur.prev_end()))
+            }
+            _ => {
+                let mut rows = [Vec4::ZERO; 4];
+                for row in &mut rows {
+                    *row = Vec4::from(self.tuple::<4>(&ctx)?.0);
+                    self.cur
+                        .expect(Tok::Comma, &format!("after a matrix row {ctx}"))?;
+                }
+                transform_stack::from_rows(rows, &(start..self.cur.prev_end()))
+            }
+        }
+    }
+
+    /// `N` numbers, each followed by a comma.
+    fn numbers_then_comma<const N: usize>(
+        &mut self,
+        context: &str,
+    ) -> Result<[f32; N], ParseError> {
+        let mut values = [0.0; N];
+        for value in &mut values {
+            *value = self.cur.number(context)?.0;
+            self.cur
+                .expect(Tok::Comma, &format!("after a number {context}"))?;
+        }
+        Ok(values)
+    }
+
+    /// `( n, n, … )` with exactly `N` numbers; returns them and the span of the tuple.
+    fn tuple<const N: usize>(&mut self, context: &str) -> Result<([f32; N], Span), ParseError> {
+        let open = self
+            .cur
+            .expect(Tok::LParen, &format!("to start a {N}-tuple {context}"))?;
+        let mut values = [0.0; N];
+        for (i, value) in values.iter_mut().enumerate() {
+            if i > 0 {
+                self.cur.expect(
+                    Tok::Comma,
+                    &format!("between the numbers of a {N}-tuple {context}"),
+                )?;
+            }
+            *value = self.cur.number(&format!("in a {N}-tuple {context}"))?.0;
+        }
+        self.cur
+            .expect(Tok::RParen, &format!("to close a {N}-tuple {context}"))?;
+        Ok((values, open.span.start..self.cur.prev_end()))
+    }
+
+    fn vec3(&mut self, context: &str) -> Result<Vec3, ParseError> {
+        Ok(Vec3::from(self.tuple::<3>(context)?.0))
+    }
+
+    /// Consumes `key` (already peeked) and the `=` after it; returns the key token.
+    fn key_equals(&mut self) -> Result<Token, ParseError> {
+        let key = self.cur.next();
+        let context = format!("after `{}`", self.cur.text_of(&key));
+        self.cur.expect(Tok::Equals, &context)?;
+        Ok(key)
+    }
+
+    /// An identifier or a quoted string (names and file names).
+    fn identifier(&mut self, context: &str) -> Result<(String, Span), ParseError> {
+        let token = self.cur.peek().clone();
+        match token.tok {
+            Tok::Quoted => {
+                self.cur.next();
+                Ok((self.cur.text_of(&token).to_string(), token.span))
+            }
+            Tok::Word if !is_reserved(self.cur.text_of(&token)) => {
+                self.cur.next();
+                Ok((self.cur.text_of(&token).to_string(), token.span))
+            }
+            Tok::Word => Err(self
+                .cur
+                .unexpected(&format!("a name {context}"))
+                .with_help("keywords are reserved; put the name in double quotes")),
+            _ => Err(self.cur.unexpected(&format!("a name {context}"))),
+        }
+    }
+
+    /// `name = ID ;?` on an object (the value is ignored).
+    fn name_attr(&mut self) -> Result<(), ParseError> {
+        self.key_equals()?;
+        self.identifier("after `name =`")?;
+        self.cur.eat(Tok::Semicolon);
+        Ok(())
+    }
+
+    /// A block `{ key = value … }` of some statement; calls `field` for each key.
+    fn block(
+        &mut self,
+        keyword: &Token,
+        mut field: impl FnMut(&mut Self, &Token, &str) -> Result<bool, ParseError>,
+        allowed: &[&str],
+    ) -> Result<(), ParseError> {
+        let name = self.cur.text_of(keyword);
+        self.cur.expect(Tok::LBrace, &format!("after `{name}`"))?;
+        loop {
+            let token = self.cur.peek().clone();
+            if self.cur.eat(Tok::RBrace) {
+                return Ok(());
+            }
+            let handled = token.tok == Tok::Word && field(self, &token, self.cur.text_of(&token))?;
+            if !handled {
+                let list = allowed
+                    .iter()
+                    .map(|f| format!("`{f}`"))
+                    .collect::<Vec<_>>()
+                    .join(", ");
+                return Err(self.bad_word(&format!("a `{name}` field ({list}) or `}}`"), allowed));
+            }
+        }
+    }
+
+    fn camera(&mut self) -> Result<(), ParseError> {
+        let keyword = self.cur.next();
+        // Later camera blocks modify the same camera, as in the skeleton.
+        let mut camera = self.scene.camera.take().unwrap_or(CameraDesc {
+            position: Vec3::ZERO,
+            viewdir: None,
+            updir: None,
+            look_at: None,
+            quaternion: None,
+            fov_degrees: None,
+            aspect_ratio: None,
+            basis: CameraBasis::AsGiven,
+            span: keyword.span.clone(),
+        });
+        let (mut viewdir, mut updir) = (None, None);
+        self.block(
+            &keyword,
+            |p, _, key| {
+                match key {
+                    "position" | "viewdir" | "updir" | "look_at" => {
+                        p.key_equals()?;
+                        let v = p.vec3(&format!("for the camera `{key}`"))?;
+                        match key {
+                            "position" => camera.position = v,
+                            "viewdir" => viewdir = Some(v),
+                            "updir" => updir = Some(v),
+                            _ => camera.look_at = Some(v),
+                        }
+                    }
+                    "fov" | "aspectratio" => {
+                        p.key_equals()?;
+                        let (v, _) = p.cur.number(&format!("for `{key}`"))?;
+                        if key == "fov" {
+                            camera.fov_degrees = Some(v);
+                        } else {
+                            camera.aspect_ratio = Some(v);
+                        }
+                    }
+                    "quaternian" => {
+                        p.key_equals()?;
+                        camera.quaternion = Some(p.tuple::<4>("for `quaternian`")?.0);
+                    }
+                    _ => return Ok(false),
+                }
+                p.cur.eat(Tok::Semicolon);
+                Ok(true)
+            },
+            CAMERA_FIELDS,
+        )?;
+        camera.span = keyword.span.start..self.cur.prev_end();
+        match (viewdir, updir, camera.look_at) {
+            (Some(_), None, None) | (None, Some(_), None) => {
+                return Err(ParseError::new(
+                    "the camera needs `viewdir` and `updir` together",
+                    camera.span,
+                ))
+            }
+            (Some(_), _, Some(_)) => {
+                return Err(ParseError::new(
+                    "the camera has both `viewdir` and `look_at`; give only one",
+                    camera.span,
+                ))
+            }
+            _ => {}
+        }
+        if viewdir.is_some() {
+            camera.viewdir = viewdir;
+        }
+        if updir.is_some() {
+            camera.updir = updir;
+        }
+        if camera.look_at.is_some() {
+            camera.basis = CameraBasis::Orthonormal;
+        }
+        self.scene.camera = Some(camera);
+        Ok(())
+    }
+
+    fn point_light(&mut self) -> Result<(), ParseError> {
+        let keyword = self.cur.next();
+        let (mut position, mut color) = (None, None);
+        let mut attenuation = [0.0, 0.0, 1.0];
+        self.block(
+            &keyword,
+            |p, token, key| {
+                match key {
+                    "position" | "color" | "colour" => {
+                        let slot = if key == "position" {
+                            &mut position
+                        } else {
+                            &mut color
+                        };
+                        if slot.is_some() {
+                            return Err(ParseError::new(
+                                format!("`point_light` has a second `{key}`"),
+                                token.span.clone(),
+                            ));
+                        }
+                        p.key_equals()?;
+                        *slot = Some(p.vec3(&format!("for `{key}`"))?);
+                    }
+                    "constant_attenuation_coeff"
+                    | "linear_attenuation_coeff"
+                    | "quadratic_attenuation_coeff" => {
+                        p.key_equals()?;
+                        let i = match key {
+                            "constant_attenuation_coeff" => 0,
+                            "linear_attenuation_coeff" => 1,
+                            _ => 2,
+                        };
+                        attenuation[i] = p.cur.number(&format!("for `{key}`"))?.0;
+                    }
+                    _ => return Ok(false),
+                }
+                p.cur.eat(Tok::Semicolon);
+                Ok(true)
+            },
+            POINT_LIGHT_FIELDS,
+        )?;
+        let span = keyword.span.start..self.cur.prev_end();
+        let (position, color) = match (position, color) {
+            (Some(position), Some(color)) => (position, color),
+            (None, _) => return Err(ParseError::new("`point_light` needs a `position`", span)),
+            (_, None) => return Err(ParseError::new("`point_light` needs a `color`", span)),
+        };
+        self.scene.lights.push(LightDesc::Point {
+            position,
+            color,
+            attenuation,
+            span,
+        });
+        Ok(())
+    }
+
+    fn directional_light(&mut self) -> Result<(), ParseError> {
+        let keyword = self.cur.next();
+        let (mut direction, mut color) = (None, None);
+        self.block(
+            &keyword,
+            |p, token, key| {
+                if !matches!(key, "direction" | "color" | "colour") {
+                    return Ok(false);
+                }
+                let slot = if key == "direction" {
+                    &mut direction
+                } else {
+                    &mut color
+                };
+                if slot.is_some() {
+                    return Err(ParseError::new(
+                        format!("`directional_light` has a second `{key}`"),
+                        token.span.clone(),
+                    ));
+                }
+                p.key_equals()?;
+                *slot = Some(p.vec3(&format!("for `{key}`"))?);
+                p.cur.eat(Tok::Semicolon);
+                Ok(true)
+            },
+            DIRECTIONAL_LIGHT_FIELDS,
+        )?;
+        let span = keyword.span.start..self.cur.prev_end();
+        let (direction, color) = match (direction, color) {
+            (Some(direction), Some(color)) => (direction, color),
+            (None, _) => {
+                return Err(ParseError::new(
+                    "`directional_light` needs a `direction`",
+                    span,
+                ))
+            }
+            (_, None) => return Err(ParseError::new("`directional_light` needs a `color`", span)),
+        };
+        self.scene.lights.push(LightDesc::Directional {
+            direction,
+            color,
+            span,
+        });
+        Ok(())
+    }
+
+    fn ambient_light(&mut self) -> Result<(), ParseError> {
+        self.cur.next();
+        self.cur.expect(Tok::LBrace, "after `ambient_light`")?;
+        if !(self.cur.at_word("color") || self.cur.at_word("colour")) {
+            return Err(self.bad_word("`color` in `ambient_light`", &["color", "colour"]));
+        }
+        self.key_equals()?;
+        let color = self.vec3("for the ambient `color`")?;
+        self.scene.ambient += color;
+        self.cur.eat(Tok::Semicolon);
+        self.cur.expect(
+            Tok::RBrace,
+            "to close `ambient_light` (it has exactly one `color`)",
+        )?;
+        Ok(())
+    }
+
+    /// `material = body ;?` (the `material` word is next); the body starts from `base`.
+    fn material_stmt(&mut self, base: &MaterialDesc) -> Result<MaterialDesc, ParseError> {
+        self.key_equals()?;
+        let material = self.material_body(base)?;
+        self.cur.eat(Tok::Semicolon);
+        Ok(material)
+    }
+
+    /// `{ fields }` starting from `base`, or a named material's name.
+    fn material_body(&mut self, base: &MaterialDesc) -> Result<MaterialDesc, ParseError> {
+        let token = self.cur.peek().clone();
+        if token.tok == Tok::Quoted
+            || (token.tok == Tok::Word && !is_reserved(self.cur.text_of(&token)))
+        {
+            if let Some(error) = extension_error(self.cur.text_of(&token), &token.span) {
+                return Err(error);
+            }
+            let (name, span) = self.identifier("")?;
+            return self.named.get(&name, &span);
+        }
+        if token.tok != Tok::LBrace {
+            return Err(self
+                .cur
+                .unexpected("`{` or a material name after `material =`"));
+        }
+        self.cur.next();
+        let mut material = base.clone();
+        material.name = None;
+        let mut name: Option<(String, Span)> = None;
+        loop {
+            let token = self.cur.peek().clone();
+            if self.cur.eat(Tok::RBrace) {
+                break;
+            }
+            let key = if token.tok == Tok::Word {
+                self.cur.text_of(&token)
+            } else {
+                ""
+            };
+            match key {
+                "name" => {
+                    self.cur.next();
+                    // `name ID;` is the skeleton's form; `name = ID` is accepted as well.
+                    let with_equals = self.cur.eat(Tok::Equals);
+                    let (value, span) = self.identifier("after `name`")?;
+                    if with_equals {
+                        self.cur.eat(Tok::Semicolon);
+                    } else {
+                        self.cur
+                            .expect(Tok::Semicolon, "after `name ID` in a material")?;
+                    }
+                    if name.is_some() {
+                        return Err(ParseError::new("this material has a second `name`", span));
+                    }
+                    name = Some((value, span));
+                }
+                _ if COLOUR_FIELDS.contains(&key) || key == "shininess" || key == "index" => {
+                    self.key_equals()?;
+                    let value = if self.cur.at_word("map") {
+                        self.texture()?
+                    } else if key == "shininess" || key == "index" {
+                        Param::grey(self.cur.number(&format!("or `map(…)` for `{key}`"))?.0)
+                    } else {
+                        Param::Constant(self.vec3(&format!("(or `map(…)`) for `{key}`"))?)
+                    };
+                    self.cur.eat(Tok::Semicolon);
+                    *field_mut(&mut material, key) = value;
+                }
+                _ => {
+                    let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `name`";
+                    return Err(self.bad_word(
+                        &format!("a material field ({list}) or `}}`"),
+                        MATERIAL_FIELDS,
+                    ));
+                }
+            }
+        }
+        if let Some((value, span)) = name {
+            material.name = Some(value.clone());
+            self.named.register(&value, material.clone(), &span)?;
+        }
+        Ok(material)
+    }
+
+    /// `map ( ID )` with the path resolved against the scene directory.
+    fn texture(&mut self) -> Result<Param, ParseError> {
+        let start = self.cur.next().span.start;
+        self.cur.expect(Tok::LParen, "after `map`")?;
+        let (file, _) = self.identifier("(the image file) in `map(…)`")?;
+        self.cur.expect(Tok::RParen, "to close `map(…)`")?;
+        Ok(Param::Texture {
+            path: self.scene_dir.join(file),
+            span: start..self.cur.prev_end(),
+        })
+    }
+
+    fn push_object(&mut self, shape: ShapeDesc, material: MaterialDesc, span: Span) {
+        self.scene.objects.push(ObjectDesc {
+            shape,
+            world_from_object: self.transforms.current(),
+            material,
+            span,
+        });
+    }
+
+    /// sphere, box, square, cylinder, cone (the keyword is consumed).
+    fn simple_primitive(&mut self, keyword: &Token) -> Result<(), ParseError> {
+        let kind = self.cur.text_of(keyword);
+        let mut material = None;
+        let (mut height, mut bottom, mut top, mut capped) = (1.0f32, 1.0f32, 0.0f32, true);
+        let allowed: &[&str] = match kind {
+            "cone" => &[
+                "material",
+                "name",
+                "capped",
+                "height",
+                "bottom_radius",
+                "top_radius",
+            ],
+            "cylinder" => &["material", "name", "capped"],
+            _ => &["material", "name"],
+        };
+        self.block(
+            keyword,
+            |p, _, key| {
+                match key {
+                    "material" => {
+                        let base = p.default_material.clone();
+                        material = Some(p.material_stmt(&base)?);
+                    }
+                    "name" => p.name_attr()?,
+                    "capped" if kind == "cone" || kind == "cylinder" => {
+                        p.key_equals()?;
+                        capped = p.boolean("after `capped =`")?;
+                        p.cur.eat(Tok::Semicolon);
+                    }
+                    "height" | "bottom_radius" | "top_radius" if kind == "cone" => {
+                        p.key_equals()?;
+                        let value = p.cur.number(&format!("for `{key}`"))?.0;
+                        match key {
+                            "height" => height = value,
+                            // Radii are kept as magnitudes, as the course reader does.
+                            "bottom_radius" => bottom = value.abs(),
+                            _ => top = value.abs(),
+                        }
+                        p.cur.eat(Tok::Semicolon);
+                    }
+                    _ => return Ok(false),
+                }
+                Ok(true)
+            },
+            allowed,
+        )?;
+        let shape = match kind {
+            "sphere" => ShapeDesc::Sphere,
+            "box" => ShapeDesc::Box,
+            "square" => ShapeDesc::Square,
+            "cylinder" => ShapeDesc::Cylinder { capped },
+            _ => ShapeDesc::Cone {
+                height,
+                bottom_radius: bottom,
+                top_radius: top,
+                capped,
+            },
+        };
+        let material = material.unwrap_or_else(|| self.default_material.clone());
+        self.push_object(shape, material, keyword.span.clone());
+        Ok(())
+    }
+
+    fn boolean(&mut self, context: &str) -> Result<bool, ParseError> {
+        if self.cur.at_word("true") {
+            self.cur.next();
+            Ok(true)
+        } else if self.cur.at_word("false") {
+            self.cur.next();
+            Ok(false)
+        } else {
+            Err(self.cur.unexpected(&format!("`true` or `false` {context}")))
+        }
+    }
+
+    /// `( item, item, … )` where `item` reads one entry; `;` after the `)` is required.
+    fn list(
+        &mut self,
+        key: &str,
+        mut item: impl FnMut(&mut Self) -> Result<(), ParseError>,
+    ) -> Result<Span, ParseError> {
+        let open = self
+            .cur
+            .expect(Tok::LParen, &format!("to start the `{key}` list"))?;
+        if !self.cur.eat(Tok::RParen) {
+            loop {
+                item(self)?;
+                if self.cur.eat(Tok::RParen) {
+                    break;
+                }
+                self.cur
+                    .expect(Tok::Comma, &format!("or `)` between entries of `{key}`"))?;
+            }
+        }
+        let span = open.span.start..self.cur.prev_end();
+        self.cur.expect(
+            Tok::Semicolon,
+            &format!("after the `{key}` list (it is required here)"),
+        )?;
+        Ok(span)
+    }
+
+    fn trimesh(&mut self, keyword: &Token) -> Result<(), ParseError> {
+        let mut material: Option<MaterialDesc> = None;
+        let mut mesh = MeshInput::default();
+        self.block(
+            keyword,
+            |p, _, key| {
+                match key {
+                    "material" => {
+                        let base = p.default_material.clone();
+                        material = Some(p.material_stmt(&base)?);
+                    }
+                    "name" => p.name_attr()?,
+                    "gennormals" => {
+                        p.cur.next();
+                        p.cur.expect(Tok::Semicolon, "after `gennormals`")?;
+                        mesh.gennormals = true;
+                    }
+                    "points" => {
+                        p.key_equals()?;
+                        let mut points = Vec::new();
+                        p.list(key, |p| {
+                            points.push(p.vec3("in `points`")?);
+                            Ok(())
+                        })?;
+                        mesh.points = points;
+                    }
+                    "normals" => {
+                        p.key_equals()?;
+                        let mut normals = Vec::new();
+                        let span = p.list(key, |p| {
+                            normals.push(p.vec3("in `normals`")?);
+                            Ok(())
+                        })?;
+                        mesh.normals = Some((normals, span));
+                    }
+                    "texture_uv" => {
+                        p.key_equals()?;
+                        let mut uvs = Vec::new();
+                        let span = p.list(key, |p| {
+                            uvs.push(Vec2::from(p.tuple::<2>("in `texture_uv`")?.0));
+                            Ok(())
+                        })?;
+                        mesh.uvs = Some((uvs, span));
+                    }
+                    "faces" => {
+                        p.key_equals()?;
+                        // A later `faces` replaces an earlier one, like any repeated attribute.
+                        mesh.face_indices.clear();
+                        mesh.faces.clear();
+                        p.list(key, |p| {
+                            let open = p.cur.expect(Tok::LParen, "to start a face")?;
+                            let first = mesh.face_indices.len();
+                            loop {
+                                mesh.face_indices
+                                    .push(p.cur.number_f64("(a vertex index) in a face")?);
+                                if p.cur.eat(Tok::RParen) {
+                                    break;
+                                }
+                                p.cur
+                                    .expect(Tok::Comma, "or `)` between the indices of a face")?;
+                            }
+                            let span = open.span.start..p.cur.prev_end();
+                            mesh.faces.push((first..mesh.face_indices.len(), span));
+                            Ok(())
+                        })?;
+                    }
+                    "materials" => {
+                        p.key_equals()?;
+                        // Each entry starts from the mesh's material as it is at this point.
+                        let base = material
+                            .clone()
+                            .unwrap_or_else(|| p.default_material.clone());
+                        let mut materials = Vec::new();
+                        let span = p.list(key, |p| {
+                            materials.push(p.material_body(&base)?);
+                            Ok(())
+                        })?;
+                        mesh.materials = Some((materials, span));
+                    }
+                    _ => return Ok(false),
+                }
+                Ok(true)
+            },
+            MESH_FIELDS,
+        )?;
+        let span = keyword.span.clone();
+        let block_span = keyword.span.start..self.cur.prev_end();
+        if let Some(desc) = trimesh::finish(mesh, &block_span, &mut self.scene.warnings)? {
+            let material = material.unwrap_or_else(|| self.default_material.clone());
+            self.push_object(ShapeDesc::Trimesh(Box::new(desc)), material, span);
+        }
+        Ok(())
+    }
+}
+
+/// The material field named `key` (one of the colour fields, `shininess` or `index`).
+pub(crate) fn field_mut<'m>(material: &'m mut MaterialDesc, key: &str) -> &'m mut Param {
+    match key {
+        "emissive" => &mut material.emissive,
+        "ambient" => &mut material.ambient,
+        "specular" => &mut material.specular,
+        "reflective" => &mut material.reflective,
+        "diffuse" => &mut material.diffuse,
+        "transmissive" => &mut material.transmissive,
+        "shininess" => &mut material.shininess,
+        _ => &mut material.index,
+    }
+}

@@ -1,0 +1,302 @@
+//! Every scene of the shared corpus either parses or fails with the error this table expects.
+
+use caustica::error::line_col;
+use caustica::scene::ray_file::{self, ast::Dialect, ParseOptions};
+use std::path::{Path, PathBuf};
+
+fn corpus_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/sbt-corpus")
+}
+
+/// Files that must fail: (file name, expected message substring, why).
+const EXPECTED_FAILURES: &[(&str, &str, &str)] = &[
+    (
+        "aashish-sheshadri__cs384G-ray__bump.ray",
+        "`bump_mapping` is a student extension",
+        "UT 2013 fork: bump maps in materials",
+    ),
+    (
+        "aashish-sheshadri__cs384G-ray__earthMoon.ray",
+        "`bump_mapping` is a student extension",
+        "UT 2013 fork: bump maps in materials",
+    ),
+    (
+        "aashish-sheshadri__cs384G-ray__earthMoonDragon.ray",
+        "`bump_mapping` is a student extension",
+        "UT 2013 fork: bump maps in materials",
+    ),
+    (
+        "aashish-sheshadri__cs384G-ray__final-box.ray",
+        "`bump_mapping` is a student extension",
+        "UT 2013 fork: bump maps in materials",
+    ),
+    (
+        "aashish-sheshadri__cs384G-ray__finalDragon.ray",
+        "`bump_mapping` is a student extension",
+        "UT 2013 fork: bump maps in materials",
+    ),
+    (
+        "aashish-sheshadri__cs384G-ray__hitchcockEarth.ray",
+        "`bump_mapping` is a student extension",
+        "UT 2013 fork: bump maps in materials",
+    ),
+    (
+        "aashish-sheshadri__cs384G-ray__sphere1.ray",
+        "`bump_mapping` is a student extension",
+        "UT 2013 fork: bump maps in materials",
+    ),
+    (
+        "aashish-sheshadri__cs384G-ray__stars.ray",
+        "expected the header `SBT-raytracer 1.0`",
+        "include fragment without a header",
+    ),
+    (
+        "chipbuster__p2-raytracer__cbox.ray",
+        "`area_light` is a student extension",
+        "UT 2018 fork: area lights",
+    ),
+    (
+        "chipbuster__p2-raytracer__simple.ray",
+        "`area_light` is a student extension",
+        "UT 2018 fork: area lights",
+    ),
+    (
+        "danvim__COMP4411-Trace__box_csg_reflect_texture_brick_marble.ray",
+        "`subtraction` is a student extension",
+        "HKUST fork: CSG operations",
+    ),
+    (
+        "danvim__COMP4411-Trace__box_cyl_reflect_texture_brick_marble.ray",
+        "`marble` is a student extension",
+        "HKUST fork: procedural marble texture",
+    ),
+    (
+        "danvim__COMP4411-Trace__box_torus_reflect_texture_brick_marble.ray",
+        "`torus` is a student extension",
+        "HKUST fork: torus primitive",
+    ),
+    (
+        "danvim__COMP4411-Trace__metaballs.ray",
+        "`metaballs` is a student extension",
+        "HKUST fork: metaballs",
+    ),
+    (
+        "danvim__COMP4411-Trace__particles.ray",
+        "`particles` is a student extension",
+        "HKUST fork: particle systems",
+    ),
+    (
+        "danvim__COMP4411-Trace__recurse_depth_spot.ray",
+        "`spot_light` is a student extension",
+        "HKUST fork: spot lights",
+    ),
+    (
+        "danvim__COMP4411-Trace__shapeLight.ray",
+        "`warn_light` is a student extension",
+        "HKUST fork: Warn lights",
+    ),
+    (
+        "mbartling__photonMapper__cube.ray",
+        "`objfile` is a student extension",
+        "UT 2016 fork: meshes loaded from .obj files",
+    ),
+    (
+        "mbartling__photonMapper__mbox.ray",
+        "`objfile` is a student extension",
+        "UT 2016 fork: meshes loaded from .obj files",
+    ),
+    (
+        "mbartling__photonMapper__sintel.ray",
+        "`objfile` is a student extension",
+        "UT 2016 fork: meshes loaded from .obj files",
+    ),
+    (
+        "mbartling__photonMapper__suzanne.ray",
+        "`objfile` is a student extension",
+        "UT 2016 fork: meshes loaded from .obj files",
+    ),
+    (
+        "mbartling__photonMapper__wineglasses.ray",
+        "`objfile` is a student extension",
+        "UT 2016 fork: meshes loaded from .obj files",
+    ),
+    (
+        "michaelasper__ray-tracer__quad_cone.ray",
+        "`quadric` is a student extension",
+        "UT 2019 student: quadric surfaces",
+    ),
+    (
+        "michaelasper__ray-tracer__quad_ellipsoid.ray",
+        "`quadric` is a student extension",
+        "UT 2019 student: quadric surfaces",
+    ),
+    (
+        "michaelasper__ray-tracer__quad_paraboloid.ray",
+        "`quadric` is a student extension",
+        "UT 2019 student: quadric surfaces",
+    ),
+    (
+        "michaelasper__ray-tracer__quad_sphere.ray",
+        "`quadric` is a student extension",
+        "UT 2019 student: quadric surfaces",
+    ),
+    (
+        "michaelasper__ray-tracer__soft1.ray",
+        "`area_light` is a student extension",
+        "UT 2019 student: area lights",
+    ),
+    (
+        "michaelasper__ray-tracer__soft2.ray",
+        "`area_light` is a student extension",
+        "UT 2019 student: area lights",
+    ),
+    (
+        "michaelasper__ray-tracer__torii.ray",
+        "`torus` is a student extension",
+        "UT 2019 student: torus primitive",
+    ),
+    (
+        "michaelasper__ray-tracer__torus1.ray",
+        "`torus` is a student extension",
+        "UT 2019 student: torus primitive",
+    ),
+    (
+        "michaelasper__ray-tracer__torus2.ray",
+        "`torus` is a student extension",
+        "UT 2019 student: torus primitive",
+    ),
+    (
+        "michaelasper__ray-tracer__torus_reflect.ray",
+        "`torus` is a student extension",
+        "UT 2019 student: torus primitive",
+    ),
+    (
+        "snowboat__RayTracingS17__Hyperbolic_Paraboloid.ray",
+        "`warn_model_light` is a student extension",
+        "HKUST 2017 fork: Warn model lights",
+    ),
+    (
+        "snowboat__RayTracingS17__Hyperboloid.ray",
+        "`hyperboloid` is a student extension",
+        "HKUST 2017 fork: hyperboloid primitive",
+    ),
+    (
+        "snowboat__RayTracingS17__box_test_spotlight.ray",
+        "`spot_light` is a student extension",
+        "HKUST 2017 fork: spot lights",
+    ),
+    (
+        "snowboat__RayTracingS17__emptyScene-testHeightField.ray",
+        "`warn_model_light` is a student extension",
+        "HKUST 2017 fork: Warn model lights",
+    ),
+    (
+        "snowboat__RayTracingS17__test_warn_model.ray",
+        "`warn_model_light` is a student extension",
+        "HKUST 2017 fork: Warn model lights",
+    ),
+];
+
+#[test]
+fn corpus_parses_or_fails_as_expected() {
+    let dir = corpus_dir();
+    let Ok(entries) = std::fs::read_dir(&dir) else {
+        println!("skipping: corpus directory {} is absent", dir.display());
+        return;
+    };
+    let mut names: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".ray"))
+        .collect();
+    names.sort();
+    let mut problems = Vec::new();
+    let (mut parsed, mut failed, mut dialect_o) = (0, 0, 0);
+    for name in &names {
+        let bytes = std::fs::read(dir.join(name)).expect("readable corpus file");
+        let text = String::from_utf8_lossy(&bytes);
+        let result = ray_file::parse(&text, &dir, &ParseOptions::default());
+        let expected = EXPECTED_FAILURES.iter().find(|(n, _, _)| n == name);
+        match (result, expected) {
+            (Ok(scene), None) => {
+                parsed += 1;
+                let spans = scene
+                    .objects
+                    .iter()
+                    .map(|o| &o.span)
+                    .chain(scene.warnings.iter().map(|(_, s)| s));
+                for span in spans {
+                    if text.get(span.clone()).is_none() {
+                        problems.push(format!("{name}: span {span:?} is outside the text"));
+                    }
+                }
+                if scene.dialect == Dialect::Dictionary {
+                    dialect_o += 1;
+                }
+                println!(
+                    "OK   {name} {:?} objects={} warnings={}",
+                    scene.dialect,
+                    scene.objects.len(),
+                    scene.warnings.len()
+                );
+            }
+            (Ok(_), Some((_, message, _))) => problems.push(format!(
+                "{name}: parsed, but was expected to fail with `{message}`"
+            )),
+            (Err(error), Some((_, message, _))) if error.message.contains(message) => failed += 1,
+            (Err(error), _) => {
+                let (line, col) = line_col(&text, error.span.start);
+                problems.push(format!(
+                    "{name}:{line}:{col}: unexpected error: {} (help: {:?})",
+                    error.message, error.help
+                ));
+            }
+        }
+    }
+    for (name, _, _) in EXPECTED_FAILURES {
+        if !names.iter().any(|n| n == name) {
+            problems.push(format!(
+                "{name}: listed as an expected failure but not in the corpus"
+            ));
+        }
+    }
+    println!(
+        "{parsed} parsed ({dialect_o} as dialect O), {failed} failed as expected, of {}",
+        names.len()
+    );
+    for p in &problems {
+        println!("{p}");
+    }
+    assert!(
+        problems.is_empty(),
+        "{} corpus files did not behave as expected",
+        problems.len()
+    );
+}
+
+/// Jared Croy's nephroid scene: an open ring made of an equal-radius, uncapped cone.
+#[test]
+fn caustics_ring_scene_reads_as_written() {
+    let dir = corpus_dir();
+    let Ok(text) = std::fs::read_to_string(dir.join("OccamsRazer__cs384g__ring.ray")) else {
+        println!("skipping: corpus directory {} is absent", dir.display());
+        return;
+    };
+    let scene = ray_file::parse(&text, &dir, &ParseOptions::default()).expect("ring.ray parses");
+    assert_eq!(scene.dialect, Dialect::Tokenizer);
+    let ring = scene
+        .objects
+        .iter()
+        .find_map(|o| match o.shape {
+            ray_file::ast::ShapeDesc::Cone {
+                height,
+                bottom_radius,
+                top_radius,
+                capped,
+            } => Some((height, bottom_radius, top_radius, capped)),
+            _ => None,
+        })
+        .expect("a cone");
+    assert_eq!(ring, (2.0, 3.0, 3.0, false));
+    assert_eq!(scene.lights.len(), 1);
+}
