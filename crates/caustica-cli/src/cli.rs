@@ -33,12 +33,14 @@ Examples:
   caustica photons scenes/lens.ray -o lens-map.png --ply lens.ply --photons 50000")]
     Photons(PhotonArgs),
     /// Time whole renders of the project's scenes and print a table (for BENCHMARKS.md).
-    #[command(after_help = "Each render runs in a child `caustica render --json` process, so peak memory is per render.
+    #[command(
+        after_help = "Each render runs in a child `caustica render --json` process, so peak memory is per render.
 
 Examples:
   caustica bench                          # the full table, run from the repository root
   caustica bench --quick                  # small images, for a smoke test
-  caustica bench --corpus ../shared/scenes/sbt-corpus   # adds the original project's ring scene")]
+  caustica bench --corpus ../shared/scenes/sbt-corpus   # adds the original project's ring scene"
+    )]
     Bench(BenchArgs),
 }
 

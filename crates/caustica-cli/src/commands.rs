@@ -39,11 +39,13 @@ pub fn load_scene(path: Option<&Path>, args: &SceneArgs) -> Result<Scene> {
     let settings = build_settings(args);
     match path {
         Some(path) => caustica::scene::load(path, &settings),
-        None => caustica::scene::build::from_text(presets::RING, Path::new("."), &settings).map_err(|error| Error::Scene {
-            path: "<built-in ring scene>".into(),
-            text: presets::RING.to_string(),
-            error,
-        }),
+        None => {
+            caustica::scene::build::from_text(presets::RING, Path::new("."), &settings).map_err(|error| Error::Scene {
+                path: "<built-in ring scene>".into(),
+                text: presets::RING.to_string(),
+                error,
+            })
+        }
     }
 }
 
@@ -61,7 +63,9 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 /// Refuses image sizes that cannot be rendered, before any memory is committed.
 pub fn check_image_size(width: usize, height: usize) -> Result<()> {
     if width == 0 || height == 0 {
-        return Err(Error::InvalidSettings("the image needs a width and height of at least 1 pixel".into()));
+        return Err(Error::InvalidSettings(
+            "the image needs a width and height of at least 1 pixel".into(),
+        ));
     }
     if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
         return Err(Error::InvalidSettings(format!(

@@ -11,7 +11,9 @@ pub fn report(error: Error) -> Report {
             let (line, col) = line_col(&text, error.span.start);
             let len = error.span.end.saturating_sub(error.span.start).max(1);
             let start = error.span.start.min(text.len());
-            let len = len.min(text.len().saturating_sub(start)).max(usize::from(start < text.len()));
+            let len = len
+                .min(text.len().saturating_sub(start))
+                .max(usize::from(start < text.len()));
             let mut diagnostic = MietteDiagnostic::new(format!("{}:{line}:{col}: {}", path.display(), error.message))
                 .with_code("caustica::scene")
                 .with_label(LabeledSpan::at(start..start + len, "here"));

@@ -30,7 +30,11 @@ fn main() -> ExitCode {
     match result {
         Ok(code) => ExitCode::from(code),
         Err(error) => {
-            let code = if error.is_bad_input() { EXIT_BAD_INPUT } else { EXIT_INTERNAL };
+            let code = if error.is_bad_input() {
+                EXIT_BAD_INPUT
+            } else {
+                EXIT_INTERNAL
+            };
             eprintln!("{:?}", diagnostics::report(error));
             ExitCode::from(code)
         }

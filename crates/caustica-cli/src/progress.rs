@@ -13,7 +13,10 @@ pub struct Bars {
 impl Bars {
     /// Bars that draw unless `quiet`.
     pub fn new(quiet: bool) -> Bars {
-        Bars { quiet, bar: Mutex::new(None) }
+        Bars {
+            quiet,
+            bar: Mutex::new(None),
+        }
     }
 }
 

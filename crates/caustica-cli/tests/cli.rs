@@ -50,7 +50,10 @@ fn render_writes_exr_and_json_summary() {
         .assert()
         .success();
     let stdout = String::from_utf8(assert.get_output().stdout.clone()).unwrap();
-    assert!(stdout.contains("\"photons_stored\":5") && stdout.contains("\"complete\":true"), "{stdout}");
+    assert!(
+        stdout.contains("\"photons_stored\":5") && stdout.contains("\"complete\":true"),
+        "{stdout}"
+    );
     let bytes = std::fs::read(&out).unwrap();
     assert_eq!(&bytes[..4], &[0x76, 0x2f, 0x31, 0x01], "OpenEXR magic number");
 }
@@ -59,8 +62,18 @@ fn render_writes_exr_and_json_summary() {
 fn a_malformed_scene_names_file_line_and_column_and_exits_2() {
     let dir = temp_dir("bad");
     let scene = dir.join("bad.ray");
-    std::fs::write(&scene, "SBT-raytracer 1.0\ncamera {\n  position = (0, 0, 1);\n  difuse = (1, 1, 1);\n}\n").unwrap();
-    let assert = caustica().arg("render").arg(&scene).arg("-o").arg(dir.join("out.png")).assert().code(2);
+    std::fs::write(
+        &scene,
+        "SBT-raytracer 1.0\ncamera {\n  position = (0, 0, 1);\n  difuse = (1, 1, 1);\n}\n",
+    )
+    .unwrap();
+    let assert = caustica()
+        .arg("render")
+        .arg(&scene)
+        .arg("-o")
+        .arg(dir.join("out.png"))
+        .assert()
+        .code(2);
     let stderr = String::from_utf8(assert.get_output().stderr.clone()).unwrap();
     assert!(stderr.contains("bad.ray:4:3"), "{stderr}");
     assert!(!dir.join("out.png").exists(), "no output for a bad scene");
@@ -100,7 +113,12 @@ fn every_subcommand_has_help_with_examples() {
 
 #[test]
 fn info_reports_camera_lights_and_objects() {
-    let assert = caustica().arg("info").arg(scenes().join("ring_double.ray")).arg("--json").assert().success();
+    let assert = caustica()
+        .arg("info")
+        .arg(scenes().join("ring_double.ray"))
+        .arg("--json")
+        .assert()
+        .success();
     let stdout = String::from_utf8(assert.get_output().stdout.clone()).unwrap();
     assert!(stdout.contains("\"lights\":[{\"type\":\"point\""), "{stdout}");
     assert!(stdout.contains("\"shapes\":2"), "{stdout}");
@@ -122,7 +140,10 @@ fn photons_draws_a_map_and_writes_ply() {
     assert_eq!(png_size(&dir.join("map.png")), (48, 48));
     let ply = std::fs::read(dir.join("map.ply")).unwrap();
     let header = String::from_utf8_lossy(&ply[..200]);
-    assert!(header.starts_with("ply\n") && header.contains("element vertex 3"), "{header}");
+    assert!(
+        header.starts_with("ply\n") && header.contains("element vertex 3"),
+        "{header}"
+    );
 }
 
 #[test]
@@ -134,7 +155,17 @@ fn the_image_does_not_depend_on_the_thread_count() {
             .arg(scenes().join("ring.ray"))
             .arg("-o")
             .arg(dir.join(format!("t{threads}.png")))
-            .args(["--width", "48", "--aa", "2", "--photons", "10000", "--threads", threads, "--quiet"])
+            .args([
+                "--width",
+                "48",
+                "--aa",
+                "2",
+                "--photons",
+                "10000",
+                "--threads",
+                threads,
+                "--quiet",
+            ])
             .assert()
             .success();
     }

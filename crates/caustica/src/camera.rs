@@ -43,7 +43,11 @@ impl Camera {
         let mut basis = desc.basis;
         if let Some(target) = desc.look_at {
             view = target - desc.position;
-            up = desc.updir.unwrap_or(if view.cross(Vec3::Y).length_squared() < 1e-12 { Vec3::X } else { Vec3::Y });
+            up = desc.updir.unwrap_or(if view.cross(Vec3::Y).length_squared() < 1e-12 {
+                Vec3::X
+            } else {
+                Vec3::Y
+            });
             basis = CameraBasis::Orthonormal;
         } else if let (Some(v), Some(u)) = (desc.viewdir, desc.updir) {
             view = v;
@@ -51,7 +55,13 @@ impl Camera {
         }
         match basis {
             CameraBasis::AsGiven => Camera::from_basis(desc.position, view, up, h, aspect),
-            CameraBasis::Normalized => Camera::from_basis(desc.position, view.normalize_or_zero(), up.normalize_or_zero(), h, aspect),
+            CameraBasis::Normalized => Camera::from_basis(
+                desc.position,
+                view.normalize_or_zero(),
+                up.normalize_or_zero(),
+                h,
+                aspect,
+            ),
             CameraBasis::Orthonormal => {
                 let z = -view.normalize_or_zero();
                 let x = up.cross(z).normalize_or_zero();

@@ -64,7 +64,10 @@ impl Film {
 
     /// 8-bit RGB bytes under `tone_map`.
     pub fn to_rgb8(&self, tone_map: ToneMap) -> Vec<u8> {
-        self.pixels.iter().flat_map(|p| p.to_array().map(|c| encode_channel(c, tone_map))).collect()
+        self.pixels
+            .iter()
+            .flat_map(|p| p.to_array().map(|c| encode_channel(c, tone_map)))
+            .collect()
     }
 
     /// Writes the film as PNG or EXR by the extension of `path`, atomically.
@@ -113,7 +116,10 @@ mod tests {
     fn srgb_and_reinhard() {
         assert!((srgb_encode(0.5) - 0.7354).abs() < 1e-3);
         // x = 1 maps to 0.5 before the sRGB curve.
-        assert_eq!(encode_channel(1.0, ToneMap::Reinhard { exposure: 0.0 }), (srgb_encode(0.5) * 255.0).round() as u8);
+        assert_eq!(
+            encode_channel(1.0, ToneMap::Reinhard { exposure: 0.0 }),
+            (srgb_encode(0.5) * 255.0).round() as u8
+        );
         assert_eq!(encode_channel(0.25, ToneMap::Linear { exposure: 2.0 }), 255);
     }
 }

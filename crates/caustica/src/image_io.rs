@@ -33,7 +33,11 @@ pub enum ImageFormat {
 impl ImageFormat {
     /// The format for `path`'s extension, or an error naming the accepted ones.
     pub fn from_path(path: &Path) -> Result<ImageFormat> {
-        match path.extension().and_then(|e| e.to_str()).map(|e| e.to_ascii_lowercase()) {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(|e| e.to_ascii_lowercase())
+        {
             Some(e) if e == "png" => Ok(ImageFormat::Png),
             Some(e) if e == "exr" => Ok(ImageFormat::Exr),
             _ => Err(Error::InvalidSettings(format!(
@@ -47,8 +51,15 @@ impl ImageFormat {
 /// Writes 8-bit RGB rows (top to bottom) as PNG, atomically.
 pub fn write_png(path: &Path, width: usize, height: usize, rgb8: &[u8]) -> Result<()> {
     write_atomically(path, |tmp| {
-        image::save_buffer_with_format(tmp, rgb8, width as u32, height as u32, image::ExtendedColorType::Rgb8, image::ImageFormat::Png)
-            .map_err(|e| e.to_string())
+        image::save_buffer_with_format(
+            tmp,
+            rgb8,
+            width as u32,
+            height as u32,
+            image::ExtendedColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| e.to_string())
     })
 }
 
@@ -60,7 +71,9 @@ pub fn write_exr(path: &Path, width: usize, height: usize, pixels: &[Vec3]) -> R
         message: "pixel count does not match the image size".into(),
     })?;
     write_atomically(path, |tmp| {
-        image::DynamicImage::ImageRgb32F(buffer).save_with_format(tmp, image::ImageFormat::OpenExr).map_err(|e| e.to_string())
+        image::DynamicImage::ImageRgb32F(buffer)
+            .save_with_format(tmp, image::ImageFormat::OpenExr)
+            .map_err(|e| e.to_string())
     })
 }
 
@@ -95,9 +108,15 @@ pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> std::result::R
 }
 
 fn temporary_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     // Keep the real extension last: the encoders pick the format from it.
-    let ext = path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()))
 }
 
@@ -119,7 +138,10 @@ mod tests {
         let (w, h, back) = read_exr(&exr).unwrap();
         assert_eq!((w, h), (2, 1));
         assert_eq!(back, pixels.to_vec());
-        let leftovers = std::fs::read_dir(&dir).unwrap().filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains(".tmp")).count();
+        let leftovers = std::fs::read_dir(&dir)
+            .unwrap()
+            .filter(|e| e.as_ref().unwrap().file_name().to_string_lossy().contains(".tmp"))
+            .count();
         assert_eq!(leftovers, 0);
         assert!(ImageFormat::from_path(Path::new("x.jpg")).is_err());
         assert!(load_texture(&dir.join("missing.png")).is_err());

@@ -88,7 +88,11 @@ where
                     let mut sum = crate::math::Vec3::ZERO;
                     for sy in 0..aa {
                         for sx in 0..aa {
-                            let (jx, jy) = if aa == 1 { (0.5, 0.5) } else { (rng.uniform(), rng.uniform()) };
+                            let (jx, jy) = if aa == 1 {
+                                (0.5, 0.5)
+                            } else {
+                                (rng.uniform(), rng.uniform())
+                            };
                             let px = x as f32 + (sx as f32 + jx) / aa as f32;
                             let py = y as f32 + (sy as f32 + jy) / aa as f32;
                             // Screen y runs upwards; film rows run downwards.

@@ -39,7 +39,11 @@ impl Light {
     /// Illumination of point `p`.
     pub fn sample_li(&self, p: Vec3) -> Option<LightSample> {
         match *self {
-            Light::Point { position, color, attenuation } => {
+            Light::Point {
+                position,
+                color,
+                attenuation,
+            } => {
                 let to_light = position - p;
                 let distance = to_light.length();
                 if distance == 0.0 || !distance.is_finite() {
@@ -94,7 +98,10 @@ mod tests {
 
     #[test]
     fn directional_light_comes_from_against_its_direction() {
-        let l = Light::Directional { direction: -Vec3::Z, color: Vec3::ONE };
+        let l = Light::Directional {
+            direction: -Vec3::Z,
+            color: Vec3::ONE,
+        };
         let s = l.sample_li(Vec3::ZERO).unwrap();
         assert_eq!(s.wi, Vec3::Z);
         assert!(s.distance.is_infinite());

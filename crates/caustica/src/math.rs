@@ -230,7 +230,12 @@ mod tests {
     #[test]
     fn box_transform_and_slab_test() {
         let b = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
-        let hit = b.intersect(Vec3::new(-5.0, 0.0, 0.0), Vec3::new(1.0, f32::INFINITY, f32::INFINITY), 0.0, 100.0);
+        let hit = b.intersect(
+            Vec3::new(-5.0, 0.0, 0.0),
+            Vec3::new(1.0, f32::INFINITY, f32::INFINITY),
+            0.0,
+            100.0,
+        );
         assert_eq!(hit, Some((4.0, 6.0)));
         let moved = b.transformed(&Mat4::from_translation(Vec3::new(2.0, 0.0, 0.0)));
         assert_eq!(moved.min, Vec3::new(1.0, -1.0, -1.0));

@@ -147,7 +147,12 @@ mod tests {
 
     #[test]
     fn power_round_trips_within_rgbe_precision() {
-        for c in [Vec3::new(1.0, 0.5, 0.25), Vec3::new(3e-6, 1e-6, 0.0), Vec3::new(1234.5, 1.0, 700.0), Vec3::splat(0.999)] {
+        for c in [
+            Vec3::new(1.0, 0.5, 0.25),
+            Vec3::new(3e-6, 1e-6, 0.0),
+            Vec3::new(1234.5, 1.0, 700.0),
+            Vec3::splat(0.999),
+        ] {
             let back = decode_rgbe(encode_rgbe(c));
             let tol = c.max_element() / 256.0;
             assert!((back - c).abs().max_element() <= tol, "{c:?} -> {back:?}");
@@ -158,7 +163,13 @@ mod tests {
 
     #[test]
     fn directions_round_trip() {
-        let dirs = [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.8, -0.52).normalize(), Vec3::new(-0.577, 0.577, 0.577).normalize()];
+        let dirs = [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::X,
+            Vec3::new(0.3, -0.8, -0.52).normalize(),
+            Vec3::new(-0.577, 0.577, 0.577).normalize(),
+        ];
         for d in dirs {
             let p = Photon::new(Vec3::ZERO, Vec3::ONE, d, d, 0, 0);
             assert!(p.direction().dot(d) > 0.99999, "{d:?} {:?}", p.direction());

@@ -127,7 +127,11 @@ impl Scene {
         triangle_refs: Vec<TriangleRef>,
         warnings: Vec<String>,
     ) -> Scene {
-        let prim_bounds: Vec<Aabb> = shapes.iter().map(|s| s.bounds).chain(triangles.iter().map(|t| t.bounds())).collect();
+        let prim_bounds: Vec<Aabb> = shapes
+            .iter()
+            .map(|s| s.bounds)
+            .chain(triangles.iter().map(|t| t.bounds()))
+            .collect();
         let bvh = Bvh::build(&prim_bounds);
         Scene {
             camera,
@@ -202,12 +206,14 @@ impl Scene {
                     uv: h.uv,
                 })
             } else {
-                self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max).map(|h| Intersection {
-                    t: h.t,
-                    prim,
-                    normal_or_bary: Vec3::new(h.u, h.v, 0.0),
-                    uv: Vec2::ZERO,
-                })
+                self.triangles[(prim - n_shapes) as usize]
+                    .intersect(ray, t_max)
+                    .map(|h| Intersection {
+                        t: h.t,
+                        prim,
+                        normal_or_bary: Vec3::new(h.u, h.v, 0.0),
+                        uv: Vec2::ZERO,
+                    })
             };
             hit.is_some_and(|h| visit(&h))
         })
@@ -259,7 +265,9 @@ impl Scene {
         let [i0, i1, i2] = mesh.indices[tri_ref.index as usize].map(|i| i as usize);
         let (b1, b2) = (hit.normal_or_bary.x, hit.normal_or_bary.y);
         let w = [1.0 - b1 - b2, b1, b2];
-        let uv = mesh.uvs.as_ref().map_or(Vec2::new(b1, b2), |uvs| uvs[i0] * w[0] + uvs[i1] * w[1] + uvs[i2] * w[2]);
+        let uv = mesh.uvs.as_ref().map_or(Vec2::new(b1, b2), |uvs| {
+            uvs[i0] * w[0] + uvs[i1] * w[1] + uvs[i2] * w[2]
+        });
         let mut geometric_normal = self.triangles[tri_index].geometric_normal();
         let shading_normal = match &mesh.normals {
             Some(n) => {
@@ -325,8 +333,16 @@ impl Scene {
 
     /// Every object with its world bounds, shapes first.
     pub fn objects(&self) -> impl Iterator<Item = (ObjectRef, Aabb)> + '_ {
-        let shapes = self.shapes.iter().enumerate().map(|(i, s)| (ObjectRef::Shape(i as u32), s.bounds));
-        let meshes = self.meshes.iter().enumerate().map(|(i, m)| (ObjectRef::Mesh(i as u32), m.bounds));
+        let shapes = self
+            .shapes
+            .iter()
+            .enumerate()
+            .map(|(i, s)| (ObjectRef::Shape(i as u32), s.bounds));
+        let meshes = self
+            .meshes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| (ObjectRef::Mesh(i as u32), m.bounds));
         shapes.chain(meshes)
     }
 

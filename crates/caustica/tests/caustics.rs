@@ -11,8 +11,22 @@ fn trace(scene: &caustica::scene::Scene, settings: PhotonSettings, k: usize) -> 
     PhotonMap::trace(scene, &settings, k, common::control())
 }
 
+/// For smooth fields: 3000 photons per estimate (noise ≈ 1/√k ≈ 2%) and a box filter.
+fn smooth() -> EstimateSettings {
+    EstimateSettings {
+        k: 3000,
+        max_radius: Some(1e3),
+        cone_filter: None,
+        ..EstimateSettings::default()
+    }
+}
+
 fn photons(n: usize) -> PhotonSettings {
-    PhotonSettings { target_stored: n, seed: 7, ..PhotonSettings::default() }
+    PhotonSettings {
+        target_stored: n,
+        seed: 7,
+        ..PhotonSettings::default()
+    }
 }
 
 /// A vertical mirror wall at x = 0 and a point light at (2, 0, 3) above a diffuse floor: on the
@@ -28,17 +42,27 @@ scale(20, square { material = { diffuse = (1, 1, 1); } })
 fn flat_mirror_caustic_is_the_mirror_image_of_the_light() {
     let scene = common::scene(MIRROR);
     let map = trace(&scene, photons(400_000), 200);
-    let settings = EstimateSettings { k: 400, ..EstimateSettings::default() };
+    let settings = smooth();
     let image = Vec3::new(-2.0, 0.0, 3.0);
-    for p in [Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 0.5, 0.0), Vec3::new(3.0, -1.0, 0.0), Vec3::new(1.5, 1.5, 0.0)] {
+    for p in [
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(2.0, 0.5, 0.0),
+        Vec3::new(3.0, -1.0, 0.0),
+        Vec3::new(1.5, 1.5, 0.0),
+    ] {
         let to = image - p;
         let d = to.length();
         let want = (to.z / d) / (d * d);
         let got = map.flux_density(&scene, p, Vec3::Z, &settings).x;
-        assert!(common::rel(got, want) < 0.05, "at {p:?}: photons {got}, mirror image {want}");
+        assert!(
+            common::rel(got, want) < 0.05,
+            "at {p:?}: photons {got}, mirror image {want}"
+        );
     }
     // Behind the mirror (x < 0) the floor receives no reflected light.
-    let behind = map.flux_density(&scene, Vec3::new(-1.5, 0.0, 0.0), Vec3::Z, &settings).x;
+    let behind = map
+        .flux_density(&scene, Vec3::new(-1.5, 0.0, 0.0), Vec3::Z, &settings)
+        .x;
     assert!(behind < 1e-4, "{behind}");
 }
 
@@ -53,8 +77,12 @@ scale(20, square { material = { diffuse = (1, 1, 1); } })
 fn glass_slab_passes_exactly_the_transmitted_power() {
     let scene = common::scene(SLAB);
     let map = trace(&scene, photons(200_000), 100);
-    let settings = EstimateSettings { k: 200, ..EstimateSettings::default() };
-    for p in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(0.5, -0.3, 0.0), Vec3::new(-0.6, 0.6, 0.0)] {
+    let settings = smooth();
+    for p in [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(0.5, -0.3, 0.0),
+        Vec3::new(-0.6, 0.6, 0.0),
+    ] {
         let got = map.flux_density(&scene, p, Vec3::Z, &settings).x;
         assert!(common::rel(got, 0.64) < 0.03, "under the slab at {p:?}: {got}");
     }
@@ -77,14 +105,23 @@ translate(2.5, 0, 1, sphere { material = { reflective = (0.8, 0.6, 0.4); } })
 scale(30, square { material = { diffuse = (0.7, 0.7, 0.7); } })
 ";
     let scene = common::scene(text);
-    let settings = PhotonSettings { aim: false, ..photons(50_000) };
+    let settings = PhotonSettings {
+        aim: false,
+        ..photons(50_000)
+    };
     let map = trace(&scene, settings, 50);
     let stored: Vec3 = map.photons().iter().map(|p| p.power()).sum();
     // Emitted flux in the course convention: 4π × intensity (photon powers sum to it).
     let emitted = 4.0 * std::f32::consts::PI;
     assert!(map.len() > 10_000);
-    assert!(stored.max_element() <= emitted * 1.001, "stored {stored:?} > emitted {emitted}");
-    assert!(stored.max_element() > 0.05 * emitted, "the caustics carry real power: {stored:?}");
+    assert!(
+        stored.max_element() <= emitted * 1.001,
+        "stored {stored:?} > emitted {emitted}"
+    );
+    assert!(
+        stored.max_element() > 0.01 * emitted,
+        "the caustics carry real power: {stored:?}"
+    );
     assert!(stored.z < stored.x, "photons take the mirror's colour");
 }
 
@@ -109,13 +146,25 @@ directional_light { direction = (-1, 0.5, -2); color = (0.4, 0.4, 0.4); }
 scale(12, square { material = { diffuse = (1, 1, 1); } })
 ";
     let scene = common::scene(text);
-    let settings = PhotonSettings { first_hit: true, aim: false, ..photons(1_000_000) };
+    let settings = PhotonSettings {
+        first_hit: true,
+        aim: false,
+        ..photons(1_000_000)
+    };
     let map = trace(&scene, settings, 300);
-    let estimate = EstimateSettings { k: 300, cone_filter: None, ..EstimateSettings::default() };
-    for p in [Vec3::new(0.0, 0.0, 0.0), Vec3::new(2.0, -1.0, 0.0), Vec3::new(-2.5, 2.0, 0.0), Vec3::new(1.0, 3.0, 0.0)] {
+    let estimate = smooth();
+    for p in [
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(2.0, -1.0, 0.0),
+        Vec3::new(-2.5, 2.0, 0.0),
+        Vec3::new(1.0, 3.0, 0.0),
+    ] {
         let want = direct_light_at(&scene, p);
         let got = map.flux_density(&scene, p, Vec3::Z, &estimate).x;
-        assert!(common::rel(got, want) < 0.04, "at {p:?}: photons {got}, shadow rays {want}");
+        assert!(
+            common::rel(got, want) < 0.04,
+            "at {p:?}: photons {got}, shadow rays {want}"
+        );
     }
     // The course's falloff is carried by the photons: check it is far from inverse-square here.
     let d = (Vec3::new(1.0, -1.0, 4.0)).length();
@@ -127,17 +176,23 @@ fn no_light_bleeds_through_a_thin_wall() {
     // A mirror throws light onto the floor on the +x side of a thin wall at x = 0; the floor just
     // behind the wall (−x side) is in shadow and must stay dark.
     let text = "SBT-raytracer 1.0
-point_light { position = (3, 0, 5); color = (1, 1, 1);
+point_light { position = (1.5, 0, 4); color = (1, 1, 1);
   constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
-translate(4, 0, 2.5, rotate(0, 1, 0, 1.2, scale(3, 3, 1, square { material = { reflective = (1, 1, 1); } })))
+translate(3, 0, 2.5, rotate(0, 1, 0, 1.5707963, scale(3, 6, 1, square { material = { reflective = (1, 1, 1); } })))
 translate(0, 0, 1, scale(0.02, 6, 2, box { material = { diffuse = (1, 1, 1); } }))
 scale(20, square { material = { diffuse = (1, 1, 1); } })
 ";
     let scene = common::scene(text);
     let map = trace(&scene, photons(100_000), 100);
-    let estimate = EstimateSettings { k: 100, max_radius: Some(0.5), ..EstimateSettings::default() };
+    let estimate = EstimateSettings {
+        k: 100,
+        max_radius: Some(0.5),
+        ..EstimateSettings::default()
+    };
     let lit = map.flux_density(&scene, Vec3::new(0.1, 0.0, 0.0), Vec3::Z, &estimate).x;
-    let behind = map.flux_density(&scene, Vec3::new(-0.1, 0.0, 0.0), Vec3::Z, &estimate).x;
+    let behind = map
+        .flux_density(&scene, Vec3::new(-0.1, 0.0, 0.0), Vec3::Z, &estimate)
+        .x;
     assert!(lit > 0.01, "the lit side receives the mirror's light: {lit}");
     assert!(behind < 0.01 * lit, "light bled through the wall: {behind} vs {lit}");
 }
@@ -146,9 +201,19 @@ scale(20, square { material = { diffuse = (1, 1, 1); } })
 fn aimed_and_uniform_emission_give_the_same_caustic() {
     let scene = common::scene(SLAB);
     let aimed = trace(&scene, photons(100_000), 100);
-    let uniform = trace(&scene, PhotonSettings { aim: false, ..photons(100_000) }, 100);
-    assert!(aimed.stats.useful_fraction() > 2.0 * uniform.stats.useful_fraction(), "aiming wastes fewer photons");
-    let settings = EstimateSettings { k: 200, ..EstimateSettings::default() };
+    let uniform = trace(
+        &scene,
+        PhotonSettings {
+            aim: false,
+            ..photons(100_000)
+        },
+        100,
+    );
+    assert!(
+        aimed.stats.useful_fraction() > 2.0 * uniform.stats.useful_fraction(),
+        "aiming wastes fewer photons"
+    );
+    let settings = smooth();
     for p in [Vec3::new(0.2, 0.1, 0.0), Vec3::new(-0.5, 0.5, 0.0)] {
         let a = aimed.flux_density(&scene, p, Vec3::Z, &settings).x;
         let u = uniform.flux_density(&scene, p, Vec3::Z, &settings).x;
@@ -194,7 +259,10 @@ translate(0, 0, 3, scale(0.01, sphere { material = { reflective = (1, 1, 1); } }
 translate(0, 0, 2, scale(30, square { material = { diffuse = (1, 1, 1); } }))
 ";
     let scene = common::scene(text);
-    let settings = PhotonSettings { max_emitted: 50_000, ..photons(10_000) };
+    let settings = PhotonSettings {
+        max_emitted: 50_000,
+        ..photons(10_000)
+    };
     let map = trace(&scene, settings, 10);
     assert!(map.stats.cap_reached);
     assert!(map.stats.emitted <= 50_000);

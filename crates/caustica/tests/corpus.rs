@@ -240,9 +240,9 @@ fn corpus_parses_or_fails_as_expected() {
                     scene.warnings.len()
                 );
             }
-            (Ok(_), Some((_, message, _))) => problems.push(format!(
-                "{name}: parsed, but was expected to fail with `{message}`"
-            )),
+            (Ok(_), Some((_, message, _))) => {
+                problems.push(format!("{name}: parsed, but was expected to fail with `{message}`"))
+            }
             (Err(error), Some((_, message, _))) if error.message.contains(message) => failed += 1,
             (Err(error), _) => {
                 let (line, col) = line_col(&text, error.span.start);
@@ -255,9 +255,7 @@ fn corpus_parses_or_fails_as_expected() {
     }
     for (name, _, _) in EXPECTED_FAILURES {
         if !names.iter().any(|n| n == name) {
-            problems.push(format!(
-                "{name}: listed as an expected failure but not in the corpus"
-            ));
+            problems.push(format!("{name}: listed as an expected failure but not in the corpus"));
         }
     }
     println!(

@@ -45,7 +45,11 @@ fn expected(p: Vec3, v: Vec3) -> Vec3 {
     for (to_light, color, is_point) in lights {
         let d = to_light.length();
         let l = to_light / d;
-        let f = if is_point { (1.0 / (0.25 + 0.1 * d + 0.01 * d * d)).min(1.0) } else { 1.0 };
+        let f = if is_point {
+            (1.0 / (0.25 + 0.1 * d + 0.01 * d * d)).min(1.0)
+        } else {
+            1.0
+        };
         let shadow = kt.powf(sphere_crossings(p, l, if is_point { d } else { f32::INFINITY }) as f32);
         let r = 2.0 * n.dot(l) * n - l;
         c += f * shadow * color * (kd * n.dot(l).max(0.0) + ks * v.dot(r).max(0.0).powf(ns));
@@ -57,8 +61,16 @@ fn expected(p: Vec3, v: Vec3) -> Vec3 {
 fn pixels_match_the_phong_formula_with_filtered_shadows() {
     let scene = common::scene(SCENE);
     let (w, h) = (48, 48);
-    let image = ImageSettings { width: w, height: h, aa: 1, seed: 0 };
-    let settings = WhittedSettings { max_depth: 0, ..WhittedSettings::default() };
+    let image = ImageSettings {
+        width: w,
+        height: h,
+        aa: 1,
+        seed: 0,
+    };
+    let settings = WhittedSettings {
+        max_depth: 0,
+        ..WhittedSettings::default()
+    };
     let (film, complete) = render(&scene, None, &settings, &image, common::control());
     assert!(complete);
     let mut checked = 0;
@@ -78,15 +90,26 @@ fn pixels_match_the_phong_formula_with_filtered_shadows() {
             let p = ray.origin + ray.dir * t;
             let want = expected(p, -ray.dir);
             let got = film.pixel(x, y);
-            assert!((got - want).abs().max_element() < 2e-4, "pixel ({x}, {y}): got {got:?}, want {want:?}");
+            assert!(
+                (got - want).abs().max_element() < 2e-4,
+                "pixel ({x}, {y}): got {got:?}, want {want:?}"
+            );
             checked += 1;
-            if sphere_crossings(p, (Vec3::new(1.0, 2.0, 3.0) - p).normalize(), (Vec3::new(1.0, 2.0, 3.0) - p).length()) > 0 {
+            if sphere_crossings(
+                p,
+                (Vec3::new(1.0, 2.0, 3.0) - p).normalize(),
+                (Vec3::new(1.0, 2.0, 3.0) - p).length(),
+            ) > 0
+            {
                 shadowed += 1;
             }
         }
     }
     assert!(checked > 1500, "most pixels see the floor: {checked}");
-    assert!(shadowed > 10, "some pixels lie in the glass sphere's filtered shadow: {shadowed}");
+    assert!(
+        shadowed > 10,
+        "some pixels lie in the glass sphere's filtered shadow: {shadowed}"
+    );
 }
 
 #[test]
@@ -98,12 +121,26 @@ scale(10, square { material = { reflective = (0.5, 0.25, 1.0); } })
 translate(0, 0, 20, scale(8, sphere { material = { emissive = (0.8, 0.8, 0.8); } }))
 ";
     let scene = common::scene(text);
-    let image = ImageSettings { width: 8, height: 8, aa: 1, seed: 0 };
-    let deep = WhittedSettings { max_depth: 2, ..WhittedSettings::default() };
+    let image = ImageSettings {
+        width: 8,
+        height: 8,
+        aa: 1,
+        seed: 0,
+    };
+    let deep = WhittedSettings {
+        max_depth: 2,
+        ..WhittedSettings::default()
+    };
     let (film, _) = render(&scene, None, &deep, &image, common::control());
     let centre = film.pixel(4, 4);
-    assert!((centre - Vec3::new(0.4, 0.2, 0.8)).abs().max_element() < 1e-5, "{centre:?}");
-    let flat = WhittedSettings { max_depth: 0, ..WhittedSettings::default() };
+    assert!(
+        (centre - Vec3::new(0.4, 0.2, 0.8)).abs().max_element() < 1e-5,
+        "{centre:?}"
+    );
+    let flat = WhittedSettings {
+        max_depth: 0,
+        ..WhittedSettings::default()
+    };
     let (film, _) = render(&scene, None, &flat, &image, common::control());
     assert_eq!(film.pixel(4, 4), Vec3::ZERO, "depth 0: no reflection");
 }
@@ -117,7 +154,12 @@ translate(0, 0, 1, scale(4, 4, 0.5, box { material = { transmissive = (0.5, 0.8,
 translate(0, 0, -3, scale(20, square { material = { emissive = (1, 1, 1); } }))
 ";
     let scene = common::scene(text);
-    let image = ImageSettings { width: 4, height: 4, aa: 1, seed: 0 };
+    let image = ImageSettings {
+        width: 4,
+        height: 4,
+        aa: 1,
+        seed: 0,
+    };
     let (film, _) = render(&scene, None, &WhittedSettings::default(), &image, common::control());
     let c = film.pixel(2, 2);
     assert!((c - Vec3::new(0.25, 0.64, 1.0)).abs().max_element() < 1e-5, "{c:?}");

@@ -13,13 +13,21 @@ struct Case {
 
 /// Runs the command; returns the exit code.
 pub fn run(args: BenchArgs) -> Result<u8> {
-    let exe = std::env::current_exe().map_err(|e| Error::InvalidSettings(format!("cannot find the caustica binary: {e}")))?;
+    let exe =
+        std::env::current_exe().map_err(|e| Error::InvalidSettings(format!("cannot find the caustica binary: {e}")))?;
     let mut cases = vec![
         case(&args, "ring.ray", "ring (default scene)", "512", "3", "100000"),
         case(&args, "ring_double.ray", "ring, two lights", "512", "1", "200000"),
         case(&args, "lens.ray", "lens", "512", "1", "200000"),
         case(&args, "blue_cube.ray", "blue mirror cube", "512", "1", "200000"),
-        case(&args, "magnifier_sun.ray", "magnifier under the sun", "512", "1", "200000"),
+        case(
+            &args,
+            "magnifier_sun.ray",
+            "magnifier under the sun",
+            "512",
+            "1",
+            "200000",
+        ),
         case(&args, "pool.ray", "pool (4.6k-triangle water)", "512", "1", "200000"),
         case(&args, "ring_glossy.ray", "ring on a glossy floor", "512", "1", "200000"),
     ];
@@ -31,7 +39,10 @@ pub fn run(args: BenchArgs) -> Result<u8> {
             Case {
                 name: "original ring (corpus), worst case",
                 scene: corpus_dir.join("ring.ray"),
-                args: vec!["--width", "512", "--aa", "3", "--photons", "100000"].into_iter().map(String::from).collect(),
+                args: vec!["--width", "512", "--aa", "3", "--photons", "100000"]
+                    .into_iter()
+                    .map(String::from)
+                    .collect(),
             },
         );
     }
@@ -75,15 +86,24 @@ fn case(args: &BenchArgs, file: &str, name: &'static str, width: &str, aa: &str,
     Case {
         name,
         scene: args.scenes.join(file),
-        args: vec!["--width", width, "--aa", aa, "--photons", photons].into_iter().map(String::from).collect(),
+        args: vec!["--width", width, "--aa", aa, "--photons", photons]
+            .into_iter()
+            .map(String::from)
+            .collect(),
     }
 }
 
 /// The original project's ring scene beside its texture under the name the scene uses.
 fn original_ring(corpus: &Path) -> Result<PathBuf> {
     let dir = std::env::temp_dir().join(format!("caustica-bench-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).map_err(|source| Error::Io { path: dir.clone(), source })?;
-    for (from, to) in [("OccamsRazer__cs384g__ring.ray", "ring.ray"), ("OccamsRazer__cs384g__wood.png", "wood.png")] {
+    std::fs::create_dir_all(&dir).map_err(|source| Error::Io {
+        path: dir.clone(),
+        source,
+    })?;
+    for (from, to) in [
+        ("OccamsRazer__cs384g__ring.ray", "ring.ray"),
+        ("OccamsRazer__cs384g__wood.png", "wood.png"),
+    ] {
         let src = corpus.join(from);
         std::fs::copy(&src, dir.join(to)).map_err(|source| Error::Io { path: src, source })?;
     }
@@ -101,11 +121,18 @@ struct Summary {
 fn run_case(exe: &Path, case: &Case, threads: Option<usize>) -> Result<Summary> {
     let out = std::env::temp_dir().join(format!("caustica-bench-{}.png", std::process::id()));
     let mut cmd = Command::new(exe);
-    cmd.arg("render").arg(&case.scene).arg("-o").arg(&out).arg("--json").args(&case.args);
+    cmd.arg("render")
+        .arg(&case.scene)
+        .arg("-o")
+        .arg(&out)
+        .arg("--json")
+        .args(&case.args);
     if let Some(t) = threads {
         cmd.arg("--threads").arg(t.to_string());
     }
-    let output = cmd.output().map_err(|e| Error::InvalidSettings(format!("cannot run caustica: {e}")))?;
+    let output = cmd
+        .output()
+        .map_err(|e| Error::InvalidSettings(format!("cannot run caustica: {e}")))?;
     let _ = std::fs::remove_file(&out);
     if !output.status.success() {
         return Err(Error::InvalidSettings(format!(

@@ -43,16 +43,34 @@ pub fn run(args: InfoArgs) -> Result<u8> {
         return Ok(0);
     }
     println!("scene      {}", args.scene.display());
-    println!("camera     eye {:?}  look {:?}  aspect {}", cam.eye.to_array(), cam.look.to_array(), cam.aspect_ratio);
+    println!(
+        "camera     eye {:?}  look {:?}  aspect {}",
+        cam.eye.to_array(),
+        cam.look.to_array(),
+        cam.aspect_ratio
+    );
     println!("           u {:?}  v {:?}", cam.u.to_array(), cam.v.to_array());
     println!("lights     {}", scene.lights.len());
     for light in &scene.lights {
         match light {
-            Light::Point { position, color, attenuation } => {
-                println!("  point        at {:?}  colour {:?}  attenuation {:?}", position.to_array(), color.to_array(), attenuation)
+            Light::Point {
+                position,
+                color,
+                attenuation,
+            } => {
+                println!(
+                    "  point        at {:?}  colour {:?}  attenuation {:?}",
+                    position.to_array(),
+                    color.to_array(),
+                    attenuation
+                )
             }
             Light::Directional { direction, color } => {
-                println!("  directional  towards {:?}  colour {:?}", direction.to_array(), color.to_array())
+                println!(
+                    "  directional  towards {:?}  colour {:?}",
+                    direction.to_array(),
+                    color.to_array()
+                )
             }
         }
     }
@@ -77,7 +95,11 @@ pub fn run(args: InfoArgs) -> Result<u8> {
         );
     }
     println!("bounds     {:?} .. {:?}", bounds.min.to_array(), bounds.max.to_array());
-    println!("materials  {}   textures {}", scene.materials.len(), scene.textures.len());
+    println!(
+        "materials  {}   textures {}",
+        scene.materials.len(),
+        scene.textures.len()
+    );
     for (i, m) in scene.materials.iter().enumerate() {
         println!(
             "  {i:>3}  kd {}  ks {}  kr {}  kt {}  ke {}  ka {}  ns {}  index {}",
@@ -107,7 +129,11 @@ fn channel(c: &Channel) -> String {
 
 fn light_json(light: &Light) -> String {
     match light {
-        Light::Point { position, color, attenuation } => format!(
+        Light::Point {
+            position,
+            color,
+            attenuation,
+        } => format!(
             "{{\"type\":\"point\",\"position\":{:?},\"color\":{:?},\"attenuation\":{:?}}}",
             position.to_array(),
             color.to_array(),

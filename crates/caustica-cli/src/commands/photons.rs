@@ -19,7 +19,10 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let (width, height) = image_size(&scene.camera, args.width, args.height);
     check_image_size(width, height)?;
     let bars = Bars::new(args.quiet);
-    let control = Control { progress: &bars, cancel };
+    let control = Control {
+        progress: &bars,
+        cancel,
+    };
     let map = pool.install(|| PhotonMap::trace(&scene, &settings, 1, control));
     let film = draw_photons(&scene, map.photons(), width, height);
     film.save(&args.output, ToneMap::Clamp)?;

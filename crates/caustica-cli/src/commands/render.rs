@@ -26,7 +26,9 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         return Err(Error::InvalidSettings("--radius must be a positive number".into()));
     }
     if !(args.cone_filter == 0.0 || args.cone_filter >= 1.0) {
-        return Err(Error::InvalidSettings("--cone-filter must be 0 (off) or at least 1".into()));
+        return Err(Error::InvalidSettings(
+            "--cone-filter must be 0 (off) or at least 1".into(),
+        ));
     }
     if args.k == 0 || args.k > 10_000 {
         return Err(Error::InvalidSettings("--k must be between 1 and 10000".into()));
@@ -34,7 +36,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let photons = photon_settings(&args.photon, args.seed)?;
     let pool = thread_pool(args.threads)?;
     let bars = Bars::new(args.quiet || args.json);
-    let control = Control { progress: &bars, cancel };
+    let control = Control {
+        progress: &bars,
+        cancel,
+    };
 
     let t_parse = Instant::now();
     let scene = load_scene(args.scene.as_deref(), &args.scene_args)?;
@@ -64,7 +69,11 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 s.stored,
                 100.0 * s.useful_fraction(),
                 t_photons.elapsed().as_secs_f64(),
-                if s.cap_reached { " — emission cap reached before the budget was stored" } else { "" }
+                if s.cap_reached {
+                    " — emission cap reached before the budget was stored"
+                } else {
+                    ""
+                }
             );
             if s.stored == 0 {
                 eprintln!("photons: none stored (the scene has no mirror or glass that lights reach): no caustics");

@@ -9,7 +9,10 @@ pub struct Bvh {
 impl Bvh {
     pub fn build(prim_bounds: &[Aabb]) -> Bvh {
         let all = prim_bounds.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
-        Bvh { bounds: prim_bounds.to_vec(), all }
+        Bvh {
+            bounds: prim_bounds.to_vec(),
+            all,
+        }
     }
     pub fn bounds(&self) -> Aabb {
         self.all
@@ -17,7 +20,12 @@ impl Bvh {
     pub fn node_count(&self) -> usize {
         1
     }
-    pub fn closest_hit<F: FnMut(u32, f32) -> Option<f32>>(&self, _ray: &Ray, t_max: f32, mut intersect: F) -> Option<(f32, u32)> {
+    pub fn closest_hit<F: FnMut(u32, f32) -> Option<f32>>(
+        &self,
+        _ray: &Ray,
+        t_max: f32,
+        mut intersect: F,
+    ) -> Option<(f32, u32)> {
         let mut best = None;
         let mut t = t_max;
         for i in 0..self.bounds.len() as u32 {

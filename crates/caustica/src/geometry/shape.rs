@@ -124,18 +124,25 @@ mod tests {
         let hit = s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), f32::INFINITY).unwrap();
         assert!(close(hit.t, 4.0));
         assert!((hit.normal - Vec3::Z).length() < 1e-5);
-        let inside = s.intersect(&Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::X), f32::INFINITY).unwrap();
+        let inside = s
+            .intersect(&Ray::new(Vec3::new(0.0, 0.0, -5.0), Vec3::X), f32::INFINITY)
+            .unwrap();
         assert!(close(inside.t, 1.0));
         assert!((inside.normal - Vec3::X).length() < 1e-5, "outward from inside too");
         assert!(s.intersect(&Ray::new(Vec3::ZERO, Vec3::Y), f32::INFINITY).is_none());
-        assert!(s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), 3.9).is_none(), "t_max respected");
+        assert!(
+            s.intersect(&Ray::new(Vec3::ZERO, -Vec3::Z), 3.9).is_none(),
+            "t_max respected"
+        );
     }
 
     #[test]
     fn scaled_sphere_keeps_world_parameter_and_normal() {
         // An ellipsoid with semi-axes (2, 1, 1): hit at x = 2 from the right, normal +x.
         let s = Shape::new(ShapeKind::Sphere, Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0))).unwrap();
-        let hit = s.intersect(&Ray::new(Vec3::new(10.0, 0.0, 0.0), -Vec3::X * 2.0), f32::INFINITY).unwrap();
+        let hit = s
+            .intersect(&Ray::new(Vec3::new(10.0, 0.0, 0.0), -Vec3::X * 2.0), f32::INFINITY)
+            .unwrap();
         assert!(close(hit.t, 4.0), "t is in units of the world direction: {}", hit.t);
         assert!((hit.normal - Vec3::X).length() < 1e-5);
         // On the ellipsoid at 45° the normal follows the inverse transpose, not the point.
@@ -148,11 +155,15 @@ mod tests {
     #[test]
     fn box_faces_normals_and_uv() {
         let b = Shape::new(ShapeKind::Cube, Mat4::IDENTITY).unwrap();
-        let hit = b.intersect(&Ray::new(Vec3::new(0.2, 0.1, 3.0), -Vec3::Z), f32::INFINITY).unwrap();
+        let hit = b
+            .intersect(&Ray::new(Vec3::new(0.2, 0.1, 3.0), -Vec3::Z), f32::INFINITY)
+            .unwrap();
         assert!(close(hit.t, 2.5));
         assert_eq!(hit.normal, Vec3::Z);
         assert!(close(hit.uv.x, 0.7) && close(hit.uv.y, 0.6));
-        let back = b.intersect(&Ray::new(Vec3::new(0.2, 0.1, -3.0), Vec3::Z), f32::INFINITY).unwrap();
+        let back = b
+            .intersect(&Ray::new(Vec3::new(0.2, 0.1, -3.0), Vec3::Z), f32::INFINITY)
+            .unwrap();
         assert_eq!(back.normal, -Vec3::Z);
         assert!(close(back.uv.x, 0.3), "−k face mirrors u");
         let inside = b.intersect(&Ray::new(Vec3::ZERO, Vec3::X), f32::INFINITY).unwrap();
@@ -163,28 +174,43 @@ mod tests {
     #[test]
     fn square_is_two_sided_and_faces_the_ray() {
         let s = Shape::new(ShapeKind::Square, Mat4::IDENTITY).unwrap();
-        let down = s.intersect(&Ray::new(Vec3::new(0.1, -0.2, 1.0), -Vec3::Z), f32::INFINITY).unwrap();
+        let down = s
+            .intersect(&Ray::new(Vec3::new(0.1, -0.2, 1.0), -Vec3::Z), f32::INFINITY)
+            .unwrap();
         assert_eq!(down.normal, Vec3::Z);
         assert!(close(down.uv.x, 0.6) && close(down.uv.y, 0.3));
-        let up = s.intersect(&Ray::new(Vec3::new(0.1, -0.2, -1.0), Vec3::Z), f32::INFINITY).unwrap();
+        let up = s
+            .intersect(&Ray::new(Vec3::new(0.1, -0.2, -1.0), Vec3::Z), f32::INFINITY)
+            .unwrap();
         assert_eq!(up.normal, -Vec3::Z);
-        assert!(s.intersect(&Ray::new(Vec3::new(0.6, 0.0, 1.0), -Vec3::Z), f32::INFINITY).is_none());
+        assert!(s
+            .intersect(&Ray::new(Vec3::new(0.6, 0.0, 1.0), -Vec3::Z), f32::INFINITY)
+            .is_none());
     }
 
     #[test]
     fn cylinder_side_and_caps() {
         let c = Shape::new(ShapeKind::cylinder(true), Mat4::IDENTITY).unwrap();
-        let side = c.intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY).unwrap();
+        let side = c
+            .intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY)
+            .unwrap();
         assert!(close(side.t, 4.0));
         assert!((side.normal - Vec3::X).length() < 1e-5);
-        let top = c.intersect(&Ray::new(Vec3::new(0.3, 0.0, 5.0), -Vec3::Z), f32::INFINITY).unwrap();
+        let top = c
+            .intersect(&Ray::new(Vec3::new(0.3, 0.0, 5.0), -Vec3::Z), f32::INFINITY)
+            .unwrap();
         assert!(close(top.t, 4.0));
         assert_eq!(top.normal, Vec3::Z);
         let open = Shape::new(ShapeKind::cylinder(false), Mat4::IDENTITY).unwrap();
         let through = open.intersect(&Ray::new(Vec3::new(0.3, 0.0, 5.0), -Vec3::Z), f32::INFINITY);
         assert!(through.is_none(), "an open tube lets an axial ray through");
-        let from_inside = open.intersect(&Ray::new(Vec3::new(0.0, 0.0, 0.5), Vec3::X), f32::INFINITY).unwrap();
-        assert!((from_inside.normal + Vec3::X).length() < 1e-5, "faces the ray inside an open tube");
+        let from_inside = open
+            .intersect(&Ray::new(Vec3::new(0.0, 0.0, 0.5), Vec3::X), f32::INFINITY)
+            .unwrap();
+        assert!(
+            (from_inside.normal + Vec3::X).length() < 1e-5,
+            "faces the ray inside an open tube"
+        );
     }
 
     #[test]
@@ -192,17 +218,28 @@ mod tests {
         // Bottom radius 1, apex at z = 1: the side at 45°.
         let cone = Cone::new(1.0, 1.0, 0.0, true, false);
         let s = Shape::new(ShapeKind::Cone(cone), Mat4::IDENTITY).unwrap();
-        let hit = s.intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY).unwrap();
+        let hit = s
+            .intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY)
+            .unwrap();
         assert!(close(hit.t, 4.5));
         let expected = Vec3::new(1.0, 0.0, 1.0).normalize();
         assert!((hit.normal - expected).length() < 1e-4, "{:?}", hit.normal);
         let quirky = Cone::new(2.0, 3.0, 3.0, false, true);
-        assert!(close(quirky.top_radius, 3.002), "slope clamp flares equal radii by 0.001·h");
+        assert!(
+            close(quirky.top_radius, 3.002),
+            "slope clamp flares equal radii by 0.001·h"
+        );
         let sharp = Cone::new(1.0, 1.0, 0.0, true, true);
         assert!(close(sharp.top_radius, 1e-4));
         let q = Shape::new(ShapeKind::Cone(sharp), Mat4::IDENTITY).unwrap();
-        let qh = q.intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY).unwrap();
-        assert!(qh.normal.z > expected.z + 0.1, "the doubled z tilts the normal: {:?}", qh.normal);
+        let qh = q
+            .intersect(&Ray::new(Vec3::new(5.0, 0.0, 0.5), -Vec3::X), f32::INFINITY)
+            .unwrap();
+        assert!(
+            qh.normal.z > expected.z + 0.1,
+            "the doubled z tilts the normal: {:?}",
+            qh.normal
+        );
     }
 
     #[test]

@@ -18,7 +18,11 @@ pub fn intersect(ray: &Ray, t_max: f32) -> Option<LocalHit> {
         return None;
     }
     let p = ray.at(t);
-    Some(LocalHit { t, normal: p, uv: uv(p) })
+    Some(LocalHit {
+        t,
+        normal: p,
+        uv: uv(p),
+    })
 }
 
 /// Longitude around +z and latitude from the −z pole, both in [0, 1].

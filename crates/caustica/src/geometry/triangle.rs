@@ -16,7 +16,11 @@ pub struct TriangleHit {
 }
 impl Triangle {
     pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Triangle {
-        Triangle { v0: a, e1: b - a, e2: c - a }
+        Triangle {
+            v0: a,
+            e1: b - a,
+            e2: c - a,
+        }
     }
     pub fn bounds(&self) -> Aabb {
         Aabb::new(self.v0, self.v0 + self.e1).with_point(self.v0 + self.e2)

@@ -56,7 +56,11 @@ where
     let wo = -d;
     // Rays meeting the outward normal from behind are inside the object.
     let entering = d.dot(hit.geometric_normal) < 0.0;
-    let n = if d.dot(hit.shading_normal) > 0.0 { -hit.shading_normal } else { hit.shading_normal };
+    let n = if d.dot(hit.shading_normal) > 0.0 {
+        -hit.shading_normal
+    } else {
+        hit.shading_normal
+    };
     let inside_transmissive = !entering && p.transmissive != Vec3::ZERO;
 
     let mut color = p.emissive + p.ambient * scene.ambient;
@@ -129,7 +133,11 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
 pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec3, distance: f32) -> Vec3 {
     let origin = offset_origin(point, geometric_normal, wi);
     let ray = Ray::new(origin, wi);
-    let t_max = if distance.is_finite() { (distance - (origin - point).length()) * (1.0 - 1e-5) } else { f32::INFINITY };
+    let t_max = if distance.is_finite() {
+        (distance - (origin - point).length()) * (1.0 - 1e-5)
+    } else {
+        f32::INFINITY
+    };
     let mut filter = Vec3::ONE;
     // Every crossing of a surface filters by its kt: a closed glass object filters twice.
     let blocked = scene.any_hit(&ray, t_max, |isect| {

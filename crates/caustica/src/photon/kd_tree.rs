@@ -28,12 +28,22 @@ impl KdTree {
     pub fn is_empty(&self) -> bool {
         self.n == 0
     }
-    pub fn k_nearest<T: KdPoint>(&self, items: &[T], p: Vec3, k: usize, max_dist2: f32, out: &mut Vec<Neighbor>) -> f32 {
+    pub fn k_nearest<T: KdPoint>(
+        &self,
+        items: &[T],
+        p: Vec3,
+        k: usize,
+        max_dist2: f32,
+        out: &mut Vec<Neighbor>,
+    ) -> f32 {
         out.clear();
         for (i, it) in items.iter().enumerate() {
             let d2 = it.position().distance_squared(p);
             if d2 <= max_dist2 {
-                out.push(Neighbor { slot: i as u32, dist2: d2 });
+                out.push(Neighbor {
+                    slot: i as u32,
+                    dist2: d2,
+                });
             }
         }
         out.sort_by(|a, b| a.dist2.total_cmp(&b.dist2));

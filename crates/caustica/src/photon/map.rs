@@ -109,7 +109,9 @@ impl PhotonMap {
         let mut radii: Vec<f32> = (0..samples)
             .map(|i| {
                 let p = self.photons[i * n / samples].position;
-                self.tree.k_nearest(&self.photons, p, k.max(1), f32::INFINITY, &mut out).sqrt()
+                self.tree
+                    .k_nearest(&self.photons, p, k.max(1), f32::INFINITY, &mut out)
+                    .sqrt()
             })
             .filter(|r| r.is_finite())
             .collect();
@@ -135,7 +137,9 @@ impl PhotonMap {
         }
         NEIGHBORS.with(|cell| {
             let mut neighbors = cell.borrow_mut();
-            let r2 = self.tree.k_nearest(&self.photons, point, settings.k, max_r * max_r, &mut neighbors);
+            let r2 = self
+                .tree
+                .k_nearest(&self.photons, point, settings.k, max_r * max_r, &mut neighbors);
             if neighbors.is_empty() || !(r2 > 0.0) {
                 return Vec3::ZERO;
             }

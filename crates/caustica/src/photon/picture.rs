@@ -24,14 +24,18 @@ pub fn draw_photons(scene: &Scene, photons: &[Photon], width: usize, height: usi
     let mut film = Film::new(width, height);
     let camera = &scene.camera;
     for photon in photons {
-        let Some((sx, sy)) = camera.project(photon.position) else { continue };
+        let Some((sx, sy)) = camera.project(photon.position) else {
+            continue;
+        };
         if !(0.0..1.0).contains(&sx) || !(0.0..1.0).contains(&sy) {
             continue;
         }
         let to = photon.position - camera.eye;
         let distance = to.length();
         let ray = Ray::new(camera.eye, to / distance);
-        let visible = scene.intersect(&ray, f32::INFINITY).is_none_or(|hit| hit.t >= distance * (1.0 - 1e-3));
+        let visible = scene
+            .intersect(&ray, f32::INFINITY)
+            .is_none_or(|hit| hit.t >= distance * (1.0 - 1e-3));
         if !visible {
             continue;
         }

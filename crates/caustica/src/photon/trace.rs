@@ -118,11 +118,15 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
         .collect();
     let total_power: f32 = emitters.iter().flatten().map(Emitter::power).sum();
     let shares: Vec<usize> = match &settings.per_light {
-        Some(counts) => (0..scene.lights.len()).map(|i| counts.get(i).copied().unwrap_or(0)).collect(),
+        Some(counts) => (0..scene.lights.len())
+            .map(|i| counts.get(i).copied().unwrap_or(0))
+            .collect(),
         None => emitters
             .iter()
             .map(|e| match e {
-                Some(e) if total_power > 0.0 => ((settings.target_stored as f64) * (e.power() / total_power) as f64).round() as usize,
+                Some(e) if total_power > 0.0 => {
+                    ((settings.target_stored as f64) * (e.power() / total_power) as f64).round() as usize
+                }
                 _ => 0,
             })
             .collect(),
@@ -138,7 +142,16 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
             continue;
         };
         let light_cap = ((cap as f64) * share as f64 / total_share as f64).ceil().max(1.0) as u64;
-        let run = trace_light(scene, &scene.lights[index], emitter, index, share, light_cap, settings, control);
+        let run = trace_light(
+            scene,
+            &scene.lights[index],
+            emitter,
+            index,
+            share,
+            light_cap,
+            settings,
+            control,
+        );
         stats.emitted += run.emitted;
         stats.stored += run.photons.len() as u64;
         stats.cap_reached |= run.cap_reached;
@@ -175,9 +188,20 @@ fn trace_light(
     let mut reported = 0u64;
     while photons.len() < share && emitted < cap && !control.cancelled() {
         // Size the round from the yield so far: enough to finish, never absurdly many batches.
-        let yield_so_far = if emitted > 0 { photons.len() as f64 / emitted as f64 } else { 0.0 };
-        let needed = if yield_so_far > 0.0 { ((share - photons.len()) as f64 / yield_so_far * 1.1) as u64 } else { BATCH * 8 };
-        let batches = needed.div_ceil(BATCH).clamp(1, 256).min((cap - emitted).div_ceil(BATCH));
+        let yield_so_far = if emitted > 0 {
+            photons.len() as f64 / emitted as f64
+        } else {
+            0.0
+        };
+        let needed = if yield_so_far > 0.0 {
+            ((share - photons.len()) as f64 / yield_so_far * 1.1) as u64
+        } else {
+            BATCH * 8
+        };
+        let batches = needed
+            .div_ceil(BATCH)
+            .clamp(1, 256)
+            .min((cap - emitted).div_ceil(BATCH));
         let results: Vec<(Vec<Photon>, Vec<u32>)> = (0..batches)
             .into_par_iter()
             .map(|b| {
@@ -198,7 +222,10 @@ fn trace_light(
         for (batch, ends) in results {
             let needed = share - photons.len();
             if batch.len() >= needed {
-                let last = ends.iter().position(|&e| e as usize >= needed).unwrap_or(ends.len() - 1);
+                let last = ends
+                    .iter()
+                    .position(|&e| e as usize >= needed)
+                    .unwrap_or(ends.len() - 1);
                 photons.extend_from_slice(&batch[..ends[last] as usize]);
                 emitted += last as u64 + 1;
                 break;
@@ -237,17 +264,30 @@ pub fn trace_path(
     let mut flags = 0u8;
     let mut length = 0.0f32;
     for _ in 0..=settings.max_bounces {
-        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else { return };
+        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+            return;
+        };
         let hit = scene.surface(&ray, &isect);
         length += isect.t * ray.dir.length();
         let p = &hit.params;
         let d = ray.dir;
         let entering = d.dot(hit.geometric_normal) < 0.0;
-        let facing = if d.dot(hit.shading_normal) > 0.0 { -hit.shading_normal } else { hit.shading_normal };
+        let facing = if d.dot(hit.shading_normal) > 0.0 {
+            -hit.shading_normal
+        } else {
+            hit.shading_normal
+        };
         let receives = p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO;
         if receives && (flags != 0 || settings.first_hit) {
             let stored = power * falloff_scale(light, length);
-            out.push(Photon::new(hit.point, stored, d, facing, flags, light_index.min(255) as u8));
+            out.push(Photon::new(
+                hit.point,
+                stored,
+                d,
+                facing,
+                flags,
+                light_index.min(255) as u8,
+            ));
         }
         if settings.first_hit {
             return;

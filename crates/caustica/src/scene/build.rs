@@ -67,7 +67,10 @@ pub fn build(desc: &SceneDescription, settings: &BuildSettings) -> Result<Scene,
     if desc.camera.is_none() {
         warnings.push("the scene has no camera: using the default one at the origin looking down −z".into());
     }
-    if desc.lights.is_empty() && desc.ambient == Vec3::ZERO && !desc.objects.iter().any(|o| material_is_emissive(&o.material)) {
+    if desc.lights.is_empty()
+        && desc.ambient == Vec3::ZERO
+        && !desc.objects.iter().any(|o| material_is_emissive(&o.material))
+    {
         warnings.push("the scene has no lights: the image will be black".into());
     }
     for object in &desc.objects {
@@ -94,14 +97,22 @@ fn material_is_emissive(m: &MaterialDesc) -> bool {
 
 fn convert_light(light: &LightDesc) -> Option<Light> {
     match light {
-        LightDesc::Point { position, color, attenuation, .. } => Some(Light::Point {
+        LightDesc::Point {
+            position,
+            color,
+            attenuation,
+            ..
+        } => Some(Light::Point {
             position: *position,
             color: *color,
             attenuation: *attenuation,
         }),
         LightDesc::Directional { direction, color, .. } => {
             let direction = direction.normalize_or_zero();
-            (direction != Vec3::ZERO).then_some(Light::Directional { direction, color: *color })
+            (direction != Vec3::ZERO).then_some(Light::Directional {
+                direction,
+                color: *color,
+            })
         }
     }
 }
@@ -124,7 +135,12 @@ struct Builder {
 struct MaterialKey(Vec<u32>);
 
 impl Builder {
-    fn add_object(&mut self, object: &ObjectDesc, settings: &ShapeSettings, warnings: &mut Vec<String>) -> Result<(), ParseError> {
+    fn add_object(
+        &mut self,
+        object: &ObjectDesc,
+        settings: &ShapeSettings,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), ParseError> {
         let material = self.material(&object.material)?;
         let m = object.world_from_object;
         let kind = match &object.shape {
@@ -132,11 +148,25 @@ impl Builder {
             ShapeDesc::Box => ShapeKind::Cube,
             ShapeDesc::Square => ShapeKind::Square,
             ShapeDesc::Cylinder { capped } => ShapeKind::cylinder(*capped),
-            ShapeDesc::Cone { height, bottom_radius, top_radius, capped } => {
+            ShapeDesc::Cone {
+                height,
+                bottom_radius,
+                top_radius,
+                capped,
+            } => {
                 if !(*height > 0.0 && height.is_finite()) {
-                    return Err(ParseError::new(format!("a cone needs a positive height, not {height}"), object.span.clone()));
+                    return Err(ParseError::new(
+                        format!("a cone needs a positive height, not {height}"),
+                        object.span.clone(),
+                    ));
                 }
-                ShapeKind::Cone(Cone::new(*height, *bottom_radius, *top_radius, *capped, settings.cone_quirks))
+                ShapeKind::Cone(Cone::new(
+                    *height,
+                    *bottom_radius,
+                    *top_radius,
+                    *capped,
+                    settings.cone_quirks,
+                ))
             }
             ShapeDesc::Trimesh(mesh) => return self.add_mesh(object, mesh, material, warnings),
         };
@@ -160,9 +190,16 @@ impl Builder {
         }
         let normal_to_world = Mat3::from_mat4(m.inverse()).transpose();
         let points: Vec<Vec3> = desc.points.iter().map(|p| m.transform_point3(*p)).collect();
-        let normals = desc.normals.as_ref().map(|ns| ns.iter().map(|n| (normal_to_world * *n).normalize_or_zero()).collect());
+        let normals = desc
+            .normals
+            .as_ref()
+            .map(|ns| ns.iter().map(|n| (normal_to_world * *n).normalize_or_zero()).collect());
         let vertex_materials = match &desc.materials {
-            Some(ms) => Some(ms.iter().map(|md| self.material(md)).collect::<Result<Vec<u32>, ParseError>>()?),
+            Some(ms) => Some(
+                ms.iter()
+                    .map(|md| self.material(md))
+                    .collect::<Result<Vec<u32>, ParseError>>()?,
+            ),
             None => None,
         };
         let mesh_index = self.meshes.len() as u32;
@@ -185,7 +222,9 @@ impl Builder {
             indices.push(*tri);
         }
         if dropped > 0 {
-            warnings.push(format!("dropped {dropped} degenerate triangle(s) of a mesh after its transform"));
+            warnings.push(format!(
+                "dropped {dropped} degenerate triangle(s) of a mesh after its transform"
+            ));
         }
         self.meshes.push(Mesh {
             indices,
@@ -248,8 +287,11 @@ impl Builder {
                         Error::Image { message, .. } => message,
                         other => other.to_string(),
                     };
-                    ParseError::new(format!("cannot read the texture `{}`: {reason}", path.display()), span.clone())
-                        .with_help("texture paths are resolved against the scene file's folder; PNG and BMP are supported")
+                    ParseError::new(
+                        format!("cannot read the texture `{}`: {reason}", path.display()),
+                        span.clone(),
+                    )
+                    .with_help("texture paths are resolved against the scene file's folder; PNG and BMP are supported")
                 })?;
                 let id = self.textures.len() as u32;
                 self.textures.push(texture);
@@ -261,5 +303,8 @@ impl Builder {
 }
 
 fn singular(span: &Span) -> ParseError {
-    ParseError::new("this object's transform is singular (a zero scale or a degenerate matrix)", span.clone())
+    ParseError::new(
+        "this object's transform is singular (a zero scale or a degenerate matrix)",
+        span.clone(),
+    )
 }

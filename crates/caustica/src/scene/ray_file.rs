@@ -29,11 +29,7 @@ pub struct ParseOptions {
 }
 
 /// Parses a whole `.ray` file; `scene_dir` resolves `map("file")` paths (images are not loaded).
-pub fn parse(
-    text: &str,
-    scene_dir: &Path,
-    options: &ParseOptions,
-) -> Result<ast::SceneDescription, ParseError> {
+pub fn parse(text: &str, scene_dir: &Path, options: &ParseOptions) -> Result<ast::SceneDescription, ParseError> {
     match options.dialect {
         Some(ast::Dialect::Tokenizer) => tokenizer_dialect::parse(text, scene_dir),
         Some(ast::Dialect::Dictionary) => dictionary_dialect::parse(text, scene_dir),

@@ -32,11 +32,7 @@ pub(crate) struct Cursor<'a> {
 impl<'a> Cursor<'a> {
     /// A cursor at the first token; `tokens` must end with [`Tok::Eof`].
     pub fn new(text: &'a str, tokens: Vec<Token>) -> Cursor<'a> {
-        Cursor {
-            text,
-            tokens,
-            pos: 0,
-        }
+        Cursor { text, tokens, pos: 0 }
     }
 
     /// The next token, without consuming it.
@@ -61,9 +57,7 @@ impl<'a> Cursor<'a> {
 
     /// The end of the previously consumed token.
     pub fn prev_end(&self) -> usize {
-        self.pos
-            .checked_sub(1)
-            .map_or(0, |p| self.tokens[p].span.end)
+        self.pos.checked_sub(1).map_or(0, |p| self.tokens[p].span.end)
     }
 
     /// The text of a token.

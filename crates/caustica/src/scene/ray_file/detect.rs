@@ -46,8 +46,7 @@ pub(crate) fn markers(text: &str) -> Markers {
                 ("material", Some(Tok::Equals)) if depth == 0 => found.tokenizer += 1,
                 // HKUST textures: `diffuse = "file.bmp"`.
                 (field, Some(Tok::Equals))
-                    if COLOUR_FIELDS.contains(&field)
-                        && tokens.get(i + 2).map(|t| t.tok) == Some(Tok::Quoted) =>
+                    if COLOUR_FIELDS.contains(&field) && tokens.get(i + 2).map(|t| t.tok) == Some(Tok::Quoted) =>
                 {
                     found.dictionary += 1
                 }
@@ -56,10 +55,7 @@ pub(crate) fn markers(text: &str) -> Markers {
             Tok::LBrace | Tok::LParen => {
                 // A `{` after `)`, `}`, `;` or the header number opens a dialect-T group.
                 let group = token.tok == Tok::LBrace
-                    && matches!(
-                        prev,
-                        Some(Tok::RParen | Tok::RBrace | Tok::Semicolon | Tok::Number(_))
-                    );
+                    && matches!(prev, Some(Tok::RParen | Tok::RBrace | Tok::Semicolon | Tok::Number(_)));
                 if group {
                     found.tokenizer += 1;
                 }
@@ -100,9 +96,10 @@ pub(crate) fn parse_auto(text: &str, scene_dir: &Path) -> Result<SceneDescriptio
     match dictionary_dialect::parse(text, scene_dir) {
         Ok(scene) => {
             let stopped_at_ignored_key = t_error.help.is_none()
-                && scene.warnings.iter().any(|(message, span)| {
-                    message.starts_with(IGNORED_KEY) && *span == t_error.span
-                });
+                && scene
+                    .warnings
+                    .iter()
+                    .any(|(message, span)| message.starts_with(IGNORED_KEY) && *span == t_error.span);
             if found.dictionary > 0 || stopped_at_ignored_key {
                 Ok(scene)
             } else {
@@ -117,8 +114,7 @@ pub(crate) fn parse_auto(text: &str, scene_dir: &Path) -> Result<SceneDescriptio
 /// The more useful of the two readers' errors.
 fn choose(t_error: ParseError, o_error: ParseError, o_marked: bool) -> ParseError {
     // Both readers reject student extensions, so naming the extension is the best answer.
-    let o_wins =
-        is_extension_error(&o_error) || o_marked || o_error.span.start > t_error.span.start;
+    let o_wins = is_extension_error(&o_error) || o_marked || o_error.span.start > t_error.span.start;
     if is_extension_error(&t_error) || !o_wins {
         t_error
     } else {

@@ -5,8 +5,7 @@
 //! walked in a loop, so neither step recurses with the input's nesting.
 
 use super::ast::{
-    CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription,
-    ShapeDesc, Span,
+    CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
 };
 use super::cursor::Cursor;
 use super::keywords::{extension_error, COLOUR_FIELDS};
@@ -161,9 +160,7 @@ fn read_object(cur: &mut Cursor<'_>, tree: &mut Vec<Node>) -> Result<usize, Pars
                 continue;
             }
             Tok::Word => push(tree, Kind::Word, token.span, None),
-            Tok::LParen if cur.eat(Tok::RParen) => {
-                push(tree, Kind::Tuple(Vec::new()), start..cur.prev_end(), None)
-            }
+            Tok::LParen if cur.eat(Tok::RParen) => push(tree, Kind::Tuple(Vec::new()), start..cur.prev_end(), None),
             Tok::LParen => {
                 stack.push(Open::Tuple {
                     start,
@@ -171,9 +168,7 @@ fn read_object(cur: &mut Cursor<'_>, tree: &mut Vec<Node>) -> Result<usize, Pars
                 });
                 continue;
             }
-            Tok::LBrace if cur.eat(Tok::RBrace) => {
-                push(tree, Kind::Dict(Vec::new()), start..cur.prev_end(), None)
-            }
+            Tok::LBrace if cur.eat(Tok::RBrace) => push(tree, Kind::Dict(Vec::new()), start..cur.prev_end(), None),
             Tok::LBrace => {
                 let key = dict_key(cur)?;
                 stack.push(Open::Dict {
@@ -216,11 +211,7 @@ fn read_object(cur: &mut Cursor<'_>, tree: &mut Vec<Node>) -> Result<usize, Pars
                     stack.pop();
                     done = push(tree, Kind::Tuple(items), start..cur.prev_end(), None);
                 }
-                Some(Open::Dict {
-                    start,
-                    entries,
-                    key,
-                }) => {
+                Some(Open::Dict { start, entries, key }) => {
                     entries.push((key.clone(), done));
                     let closed = if cur.eat(Tok::Semicolon) {
                         if cur.eat(Tok::RBrace) {
@@ -233,9 +224,7 @@ fn read_object(cur: &mut Cursor<'_>, tree: &mut Vec<Node>) -> Result<usize, Pars
                         true
                     } else {
                         let key_text = &cur.text[key.clone()];
-                        return Err(
-                            cur.unexpected(&format!("`;` or `}}` after the value of `{key_text}`"))
-                        );
+                        return Err(cur.unexpected(&format!("`;` or `}}` after the value of `{key_text}`")));
                     };
                     if !closed {
                         break;
@@ -297,9 +286,7 @@ impl<'a> Reader<'a> {
             "ambient_light" => {
                 for (key, value) in self.entries(child, "ambient_light")? {
                     match self.word(&key) {
-                        "color" | "colour" => {
-                            self.scene.ambient += self.vec3(value, "for `color`")?
-                        }
+                        "color" | "colour" => self.scene.ambient += self.vec3(value, "for `color`")?,
                         _ => self.ignore_key(&key, "ambient_light")?,
                     }
                 }
@@ -393,12 +380,8 @@ impl<'a> Reader<'a> {
                 "viewdir" => viewdir = Some(self.vec3(value, "for `viewdir`")?),
                 "updir" => updir = Some(self.vec3(value, "for `updir`")?),
                 "fov" => camera.fov_degrees = Some(self.number(value, "for `fov`")?),
-                "aspectratio" => {
-                    camera.aspect_ratio = Some(self.number(value, "for `aspectratio`")?)
-                }
-                "quaternion" => {
-                    camera.quaternion = Some(self.tuple::<4>(value, "for `quaternion`")?)
-                }
+                "aspectratio" => camera.aspect_ratio = Some(self.number(value, "for `aspectratio`")?),
+                "quaternion" => camera.quaternion = Some(self.tuple::<4>(value, "for `quaternion`")?),
                 _ => self.ignore_key(&key, "camera")?,
             }
         }
@@ -432,15 +415,8 @@ impl<'a> Reader<'a> {
         }
         let span = head.start..self.tree[id].span.end;
         let (Some(position), Some(color)) = (position, color) else {
-            let missing = if position.is_none() {
-                "position"
-            } else {
-                "color"
-            };
-            return Err(ParseError::new(
-                format!("`point_light` needs a `{missing}`"),
-                span,
-            ));
+            let missing = if position.is_none() { "position" } else { "color" };
+            return Err(ParseError::new(format!("`point_light` needs a `{missing}`"), span));
         };
         self.scene.lights.push(LightDesc::Point {
             position,
@@ -462,21 +438,15 @@ impl<'a> Reader<'a> {
         }
         let span = head.start..self.tree[id].span.end;
         let (Some(direction), Some(color)) = (direction, color) else {
-            let missing = if direction.is_none() {
-                "direction"
-            } else {
-                "color"
-            };
+            let missing = if direction.is_none() { "direction" } else { "color" };
             return Err(ParseError::new(
                 format!("`directional_light` needs a `{missing}`"),
                 span,
             ));
         };
-        self.scene.lights.push(LightDesc::Directional {
-            direction,
-            color,
-            span,
-        });
+        self.scene
+            .lights
+            .push(LightDesc::Directional { direction, color, span });
         Ok(())
     }
 
@@ -555,10 +525,7 @@ impl<'a> Reader<'a> {
                     _ => Err(self.expected("`map(\"file\")`", id)),
                 }
             }
-            _ => Err(self.expected(
-                &format!("`(r, g, b)`, a number or `map(\"file\")` for `{key}`"),
-                id,
-            )),
+            _ => Err(self.expected(&format!("`(r, g, b)`, a number or `map(\"file\")` for `{key}`"), id)),
         }
     }
 
@@ -580,9 +547,7 @@ impl<'a> Reader<'a> {
         let mut node = id;
         loop {
             let Kind::Named(child) = self.tree[node].kind else {
-                return Err(
-                    self.expected("an object such as `sphere { … }` or `translate(…)`", node)
-                );
+                return Err(self.expected("an object such as `sphere { … }` or `translate(…)`", node));
             };
             let head = self.tree[node].head.clone();
             let word = self.word(&head);
@@ -593,8 +558,7 @@ impl<'a> Reader<'a> {
                     (transform_stack::translation(Vec3::from_slice(&args)), obj)
                 }
                 "scale" => {
-                    let (args, obj) =
-                        self.args(child, word, "(s, object) or (x, y, z, object)", &[1, 3])?;
+                    let (args, obj) = self.args(child, word, "(s, object) or (x, y, z, object)", &[1, 3])?;
                     let factors = if args.len() == 1 {
                         Vec3::splat(args[0])
                     } else {
@@ -639,13 +603,7 @@ impl<'a> Reader<'a> {
     }
 
     /// The numbers of a transform tuple and its last element (the child object).
-    fn args(
-        &self,
-        tuple: usize,
-        name: &str,
-        usage: &str,
-        counts: &[usize],
-    ) -> Result<(Vec<f32>, usize), ParseError> {
+    fn args(&self, tuple: usize, name: &str, usage: &str, counts: &[usize]) -> Result<(Vec<f32>, usize), ParseError> {
         let usage_error = || self.expected(&format!("`{name}` with {usage}"), tuple);
         let Kind::Tuple(items) = &self.tree[tuple].kind else {
             return Err(usage_error());
@@ -663,13 +621,7 @@ impl<'a> Reader<'a> {
         Ok((args, obj))
     }
 
-    fn primitive(
-        &mut self,
-        kind: &str,
-        head: Span,
-        id: usize,
-        world: Mat4,
-    ) -> Result<(), ParseError> {
+    fn primitive(&mut self, kind: &str, head: Span, id: usize, world: Mat4) -> Result<(), ParseError> {
         let mut material = None;
         let (mut height, mut bottom, mut top, mut capped) = (1.0f32, 1.0f32, 0.0f32, true);
         let mut mesh = MeshInput::default();
@@ -679,16 +631,12 @@ impl<'a> Reader<'a> {
             match word {
                 "material" => material = Some(self.material_value(value)?),
                 "name" => {}
-                "height" | "bottom_radius" | "top_radius" | "capped" if kind == "cone" => {
-                    match word {
-                        "height" => height = self.number(value, "for `height`")?,
-                        "bottom_radius" => {
-                            bottom = self.number(value, "for `bottom_radius`")?.abs()
-                        }
-                        "top_radius" => top = self.number(value, "for `top_radius`")?.abs(),
-                        _ => capped = self.boolean(value, "for `capped`")?,
-                    }
-                }
+                "height" | "bottom_radius" | "top_radius" | "capped" if kind == "cone" => match word {
+                    "height" => height = self.number(value, "for `height`")?,
+                    "bottom_radius" => bottom = self.number(value, "for `bottom_radius`")?.abs(),
+                    "top_radius" => top = self.number(value, "for `top_radius`")?.abs(),
+                    _ => capped = self.boolean(value, "for `capped`")?,
+                },
                 "points" | "normals" if is_mesh => {
                     let mut list = Vec::new();
                     for item in self.list(value, word)? {
@@ -722,9 +670,7 @@ impl<'a> Reader<'a> {
                     }
                     mesh.materials = Some((list, self.tree[value].span.clone()));
                 }
-                "gennormals" if is_mesh => {
-                    mesh.gennormals = self.boolean(value, "for `gennormals`")?
-                }
+                "gennormals" if is_mesh => mesh.gennormals = self.boolean(value, "for `gennormals`")?,
                 _ => self.ignore_key(&key, kind)?,
             }
         }

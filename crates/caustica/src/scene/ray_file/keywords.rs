@@ -97,8 +97,7 @@ pub(crate) const EXTENSIONS: &[&str] = &[
 ];
 
 /// The end of every student-extension message (used to prefer these errors over others).
-const EXTENSION_MESSAGE: &str =
-    "is a student extension of the course format that caustica does not read";
+const EXTENSION_MESSAGE: &str = "is a student extension of the course format that caustica does not read";
 
 /// Whether `error` is the rejection of a student extension.
 pub(crate) fn is_extension_error(error: &ParseError) -> bool {
@@ -108,9 +107,8 @@ pub(crate) fn is_extension_error(error: &ParseError) -> bool {
 /// The rejection error for a student extension, if `word` names one.
 pub(crate) fn extension_error(word: &str, span: &Span) -> Option<ParseError> {
     EXTENSIONS.contains(&word).then(|| {
-        ParseError::new(format!("`{word}` {EXTENSION_MESSAGE}"), span.clone()).with_help(
-            "remove it or replace it with the standard primitives, lights and material fields",
-        )
+        ParseError::new(format!("`{word}` {EXTENSION_MESSAGE}"), span.clone())
+            .with_help("remove it or replace it with the standard primitives, lights and material fields")
     })
 }
 

@@ -118,9 +118,7 @@ pub(crate) fn lex(text: &str, dialect: Dialect) -> Result<Vec<Token>, ParseError
             }
             b'a'..=b'z' | b'A'..=b'Z' | b'_' => {
                 i += 1;
-                while i < bytes.len()
-                    && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_' || bytes[i] == b'-')
-                {
+                while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_' || bytes[i] == b'-') {
                     i += 1;
                 }
                 tokens.push(Token {
@@ -190,9 +188,7 @@ fn number_end(bytes: &[u8], mut i: usize, dialect: Dialect) -> usize {
         let ok = match b {
             b'0'..=b'9' | b'-' | b'.' | b'e' => true,
             b'E' => dialect == Dialect::Dictionary,
-            b'+' => {
-                dialect == Dialect::Dictionary && i > start && matches!(bytes[i - 1], b'e' | b'E')
-            }
+            b'+' => dialect == Dialect::Dictionary && i > start && matches!(bytes[i - 1], b'e' | b'E'),
             _ => false,
         };
         if !ok {
@@ -215,10 +211,7 @@ fn parse_number(text: &str, span: Span) -> Result<f64, ParseError> {
         .parse()
         .map_err(|_| ParseError::new(format!("malformed number `{text}`"), span.clone()))?;
     if !value.is_finite() || !(value as f32).is_finite() {
-        return Err(ParseError::new(
-            format!("number `{text}` is out of range"),
-            span,
-        ));
+        return Err(ParseError::new(format!("number `{text}` is out of range"), span));
     }
     Ok(value)
 }
@@ -266,11 +259,7 @@ mod tests {
     use super::*;
 
     fn kinds(text: &str, dialect: Dialect) -> Vec<Tok> {
-        lex(text, dialect)
-            .expect("lexes")
-            .into_iter()
-            .map(|t| t.tok)
-            .collect()
+        lex(text, dialect).expect("lexes").into_iter().map(|t| t.tok).collect()
     }
 
     fn numbers(text: &str) -> Vec<f64> {
@@ -305,12 +294,7 @@ mod tests {
     fn upper_case_exponent_is_a_number_in_dialect_o() {
         assert_eq!(
             kinds("1E5 2.5E-1 3e+2", Dialect::Dictionary),
-            vec![
-                Tok::Number(1e5),
-                Tok::Number(0.25),
-                Tok::Number(300.0),
-                Tok::Eof
-            ]
+            vec![Tok::Number(1e5), Tok::Number(0.25), Tok::Number(300.0), Tok::Eof]
         );
     }
 
@@ -324,10 +308,7 @@ mod tests {
 
     #[test]
     fn malformed_and_huge_numbers_are_errors() {
-        assert_eq!(
-            lex("1-2", Dialect::Tokenizer).expect_err("malformed").span,
-            0..3
-        );
+        assert_eq!(lex("1-2", Dialect::Tokenizer).expect_err("malformed").span, 0..3);
         assert!(lex("-", Dialect::Tokenizer).is_err());
         assert!(lex("1.2.3", Dialect::Tokenizer).is_err());
         let err = lex("x 1e999", Dialect::Tokenizer).expect_err("overflow");
@@ -368,10 +349,7 @@ mod tests {
 
     #[test]
     fn bom_is_skipped_and_odd_characters_are_errors() {
-        assert_eq!(
-            kinds("\u{feff}a", Dialect::Tokenizer),
-            vec![Tok::Word, Tok::Eof]
-        );
+        assert_eq!(kinds("\u{feff}a", Dialect::Tokenizer), vec![Tok::Word, Tok::Eof]);
         let err = lex("a é", Dialect::Tokenizer).expect_err("non-ascii");
         assert_eq!(err.span, 2..4);
         assert!(lex("a # b", Dialect::Tokenizer).is_err());

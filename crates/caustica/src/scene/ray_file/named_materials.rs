@@ -13,18 +13,12 @@ pub(crate) struct NamedMaterials {
 
 impl NamedMaterials {
     /// Registers `material` under `name`; a name can be registered once.
-    pub fn register(
-        &mut self,
-        name: &str,
-        material: MaterialDesc,
-        span: &Span,
-    ) -> Result<(), ParseError> {
+    pub fn register(&mut self, name: &str, material: MaterialDesc, span: &Span) -> Result<(), ParseError> {
         if self.by_name.contains_key(name) {
-            return Err(ParseError::new(
-                format!("material `{name}` is defined twice"),
-                span.clone(),
-            )
-            .with_help("give each named material its own name"));
+            return Err(
+                ParseError::new(format!("material `{name}` is defined twice"), span.clone())
+                    .with_help("give each named material its own name"),
+            );
         }
         self.by_name.insert(name.to_string(), material);
         Ok(())
@@ -36,14 +30,10 @@ impl NamedMaterials {
             return Ok(material.clone());
         }
         let error = ParseError::new(format!("unknown material `{name}`"), span.clone());
-        Err(
-            match suggest::nearest(name, self.by_name.keys().map(String::as_str)) {
-                Some(near) => error.with_help(suggest::did_you_mean(near)),
-                None if self.by_name.is_empty() => {
-                    error.with_help("no named material is defined before this point")
-                }
-                None => error.with_help("a material must be named before it is used"),
-            },
-        )
+        Err(match suggest::nearest(name, self.by_name.keys().map(String::as_str)) {
+            Some(near) => error.with_help(suggest::did_you_mean(near)),
+            None if self.by_name.is_empty() => error.with_help("no named material is defined before this point"),
+            None => error.with_help("a material must be named before it is used"),
+        })
     }
 }

@@ -13,18 +13,13 @@ fn read(body: &str) -> SceneDescription {
     let text = format!("{HEADER}{body}");
     match parse(&text, Path::new("scenes"), &ParseOptions::default()) {
         Ok(scene) => scene,
-        Err(e) => panic!(
-            "parse failed: {} at {:?} (help {:?})",
-            e.message, e.span, e.help
-        ),
+        Err(e) => panic!("parse failed: {} at {:?} (help {:?})", e.message, e.span, e.help),
     }
 }
 
 fn read_as(body: &str, dialect: Dialect) -> Result<SceneDescription, ParseError> {
     let text = format!("{HEADER}{body}");
-    let options = ParseOptions {
-        dialect: Some(dialect),
-    };
+    let options = ParseOptions { dialect: Some(dialect) };
     parse(&text, Path::new("scenes"), &options)
 }
 
@@ -53,18 +48,10 @@ fn point(object: &ObjectDesc, p: Vec3) -> Vec3 {
 #[test]
 fn header_versions() {
     assert!(read("").objects.is_empty());
-    for ok in [
-        "SBT-raytracer 1.1",
-        "SBT-raytracer 0.5",
-        "// c\nSBT-raytracer 1.0",
-    ] {
-        assert!(
-            parse(ok, Path::new(""), &ParseOptions::default()).is_ok(),
-            "{ok}"
-        );
+    for ok in ["SBT-raytracer 1.1", "SBT-raytracer 0.5", "// c\nSBT-raytracer 1.0"] {
+        assert!(parse(ok, Path::new(""), &ParseOptions::default()).is_ok(), "{ok}");
     }
-    let err = parse("SBT-raytracer 1.2", Path::new(""), &ParseOptions::default())
-        .expect_err("version too high");
+    let err = parse("SBT-raytracer 1.2", Path::new(""), &ParseOptions::default()).expect_err("version too high");
     assert_eq!(err.span, 14..17);
     let err = parse("camera {}", Path::new(""), &ParseOptions::default()).expect_err("no header");
     assert_eq!(err.span, 0..6);
@@ -110,11 +97,7 @@ fn camera_fields() {
     assert_eq!((camera.fov_degrees, camera.aspect_ratio), (None, None));
 
     let (err, _) = fail("camera { viewdir = (0,0,-1); }");
-    assert!(
-        err.message.contains("`viewdir` and `updir`"),
-        "{}",
-        err.message
-    );
+    assert!(err.message.contains("`viewdir` and `updir`"), "{}", err.message);
 }
 
 #[test]
@@ -145,9 +128,7 @@ fn lights_and_their_defaults() {
         other => panic!("{other:?}"),
     }
     match &scene.lights[2] {
-        LightDesc::Directional {
-            direction, color, ..
-        } => {
+        LightDesc::Directional { direction, color, .. } => {
             assert_eq!(*direction, Vec3::NEG_Z);
             assert_eq!(*color, Vec3::splat(0.5));
         }
@@ -158,8 +139,7 @@ fn lights_and_their_defaults() {
 
 #[test]
 fn light_errors() {
-    let (err, covered) =
-        fail("point_light { position = (1,2,3); position = (1,2,3); color = (1,1,1); }");
+    let (err, covered) = fail("point_light { position = (1,2,3); position = (1,2,3); color = (1,1,1); }");
     assert!(err.message.contains("second `position`"));
     assert_eq!(covered, "position");
     assert_eq!(err.span.start, HEADER.len() + 34);
@@ -167,8 +147,7 @@ fn light_errors() {
     assert!(err.message.contains("needs a `color`"));
     let (err, _) = fail("directional_light { color = (1,1,1); }");
     assert!(err.message.contains("needs a `direction`"));
-    let (err, _) =
-        fail("directional_light { direction = (1,1,1); colour = (1,1,1); color = (1,1,1) }");
+    let (err, _) = fail("directional_light { direction = (1,1,1); colour = (1,1,1); color = (1,1,1) }");
     assert!(err.message.contains("second `color`"));
     let (err, _) = fail("ambient_light { color = (1,1,1); color = (1,1,1); }");
     assert!(err.message.contains("exactly one"));
@@ -192,10 +171,7 @@ fn primitives_and_their_defaults() {
             bottom_radius,
             top_radius,
             capped,
-        } => assert_eq!(
-            (*height, *bottom_radius, *top_radius, *capped),
-            (1.0, 1.0, 0.0, true)
-        ),
+        } => assert_eq!((*height, *bottom_radius, *top_radius, *capped), (1.0, 1.0, 0.0, true)),
         other => panic!("{other:?}"),
     }
     match shapes[5] {
@@ -204,10 +180,7 @@ fn primitives_and_their_defaults() {
             bottom_radius,
             top_radius,
             capped,
-        } => assert_eq!(
-            (*height, *bottom_radius, *top_radius, *capped),
-            (2.0, 3.0, 0.5, false)
-        ),
+        } => assert_eq!((*height, *bottom_radius, *top_radius, *capped), (2.0, 3.0, 0.5, false)),
         other => panic!("{other:?}"),
     }
     assert!(matches!(shapes[6], ShapeDesc::Cylinder { capped: false }));
@@ -260,25 +233,18 @@ fn trimesh_lists_and_inheritance() {
 
 #[test]
 fn trimesh_errors() {
-    let (err, covered) =
-        fail("trimesh { points = ((0,0,0),(1,0,0),(0,1,0)); faces = ((0,1,2),(0,1,7)); }");
-    assert_eq!(
-        err.message,
-        "face 1 uses vertex 7 but the mesh has 3 points"
-    );
+    let (err, covered) = fail("trimesh { points = ((0,0,0),(1,0,0),(0,1,0)); faces = ((0,1,2),(0,1,7)); }");
+    assert_eq!(err.message, "face 1 uses vertex 7 but the mesh has 3 points");
     assert_eq!(covered, "(0,1,7)");
     let (err, _) = fail("trimesh { points = ((0,0,0),(1,0,0)); faces = ((0,1)); }");
     assert!(err.message.contains("at least 3"));
-    let (err, covered) =
-        fail("trimesh { points = ((0,0,0),(1,0,0),(0,1,0)); normals = ((0,0,1)); }");
+    let (err, covered) = fail("trimesh { points = ((0,0,0),(1,0,0),(0,1,0)); normals = ((0,0,1)); }");
     assert!(err.message.contains("3 points but 1 normals"));
     assert_eq!(covered, "((0,0,1))");
     // The `;` after a list is required, and `gennormals` needs its `;` too.
     let (err, covered) = fail("trimesh { points = ((0,0,0)) faces = ((0,0,0)); }");
     assert_eq!(covered, "faces");
-    assert!(err
-        .message
-        .starts_with("expected `;` after the `points` list"));
+    assert!(err.message.starts_with("expected `;` after the `points` list"));
     assert!(fail("trimesh { gennormals }")
         .0
         .message
@@ -287,8 +253,7 @@ fn trimesh_errors() {
 
 #[test]
 fn degenerate_mesh_is_dropped_with_warnings() {
-    let scene =
-        read("trimesh { points = ((0,0,0),(1,0,0),(2,0,0)); faces = ((0,1,2)); } sphere {}");
+    let scene = read("trimesh { points = ((0,0,0),(1,0,0),(2,0,0)); faces = ((0,1,2)); } sphere {}");
     assert_eq!(scene.objects.len(), 1);
     assert_eq!(scene.warnings.len(), 2);
 }
@@ -406,18 +371,9 @@ fn groups_share_their_transform() {
          { } ;; { { } }",
     );
     assert_eq!(scene.objects.len(), 3);
-    assert!(close(
-        point(&scene.objects[0], Vec3::ZERO),
-        Vec3::new(0.0, 0.0, 5.0)
-    ));
-    assert!(close(
-        point(&scene.objects[1], Vec3::ZERO),
-        Vec3::new(1.0, 0.0, 5.0)
-    ));
-    assert!(close(
-        point(&scene.objects[2], Vec3::ZERO),
-        Vec3::new(0.0, 0.0, 5.0)
-    ));
+    assert!(close(point(&scene.objects[0], Vec3::ZERO), Vec3::new(0.0, 0.0, 5.0)));
+    assert!(close(point(&scene.objects[1], Vec3::ZERO), Vec3::new(1.0, 0.0, 5.0)));
+    assert!(close(point(&scene.objects[2], Vec3::ZERO), Vec3::new(0.0, 0.0, 5.0)));
     // A stray `;` is not allowed inside a group, and groups must close.
     let (err, covered) = fail("{ sphere {}; }");
     assert_eq!(covered, ";");
@@ -452,16 +408,8 @@ fn deep_nesting_does_not_overflow_a_small_stack() {
             "translate(0,0,0, ".repeat(DEPTH),
             ")".repeat(DEPTH)
         );
-        let groups = format!(
-            "{HEADER}{}sphere {{}}{}",
-            "{ ".repeat(DEPTH),
-            "} ".repeat(DEPTH)
-        );
-        let mixed = format!(
-            "{HEADER}{}box {{}}{}",
-            "scale(1, { ".repeat(DEPTH),
-            "}) ".repeat(DEPTH)
-        );
+        let groups = format!("{HEADER}{}sphere {{}}{}", "{ ".repeat(DEPTH), "} ".repeat(DEPTH));
+        let mixed = format!("{HEADER}{}box {{}}{}", "scale(1, { ".repeat(DEPTH), "}) ".repeat(DEPTH));
         let dictionary = format!(
             "{HEADER}{}sphere {{ material = {{}}; }}{}",
             "translate(0,0,0, ".repeat(DEPTH),
@@ -535,9 +483,7 @@ fn student_extensions_are_named() {
         assert_eq!(covered, word);
         assert_eq!(
             err.message,
-            format!(
-                "`{word}` is a student extension of the course format that caustica does not read"
-            )
+            format!("`{word}` is a student extension of the course format that caustica does not read")
         );
     }
 }
@@ -623,9 +569,7 @@ fn dialect_o_reads_its_own_rules() {
     assert!(scene.warnings[0].0.contains("focaldistance"));
     match &scene.lights[0] {
         LightDesc::Point {
-            position,
-            attenuation,
-            ..
+            position, attenuation, ..
         } => {
             assert_eq!(*position, Vec3::new(10.0, 0.0, 0.0));
             assert_eq!(*attenuation, [0.0, 0.0, 1.0]);
@@ -636,16 +580,11 @@ fn dialect_o_reads_its_own_rules() {
     assert_eq!(shiny.name.as_deref(), Some("shiny"));
     assert_eq!(shiny.shininess, Param::grey(64.0));
     assert_eq!(shiny.reflective, Param::grey(0.5));
-    assert!(close(
-        point(&scene.objects[0], Vec3::ZERO),
-        Vec3::new(1.0, 2.0, 3.0)
-    ));
+    assert!(close(point(&scene.objects[0], Vec3::ZERO), Vec3::new(1.0, 2.0, 3.0)));
     let inline = &scene.objects[1].material;
     assert_eq!(inline.reflective, Param::Constant(Vec3::Z));
     assert_eq!(inline.specular, Param::grey(0.0));
-    assert!(
-        matches!(&inline.diffuse, Param::Texture { path, .. } if path == &PathBuf::from("scenes/brick.bmp"))
-    );
+    assert!(matches!(&inline.diffuse, Param::Texture { path, .. } if path == &PathBuf::from("scenes/brick.bmp")));
     let ShapeDesc::Trimesh(mesh) = &scene.objects[2].shape else {
         panic!("mesh")
     };
@@ -670,11 +609,7 @@ fn dialect_o_errors() {
     assert_eq!(err.help.as_deref(), Some("did you mean `sphere`?"));
     let err = read_as("torus { material = {}; }", Dialect::Dictionary).expect_err("extension");
     assert!(err.message.starts_with("`torus` is a student extension"));
-    let err = read_as(
-        "translate(1, 2, sphere { material = {}; })",
-        Dialect::Dictionary,
-    )
-    .expect_err("arity");
+    let err = read_as("translate(1, 2, sphere { material = {}; })", Dialect::Dictionary).expect_err("arity");
     assert!(err.message.contains("`translate` with (x, y, z, object)"));
     let err = read_as(
         "sphere { material = { diffuse = (1,1,1) specular = (1,1,1) }; }",
@@ -689,11 +624,7 @@ fn dialect_o_errors() {
 #[test]
 fn dialect_t_rejects_dialect_o_syntax_when_forced() {
     assert!(read_as(DIALECT_O, Dialect::Tokenizer).is_err());
-    assert!(read_as(
-        "sphere { material = { diffuse = (.5, 1, 1); }; }",
-        Dialect::Tokenizer
-    )
-    .is_ok());
+    assert!(read_as("sphere { material = { diffuse = (.5, 1, 1); }; }", Dialect::Tokenizer).is_ok());
     assert!(read_as("{ sphere { material = {}; } }", Dialect::Dictionary).is_err());
 }
 

@@ -4,8 +4,7 @@
 //! turns into call-stack depth.
 
 use super::ast::{
-    CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription,
-    ShapeDesc, Span,
+    CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
 };
 use super::cursor::Cursor;
 use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS};
@@ -138,9 +137,7 @@ impl<'a> Parser<'a> {
                 .with_help("every scene file starts with `SBT-raytracer 1.0`"));
         }
         self.cur.next();
-        let (version, span) = self
-            .cur
-            .number("(the format version) after `SBT-raytracer`")?;
+        let (version, span) = self.cur.number("(the format version) after `SBT-raytracer`")?;
         if version > 1.1 {
             return Err(ParseError::new(
                 format!("format version {version} is not supported; this reader accepts versions up to 1.1"),
@@ -221,10 +218,7 @@ impl<'a> Parser<'a> {
                 }
                 _ => {
                     let (what, allowed) = if frames.is_empty() && allowed.len() > ELEMENTS.len() {
-                        (
-                            "a camera, light, `material`, object, transform or `{` group",
-                            allowed,
-                        )
+                        ("a camera, light, `material`, object, transform or `{` group", allowed)
                     } else {
                         ("an object, a transform or a `{` group", ELEMENTS)
                     };
@@ -279,8 +273,7 @@ impl<'a> Parser<'a> {
             }
             "scale" => {
                 let (first, _) = self.cur.number(&ctx)?;
-                self.cur
-                    .expect(Tok::Comma, &format!("after the first factor {ctx}"))?;
+                self.cur.expect(Tok::Comma, &format!("after the first factor {ctx}"))?;
                 // A number after the first comma means three factors (§2).
                 let factors = if matches!(self.cur.peek().tok, Tok::Number(_)) {
                     let [y, z] = self.numbers_then_comma::<2>(&ctx)?;
@@ -298,8 +291,7 @@ impl<'a> Parser<'a> {
                 let mut rows = [Vec4::ZERO; 4];
                 for row in &mut rows {
                     *row = Vec4::from(self.tuple::<4>(&ctx)?.0);
-                    self.cur
-                        .expect(Tok::Comma, &format!("after a matrix row {ctx}"))?;
+                    self.cur.expect(Tok::Comma, &format!("after a matrix row {ctx}"))?;
                 }
                 transform_stack::from_rows(rows, &(start..self.cur.prev_end()))
             }
@@ -307,15 +299,11 @@ impl<'a> Parser<'a> {
     }
 
     /// `N` numbers, each followed by a comma.
-    fn numbers_then_comma<const N: usize>(
-        &mut self,
-        context: &str,
-    ) -> Result<[f32; N], ParseError> {
+    fn numbers_then_comma<const N: usize>(&mut self, context: &str) -> Result<[f32; N], ParseError> {
         let mut values = [0.0; N];
         for value in &mut values {
             *value = self.cur.number(context)?.0;
-            self.cur
-                .expect(Tok::Comma, &format!("after a number {context}"))?;
+            self.cur.expect(Tok::Comma, &format!("after a number {context}"))?;
         }
         Ok(values)
     }
@@ -328,10 +316,8 @@ impl<'a> Parser<'a> {
         let mut values = [0.0; N];
         for (i, value) in values.iter_mut().enumerate() {
             if i > 0 {
-                self.cur.expect(
-                    Tok::Comma,
-                    &format!("between the numbers of a {N}-tuple {context}"),
-                )?;
+                self.cur
+                    .expect(Tok::Comma, &format!("between the numbers of a {N}-tuple {context}"))?;
             }
             *value = self.cur.number(&format!("in a {N}-tuple {context}"))?.0;
         }
@@ -396,11 +382,7 @@ impl<'a> Parser<'a> {
             }
             let handled = token.tok == Tok::Word && field(self, &token, self.cur.text_of(&token))?;
             if !handled {
-                let list = allowed
-                    .iter()
-                    .map(|f| format!("`{f}`"))
-                    .collect::<Vec<_>>()
-                    .join(", ");
+                let list = allowed.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", ");
                 return Err(self.bad_word(&format!("a `{name}` field ({list}) or `}}`"), allowed));
             }
         }
@@ -493,11 +475,7 @@ impl<'a> Parser<'a> {
             |p, token, key| {
                 match key {
                     "position" | "color" | "colour" => {
-                        let slot = if key == "position" {
-                            &mut position
-                        } else {
-                            &mut color
-                        };
+                        let slot = if key == "position" { &mut position } else { &mut color };
                         if slot.is_some() {
                             return Err(ParseError::new(
                                 format!("`point_light` has a second `{key}`"),
@@ -507,9 +485,7 @@ impl<'a> Parser<'a> {
                         p.key_equals()?;
                         *slot = Some(p.vec3(&format!("for `{key}`"))?);
                     }
-                    "constant_attenuation_coeff"
-                    | "linear_attenuation_coeff"
-                    | "quadratic_attenuation_coeff" => {
+                    "constant_attenuation_coeff" | "linear_attenuation_coeff" | "quadratic_attenuation_coeff" => {
                         p.key_equals()?;
                         let i = match key {
                             "constant_attenuation_coeff" => 0,
@@ -549,11 +525,7 @@ impl<'a> Parser<'a> {
                 if !matches!(key, "direction" | "color" | "colour") {
                     return Ok(false);
                 }
-                let slot = if key == "direction" {
-                    &mut direction
-                } else {
-                    &mut color
-                };
+                let slot = if key == "direction" { &mut direction } else { &mut color };
                 if slot.is_some() {
                     return Err(ParseError::new(
                         format!("`directional_light` has a second `{key}`"),
@@ -570,19 +542,12 @@ impl<'a> Parser<'a> {
         let span = keyword.span.start..self.cur.prev_end();
         let (direction, color) = match (direction, color) {
             (Some(direction), Some(color)) => (direction, color),
-            (None, _) => {
-                return Err(ParseError::new(
-                    "`directional_light` needs a `direction`",
-                    span,
-                ))
-            }
+            (None, _) => return Err(ParseError::new("`directional_light` needs a `direction`", span)),
             (_, None) => return Err(ParseError::new("`directional_light` needs a `color`", span)),
         };
-        self.scene.lights.push(LightDesc::Directional {
-            direction,
-            color,
-            span,
-        });
+        self.scene
+            .lights
+            .push(LightDesc::Directional { direction, color, span });
         Ok(())
     }
 
@@ -596,10 +561,8 @@ impl<'a> Parser<'a> {
         let color = self.vec3("for the ambient `color`")?;
         self.scene.ambient += color;
         self.cur.eat(Tok::Semicolon);
-        self.cur.expect(
-            Tok::RBrace,
-            "to close `ambient_light` (it has exactly one `color`)",
-        )?;
+        self.cur
+            .expect(Tok::RBrace, "to close `ambient_light` (it has exactly one `color`)")?;
         Ok(())
     }
 
@@ -614,9 +577,7 @@ impl<'a> Parser<'a> {
     /// `{ fields }` starting from `base`, or a named material's name.
     fn material_body(&mut self, base: &MaterialDesc) -> Result<MaterialDesc, ParseError> {
         let token = self.cur.peek().clone();
-        if token.tok == Tok::Quoted
-            || (token.tok == Tok::Word && !is_reserved(self.cur.text_of(&token)))
-        {
+        if token.tok == Tok::Quoted || (token.tok == Tok::Word && !is_reserved(self.cur.text_of(&token))) {
             if let Some(error) = extension_error(self.cur.text_of(&token), &token.span) {
                 return Err(error);
             }
@@ -624,9 +585,7 @@ impl<'a> Parser<'a> {
             return self.named.get(&name, &span);
         }
         if token.tok != Tok::LBrace {
-            return Err(self
-                .cur
-                .unexpected("`{` or a material name after `material =`"));
+            return Err(self.cur.unexpected("`{` or a material name after `material =`"));
         }
         self.cur.next();
         let mut material = base.clone();
@@ -651,8 +610,7 @@ impl<'a> Parser<'a> {
                     if with_equals {
                         self.cur.eat(Tok::Semicolon);
                     } else {
-                        self.cur
-                            .expect(Tok::Semicolon, "after `name ID` in a material")?;
+                        self.cur.expect(Tok::Semicolon, "after `name ID` in a material")?;
                     }
                     if name.is_some() {
                         return Err(ParseError::new("this material has a second `name`", span));
@@ -673,10 +631,7 @@ impl<'a> Parser<'a> {
                 }
                 _ => {
                     let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `name`";
-                    return Err(self.bad_word(
-                        &format!("a material field ({list}) or `}}`"),
-                        MATERIAL_FIELDS,
-                    ));
+                    return Err(self.bad_word(&format!("a material field ({list}) or `}}`"), MATERIAL_FIELDS));
                 }
             }
         }
@@ -714,14 +669,7 @@ impl<'a> Parser<'a> {
         let mut material = None;
         let (mut height, mut bottom, mut top, mut capped) = (1.0f32, 1.0f32, 0.0f32, true);
         let allowed: &[&str] = match kind {
-            "cone" => &[
-                "material",
-                "name",
-                "capped",
-                "height",
-                "bottom_radius",
-                "top_radius",
-            ],
+            "cone" => &["material", "name", "capped", "height", "bottom_radius", "top_radius"],
             "cylinder" => &["material", "name", "capped"],
             _ => &["material", "name"],
         };
@@ -791,9 +739,7 @@ impl<'a> Parser<'a> {
         key: &str,
         mut item: impl FnMut(&mut Self) -> Result<(), ParseError>,
     ) -> Result<Span, ParseError> {
-        let open = self
-            .cur
-            .expect(Tok::LParen, &format!("to start the `{key}` list"))?;
+        let open = self.cur.expect(Tok::LParen, &format!("to start the `{key}` list"))?;
         if !self.cur.eat(Tok::RParen) {
             loop {
                 item(self)?;
@@ -805,10 +751,8 @@ impl<'a> Parser<'a> {
             }
         }
         let span = open.span.start..self.cur.prev_end();
-        self.cur.expect(
-            Tok::Semicolon,
-            &format!("after the `{key}` list (it is required here)"),
-        )?;
+        self.cur
+            .expect(Tok::Semicolon, &format!("after the `{key}` list (it is required here)"))?;
         Ok(span)
     }
 
@@ -865,13 +809,11 @@ impl<'a> Parser<'a> {
                             let open = p.cur.expect(Tok::LParen, "to start a face")?;
                             let first = mesh.face_indices.len();
                             loop {
-                                mesh.face_indices
-                                    .push(p.cur.number_f64("(a vertex index) in a face")?);
+                                mesh.face_indices.push(p.cur.number_f64("(a vertex index) in a face")?);
                                 if p.cur.eat(Tok::RParen) {
                                     break;
                                 }
-                                p.cur
-                                    .expect(Tok::Comma, "or `)` between the indices of a face")?;
+                                p.cur.expect(Tok::Comma, "or `)` between the indices of a face")?;
                             }
                             let span = open.span.start..p.cur.prev_end();
                             mesh.faces.push((first..mesh.face_indices.len(), span));
@@ -881,9 +823,7 @@ impl<'a> Parser<'a> {
                     "materials" => {
                         p.key_equals()?;
                         // Each entry starts from the mesh's material as it is at this point.
-                        let base = material
-                            .clone()
-                            .unwrap_or_else(|| p.default_material.clone());
+                        let base = material.clone().unwrap_or_else(|| p.default_material.clone());
                         let mut materials = Vec::new();
                         let span = p.list(key, |p| {
                             materials.push(p.material_body(&base)?);

@@ -24,10 +24,7 @@ pub(crate) fn rotation(axis: Vec3, angle: f32, span: &Span) -> Result<Mat4, Pars
     let length = axis.length();
     if !(length.is_finite() && length > 1e-20) {
         return Err(ParseError::new(
-            format!(
-                "rotation axis ({}, {}, {}) has zero length",
-                axis.x, axis.y, axis.z
-            ),
+            format!("rotation axis ({}, {}, {}) has zero length", axis.x, axis.y, axis.z),
             span.clone(),
         ));
     }
@@ -112,12 +109,7 @@ mod tests {
 
     #[test]
     fn rotation_is_right_handed_radians() {
-        let m = rotation(
-            Vec3::new(0.0, 0.0, 2.0),
-            std::f32::consts::FRAC_PI_2,
-            &(0..1),
-        )
-        .expect("valid axis");
+        let m = rotation(Vec3::new(0.0, 0.0, 2.0), std::f32::consts::FRAC_PI_2, &(0..1)).expect("valid axis");
         let p = m.transform_point3(Vec3::X);
         assert!((p - Vec3::Y).length() < 1e-6, "{p}");
     }
@@ -137,12 +129,7 @@ mod tests {
     #[test]
     fn degenerate_matrices_are_rejected() {
         assert!(rotation(Vec3::ZERO, 1.0, &(3..9)).is_err());
-        assert_eq!(
-            scaling(Vec3::new(1.0, 0.0, 1.0), &(3..9))
-                .expect_err("zero")
-                .span,
-            3..9
-        );
+        assert_eq!(scaling(Vec3::new(1.0, 0.0, 1.0), &(3..9)).expect_err("zero").span, 3..9);
         assert!(from_rows([Vec4::ZERO; 4], &(0..1)).is_err());
     }
 
@@ -153,15 +140,9 @@ mod tests {
         stack
             .push(scaling(Vec3::splat(2.0), &(0..1)).expect("ok"), &(0..1))
             .expect("ok");
-        assert_eq!(
-            stack.current().transform_point3(Vec3::X),
-            Vec3::new(3.0, 0.0, 0.0)
-        );
+        assert_eq!(stack.current().transform_point3(Vec3::X), Vec3::new(3.0, 0.0, 0.0));
         stack.pop();
-        assert_eq!(
-            stack.current().transform_point3(Vec3::X),
-            Vec3::new(2.0, 0.0, 0.0)
-        );
+        assert_eq!(stack.current().transform_point3(Vec3::X), Vec3::new(2.0, 0.0, 0.0));
         let huge = scaling(Vec3::splat(1e12), &(0..1)).expect("ok");
         assert!(stack
             .push(huge, &(0..1))

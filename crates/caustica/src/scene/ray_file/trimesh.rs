@@ -33,10 +33,7 @@ pub(crate) fn finish(
     let count = input.points.len();
     for (what, len, list_span) in [
         ("normals", input.normals.as_ref().map(|(v, s)| (v.len(), s))),
-        (
-            "materials",
-            input.materials.as_ref().map(|(v, s)| (v.len(), s)),
-        ),
+        ("materials", input.materials.as_ref().map(|(v, s)| (v.len(), s))),
         ("texture_uv", input.uvs.as_ref().map(|(v, s)| (v.len(), s))),
     ]
     .into_iter()
@@ -70,9 +67,7 @@ pub(crate) fn finish(
             let index = value.trunc();
             if index < 0.0 || index >= count as f64 {
                 return Err(ParseError::new(
-                    format!(
-                        "face {face_number} uses vertex {index} but the mesh has {count} points"
-                    ),
+                    format!("face {face_number} uses vertex {index} but the mesh has {count} points"),
                     face_span.clone(),
                 ));
             }
@@ -153,9 +148,7 @@ mod tests {
     #[test]
     fn polygons_are_fan_triangulated_with_truncated_indices() {
         let mut warnings = Vec::new();
-        let mesh = finish(square(), &(0..1), &mut warnings)
-            .expect("valid")
-            .expect("kept");
+        let mesh = finish(square(), &(0..1), &mut warnings).expect("valid").expect("kept");
         assert_eq!(mesh.triangles, vec![[0, 1, 2], [0, 2, 3]]);
         assert!(warnings.is_empty());
     }
@@ -166,10 +159,7 @@ mod tests {
         input.face_indices.extend([0.0, 1.0, 40.0]);
         input.faces.push((4..7, 30..40));
         let err = finish(input, &(0..1), &mut Vec::new()).expect_err("bad index");
-        assert_eq!(
-            err.message,
-            "face 1 uses vertex 40 but the mesh has 4 points"
-        );
+        assert_eq!(err.message, "face 1 uses vertex 40 but the mesh has 4 points");
         assert_eq!(err.span, 30..40);
         let mut input = square();
         input.face_indices[0] = -1.0;
@@ -180,12 +170,7 @@ mod tests {
     fn short_faces_and_wrong_counts_are_errors() {
         let mut input = square();
         input.faces = vec![(0..2, 5..9)];
-        assert_eq!(
-            finish(input, &(0..1), &mut Vec::new())
-                .expect_err("short")
-                .span,
-            5..9
-        );
+        assert_eq!(finish(input, &(0..1), &mut Vec::new()).expect_err("short").span, 5..9);
         let mut input = square();
         input.normals = Some((vec![Vec3::Z; 3], 50..60));
         let err = finish(input, &(0..1), &mut Vec::new()).expect_err("count");
@@ -199,9 +184,7 @@ mod tests {
         input.face_indices.extend([0.0, 0.0, 1.0]);
         input.faces.push((4..7, 30..40));
         let mut warnings = Vec::new();
-        let mesh = finish(input, &(0..1), &mut warnings)
-            .expect("valid")
-            .expect("kept");
+        let mesh = finish(input, &(0..1), &mut warnings).expect("valid").expect("kept");
         assert_eq!(mesh.triangles.len(), 2);
         assert_eq!(warnings.len(), 1);
         assert_eq!(warnings[0].1, 30..40);
@@ -210,9 +193,7 @@ mod tests {
         input.face_indices = vec![0.0, 1.0, 1.0];
         input.faces = vec![(0..3, 0..5)];
         let mut warnings = Vec::new();
-        assert!(finish(input, &(7..8), &mut warnings)
-            .expect("valid")
-            .is_none());
+        assert!(finish(input, &(7..8), &mut warnings).expect("valid").is_none());
         assert_eq!(warnings.len(), 2);
         assert_eq!(warnings[1].1, 7..8);
     }
@@ -221,20 +202,13 @@ mod tests {
     fn generated_normals_average_unit_face_normals() {
         // Two faces meeting at a right angle along the x axis.
         let mut input = MeshInput {
-            points: vec![
-                Vec3::ZERO,
-                Vec3::X,
-                Vec3::new(0.0, 5.0, 0.0),
-                Vec3::new(0.0, 0.0, 1.0),
-            ],
+            points: vec![Vec3::ZERO, Vec3::X, Vec3::new(0.0, 5.0, 0.0), Vec3::new(0.0, 0.0, 1.0)],
             face_indices: vec![0.0, 1.0, 2.0, 0.0, 3.0, 1.0],
             faces: vec![(0..3, 0..1), (3..6, 1..2)],
             ..MeshInput::default()
         };
         input.gennormals = true;
-        let mesh = finish(input, &(0..1), &mut Vec::new())
-            .expect("valid")
-            .expect("kept");
+        let mesh = finish(input, &(0..1), &mut Vec::new()).expect("valid").expect("kept");
         let normals = mesh.normals.expect("generated");
         let expected = Vec3::new(0.0, 1.0, 1.0).normalize();
         assert!((normals[0] - expected).length() < 1e-6, "{}", normals[0]);
