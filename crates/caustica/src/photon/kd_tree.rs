@@ -1,1 +1,419 @@
-//! kd-tree
+//! A balanced, pointer-free kd-tree over a slice of points, for photon gathering.
+//!
+//! [`KdTree::build`] reorders the caller's items in place into tree order and keeps only one
+//! small record (split value + axis, 8 bytes) per internal node; there are roughly
+//! `n / 6 .. n / 12` internal nodes, so the overhead is about one byte per point.
+//!
+//! # Layout
+//!
+//! The item range of a node is split at its median (`len / 2`): the left child gets
+//! `[lo, lo + len/2)`, the right child the rest. Sibling sizes at any depth differ by at most
+//! one, so every leaf sits at the same depth `D` (the first depth whose ranges hold at most
+//! [`LEAF_MAX`] items) and the internal nodes form a complete binary tree of `2^D - 1` nodes.
+//! Those are stored in pre-order: a node's subtree is one contiguous run, its left child follows
+//! it and its right child follows the left subtree. Nothing but the split records is stored;
+//! item ranges are recomputed while descending.
+//!
+//! # Queries
+//!
+//! Depth-first, nearer child first, with the far child pruned by the exact squared distance from
+//! the query to the child's cell (per-axis offsets carried down, as in Arya & Mount). The k-NN
+//! result is a max-heap kept in place in the caller's `Vec`, so a query allocates nothing once
+//! that vector has grown to `k`.
+
+use crate::math::Vec3;
+
+/// Something with a position: photons implement it.
+pub trait KdPoint {
+    /// The point's position.
+    fn position(&self) -> Vec3;
+}
+
+impl KdPoint for Vec3 {
+    #[inline]
+    fn position(&self) -> Vec3 {
+        *self
+    }
+}
+
+/// One k-NN result: the item's slot in the reordered slice and its squared distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Neighbor {
+    /// Index into the slice the tree was built over.
+    pub slot: u32,
+    /// Squared distance from the query point.
+    pub dist2: f32,
+}
+
+/// Most items a leaf holds; leaves hold between about `LEAF_MAX / 2` and `LEAF_MAX`.
+pub const LEAF_MAX: usize = 12;
+
+/// Subranges at least this large are built on two rayon tasks.
+const PAR_MIN: usize = 1 << 14;
+
+/// An internal node: items left of the split have `pos[axis] <= split`, right ones `>= split`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Node {
+    split: f32,
+    axis: u32,
+}
+
+/// A balanced kd-tree built in place over a slice; see the [module docs](self).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct KdTree {
+    /// Internal nodes in pre-order; `2^D - 1` of them.
+    nodes: Vec<Node>,
+    /// Number of items the tree was built over.
+    len: u32,
+}
+
+/// Squared distance with a fixed summation order; the cell bounds use the same order, which
+/// keeps pruning exact (never rounds a cell bound above a contained point's distance).
+#[inline(always)]
+fn dist2(a: [f32; 3], b: [f32; 3]) -> f32 {
+    let dx = a[0] - b[0];
+    let dy = a[1] - b[1];
+    let dz = a[2] - b[2];
+    dx * dx + dy * dy + dz * dz
+}
+
+/// Build key: NaN sorts as +inf, so splits are never NaN and NaN items end up in cells that
+/// finite queries prune.
+#[inline(always)]
+fn key(p: Vec3, axis: usize) -> f32 {
+    let v = p.to_array()[axis];
+    if v.is_nan() {
+        f32::INFINITY
+    } else {
+        v
+    }
+}
+
+/// The smallest float above `x` (for `x >= 0`), turning an inclusive bound into a strict one.
+#[inline]
+fn strict_bound(x: f32) -> f32 {
+    if x == f32::INFINITY {
+        x
+    } else if x == 0.0 {
+        f32::from_bits(1)
+    } else {
+        f32::from_bits(x.to_bits() + 1)
+    }
+}
+
+/// Number of internal levels for `n` items: the least `d` with `ceil(n / 2^d) <= LEAF_MAX`.
+fn depth_for(n: usize) -> u32 {
+    let mut d = 0;
+    while n.div_ceil(1usize << d) > LEAF_MAX {
+        d += 1;
+    }
+    d
+}
+
+fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], items: &mut [T]) {
+    if nodes.is_empty() {
+        return;
+    }
+    let n = items.len();
+    let (lo, hi) = if n >= PAR_MIN * 4 {
+        use rayon::prelude::*;
+        // min/max are exact, so the parallel reduction is deterministic. `par_iter_mut` only
+        // because `T` is `Send` but maybe not `Sync`.
+        items
+            .par_iter_mut()
+            .with_min_len(PAR_MIN)
+            .fold(
+                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
+                |(lo, hi), it| {
+                    let p = it.position();
+                    (lo.min(p), hi.max(p))
+                },
+            )
+            .reduce(
+                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
+                |a, b| (a.0.min(b.0), a.1.max(b.1)),
+            )
+    } else {
+        items
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), it| {
+                let p = it.position();
+                (lo.min(p), hi.max(p))
+            })
+    };
+    let ext = hi - lo;
+    // Widest axis; a NaN extent never wins a comparison.
+    let mut axis = 0;
+    if ext.y > ext.x {
+        axis = 1;
+    }
+    if ext.z > ext[axis] {
+        axis = 2;
+    }
+    let mid = n / 2;
+    items.select_nth_unstable_by(mid, |a, b| {
+        key(a.position(), axis).total_cmp(&key(b.position(), axis))
+    });
+    nodes[0] = Node {
+        split: key(items[mid].position(), axis),
+        axis: axis as u32,
+    };
+    let half = nodes.len() / 2;
+    let (left_nodes, right_nodes) = nodes[1..].split_at_mut(half);
+    let (left_items, right_items) = items.split_at_mut(mid);
+    if n >= PAR_MIN {
+        rayon::join(
+            || build_rec(left_nodes, left_items),
+            || build_rec(right_nodes, right_items),
+        );
+    } else {
+        build_rec(left_nodes, left_items);
+        build_rec(right_nodes, right_items);
+    }
+}
+
+impl KdTree {
+    /// Reorders `items` into tree order and builds the tree over them.
+    ///
+    /// Deterministic: the same input gives the same order and tree for any rayon thread count.
+    /// Items with NaN coordinates are kept but never reported by queries.
+    ///
+    /// # Panics
+    /// If there are more than `u32::MAX` items.
+    pub fn build<T: KdPoint + Send>(items: &mut [T]) -> KdTree {
+        let n = items.len();
+        let len = u32::try_from(n).expect("KdTree holds at most u32::MAX items");
+        let depth = depth_for(n);
+        let mut nodes = vec![Node::default(); (1usize << depth) - 1];
+        build_rec(&mut nodes, items);
+        KdTree { nodes, len }
+    }
+
+    /// Number of items the tree was built over.
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.len as usize
+    }
+
+    /// Whether the tree holds no items.
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Heap bytes the tree itself owns (the items are the caller's).
+    pub fn heap_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Node>()
+    }
+
+    /// The k nearest items within squared distance `max_dist2` (inclusive) of `p`.
+    ///
+    /// `out` is cleared, then holds up to `k` results as a max-heap on `dist2`: `out[0]` is the
+    /// farthest one, the rest are in no particular order. Returns the squared radius that bounds
+    /// them: the k-th distance (`out[0].dist2`) when `k` items were found, else `max_dist2`
+    /// (also for `k == 0`). A NaN query point or `max_dist2` finds nothing.
+    ///
+    /// `items` must be the slice `build` reordered. Allocates only if `out` must grow.
+    pub fn k_nearest<T: KdPoint>(
+        &self,
+        items: &[T],
+        p: Vec3,
+        k: usize,
+        max_dist2: f32,
+        out: &mut Vec<Neighbor>,
+    ) -> f32 {
+        out.clear();
+        assert_eq!(items.len(), self.len(), "items are not the tree's slice");
+        if k == 0 || p.is_nan() || max_dist2.is_nan() || max_dist2 < 0.0 {
+            return max_dist2;
+        }
+        out.reserve(k.min(items.len()));
+        let mut q = Knn {
+            items,
+            nodes: &self.nodes,
+            p: p.to_array(),
+            k,
+            bound: strict_bound(max_dist2),
+            out,
+        };
+        q.visit(0, self.nodes.len(), 0, items.len(), [0.0; 3]);
+        if out.len() == k {
+            out[0].dist2
+        } else {
+            max_dist2
+        }
+    }
+
+    /// Calls `f(slot, dist2)` for every item within squared distance `r2` (inclusive) of `p`,
+    /// in tree order. A NaN query point or `r2` finds nothing.
+    ///
+    /// `items` must be the slice `build` reordered.
+    pub fn for_each_within<T: KdPoint>(
+        &self,
+        items: &[T],
+        p: Vec3,
+        r2: f32,
+        mut f: impl FnMut(u32, f32),
+    ) {
+        assert_eq!(items.len(), self.len(), "items are not the tree's slice");
+        if p.is_nan() || r2.is_nan() || r2 < 0.0 {
+            return;
+        }
+        let mut q = Within {
+            items,
+            nodes: &self.nodes,
+            p: p.to_array(),
+            bound: strict_bound(r2),
+            f: &mut f,
+        };
+        q.visit(0, self.nodes.len(), 0, items.len(), [0.0; 3]);
+    }
+}
+
+/// State of one k-NN query. `bound` is strict: a candidate must have `dist2 < bound`.
+struct Knn<'a, T> {
+    items: &'a [T],
+    nodes: &'a [Node],
+    p: [f32; 3],
+    k: usize,
+    bound: f32,
+    out: &'a mut Vec<Neighbor>,
+}
+
+impl<T: KdPoint> Knn<'_, T> {
+    /// Visits the subtree at `node` (`size` internal nodes) covering items `lo..lo + len`;
+    /// `off` holds the query's per-axis offsets to that subtree's cell.
+    fn visit(&mut self, node: usize, size: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+        if size == 0 {
+            self.leaf(lo, len);
+            return;
+        }
+        let Node { split, axis } = self.nodes[node];
+        let axis = axis as usize;
+        let diff = self.p[axis] - split;
+        let child = size / 2;
+        let half = len / 2;
+        let (left, right) = (node + 1, node + 1 + child);
+        let (near, near_lo, near_len, far, far_lo, far_len) = if diff < 0.0 {
+            (left, lo, half, right, lo + half, len - half)
+        } else {
+            (right, lo + half, len - half, left, lo, half)
+        };
+        self.visit(near, child, near_lo, near_len, off);
+        off[axis] = diff;
+        if dist2(off, [0.0; 3]) < self.bound {
+            self.visit(far, child, far_lo, far_len, off);
+        }
+    }
+
+    #[inline]
+    fn leaf(&mut self, lo: usize, len: usize) {
+        for (i, it) in self.items[lo..lo + len].iter().enumerate() {
+            let d2 = dist2(it.position().to_array(), self.p);
+            if d2 < self.bound {
+                self.push((lo + i) as u32, d2);
+            }
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, slot: u32, dist2: f32) {
+        let nb = Neighbor { slot, dist2 };
+        let out = &mut *self.out;
+        if out.len() < self.k {
+            out.push(nb);
+            let last = out.len() - 1;
+            sift_up(out, last);
+            if out.len() == self.k {
+                self.bound = out[0].dist2;
+            }
+        } else {
+            out[0] = nb;
+            sift_down(out);
+            self.bound = out[0].dist2;
+        }
+    }
+}
+
+/// Restores the max-heap after a push at `i`.
+#[inline]
+fn sift_up(h: &mut [Neighbor], mut i: usize) {
+    let x = h[i];
+    while i > 0 {
+        let parent = (i - 1) / 2;
+        if h[parent].dist2 >= x.dist2 {
+            break;
+        }
+        h[i] = h[parent];
+        i = parent;
+    }
+    h[i] = x;
+}
+
+/// Restores the max-heap after the root was replaced.
+#[inline]
+fn sift_down(h: &mut [Neighbor]) {
+    let n = h.len();
+    let x = h[0];
+    let mut i = 0;
+    loop {
+        let l = 2 * i + 1;
+        if l >= n {
+            break;
+        }
+        let r = l + 1;
+        let c = if r < n && h[r].dist2 > h[l].dist2 {
+            r
+        } else {
+            l
+        };
+        if h[c].dist2 <= x.dist2 {
+            break;
+        }
+        h[i] = h[c];
+        i = c;
+    }
+    h[i] = x;
+}
+
+/// State of one fixed-radius query.
+struct Within<'a, T, F> {
+    items: &'a [T],
+    nodes: &'a [Node],
+    p: [f32; 3],
+    bound: f32,
+    f: &'a mut F,
+}
+
+impl<T: KdPoint, F: FnMut(u32, f32)> Within<'_, T, F> {
+    fn visit(&mut self, node: usize, size: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+        if size == 0 {
+            for (i, it) in self.items[lo..lo + len].iter().enumerate() {
+                let d2 = dist2(it.position().to_array(), self.p);
+                if d2 < self.bound {
+                    (self.f)((lo + i) as u32, d2);
+                }
+            }
+            return;
+        }
+        let Node { split, axis } = self.nodes[node];
+        let axis = axis as usize;
+        let diff = self.p[axis] - split;
+        let child = size / 2;
+        let half = len / 2;
+        let (left, right) = (node + 1, node + 1 + child);
+        let (near, near_lo, near_len, far, far_lo, far_len) = if diff < 0.0 {
+            (left, lo, half, right, lo + half, len - half)
+        } else {
+            (right, lo + half, len - half, left, lo, half)
+        };
+        self.visit(near, child, near_lo, near_len, off);
+        off[axis] = diff;
+        if dist2(off, [0.0; 3]) < self.bound {
+            self.visit(far, child, far_lo, far_len, off);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
