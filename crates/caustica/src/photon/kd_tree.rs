@@ -21,6 +21,8 @@
 //! result is a max-heap kept in place in the caller's `Vec`, so a query allocates nothing once
 //! that vector has grown to `k`.
 
+use std::cmp::Ordering;
+
 use crate::math::Vec3;
 
 /// Something with a position: photons implement it.
@@ -46,7 +48,7 @@ pub struct Neighbor {
 }
 
 /// Most items a leaf holds; leaves hold between about `LEAF_MAX / 2` and `LEAF_MAX`.
-pub const LEAF_MAX: usize = 12;
+pub const LEAF_MAX: usize = 16;
 
 /// Subranges at least this large are built on two rayon tasks.
 const PAR_MIN: usize = 1 << 14;
@@ -110,50 +112,108 @@ fn depth_for(n: usize) -> u32 {
     d
 }
 
+/// Running bounds of a set of positions.
+#[derive(Clone, Copy)]
+struct Bounds {
+    lo: [f32; 3],
+    hi: [f32; 3],
+    /// Sum of all coordinates: NaN iff some coordinate is NaN (or infinities of both signs,
+    /// which merely takes the slower, NaN-safe path).
+    sum: f32,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds {
+        lo: [f32::INFINITY; 3],
+        hi: [f32::NEG_INFINITY; 3],
+        sum: 0.0,
+    };
+
+    /// Plain compares (one min/max instruction each) instead of NaN-aware `f32::min`.
+    #[inline(always)]
+    fn grow(mut self, p: Vec3) -> Bounds {
+        let p = p.to_array();
+        for a in 0..3 {
+            self.lo[a] = if p[a] < self.lo[a] { p[a] } else { self.lo[a] };
+            self.hi[a] = if p[a] > self.hi[a] { p[a] } else { self.hi[a] };
+        }
+        self.sum += (p[0] + p[1]) + p[2];
+        self
+    }
+
+    #[inline]
+    fn union(mut self, o: Bounds) -> Bounds {
+        for a in 0..3 {
+            self.lo[a] = self.lo[a].min(o.lo[a]);
+            self.hi[a] = self.hi[a].max(o.hi[a]);
+        }
+        // Only NaN-ness of the sum matters, so association order does not.
+        self.sum += o.sum;
+        self
+    }
+}
+
+/// Bounds of the items' positions; exact, hence deterministic also when computed in parallel.
+fn bounds<T: KdPoint + Send>(items: &mut [T]) -> Bounds {
+    if items.len() >= PAR_MIN * 4 {
+        use rayon::prelude::*;
+        // `par_iter_mut` only because `T` is `Send` but maybe not `Sync`.
+        items
+            .par_iter_mut()
+            .with_min_len(PAR_MIN)
+            .fold(|| Bounds::EMPTY, |b, it| b.grow(it.position()))
+            .reduce(|| Bounds::EMPTY, Bounds::union)
+    } else {
+        items
+            .iter()
+            .fold(Bounds::EMPTY, |b, it| b.grow(it.position()))
+    }
+}
+
+/// `select_nth_unstable` on a NaN-free key.
+#[inline(always)]
+fn select_by<T: KdPoint>(items: &mut [T], mid: usize, key: impl Fn(Vec3) -> f32) {
+    items.select_nth_unstable_by(mid, |a, b| {
+        let (a, b) = (key(a.position()), key(b.position()));
+        if a < b {
+            Ordering::Less
+        } else if a > b {
+            Ordering::Greater
+        } else {
+            Ordering::Equal
+        }
+    });
+}
+
 fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], items: &mut [T]) {
     if nodes.is_empty() {
         return;
     }
     let n = items.len();
-    let (lo, hi) = if n >= PAR_MIN * 4 {
-        use rayon::prelude::*;
-        // min/max are exact, so the parallel reduction is deterministic. `par_iter_mut` only
-        // because `T` is `Send` but maybe not `Sync`.
-        items
-            .par_iter_mut()
-            .with_min_len(PAR_MIN)
-            .fold(
-                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
-                |(lo, hi), it| {
-                    let p = it.position();
-                    (lo.min(p), hi.max(p))
-                },
-            )
-            .reduce(
-                || (Vec3::INFINITY, Vec3::NEG_INFINITY),
-                |a, b| (a.0.min(b.0), a.1.max(b.1)),
-            )
-    } else {
-        items
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), it| {
-                let p = it.position();
-                (lo.min(p), hi.max(p))
-            })
-    };
-    let ext = hi - lo;
+    let b = bounds(items);
+    let ext = [0, 1, 2].map(|a| b.hi[a] - b.lo[a]);
     // Widest axis; a NaN extent never wins a comparison.
     let mut axis = 0;
-    if ext.y > ext.x {
+    if ext[1] > ext[0] {
         axis = 1;
     }
-    if ext.z > ext[axis] {
+    if ext[2] > ext[axis] {
         axis = 2;
     }
+    let nan = b.sum.is_nan();
     let mid = n / 2;
-    items.select_nth_unstable_by(mid, |a, b| {
-        key(a.position(), axis).total_cmp(&key(b.position(), axis))
-    });
+    if nan {
+        items.select_nth_unstable_by(mid, |a, b| {
+            key(a.position(), axis).total_cmp(&key(b.position(), axis))
+        });
+    } else {
+        // One closure per axis so the comparison is a plain field compare.
+        match axis {
+            0 => select_by(items, mid, |p| p.x),
+            1 => select_by(items, mid, |p| p.y),
+            _ => select_by(items, mid, |p| p.z),
+        }
+    }
     nodes[0] = Node {
         split: key(items[mid].position(), axis),
         axis: axis as u32,
