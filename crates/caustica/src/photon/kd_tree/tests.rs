@@ -460,15 +460,33 @@ fn zz_timing() {
         eprintln!("   2-thread wall {:?}", t.elapsed());
         assert!(tree2 == tree);
         let mut out = Vec::new();
+        let qs: Vec<Vec3> = (0..20000).map(|_| items[rng.below(n)].pos).collect();
         for k in [50, 200] {
-            let c = cpu_ns();
+            let mut best = f64::INFINITY;
             let mut acc = 0.0;
-            for _ in 0..20000 {
-                let p = items[rng.below(n)].pos;
-                acc += tree.k_nearest(&items, p, k, 0.0625, &mut out);
+            for _ in 0..4 {
+                let c = cpu_ns();
+                for &p in &qs {
+                    acc += tree.k_nearest(&items, p, k, 0.0625, &mut out);
+                }
+                best = best.min((cpu_ns() - c) as f64 / 1e9);
             }
-            let s = (cpu_ns() - c) as f64 / 1e9;
-            eprintln!("  k={k}: {:.0} q/s cpu ({acc})", 20000.0 / s);
+            eprintln!("  k={k}: {:.0} q/s cpu ({acc})", qs.len() as f64 / best);
         }
+        let r2 = 17.0 / n as f32;
+        let mut best = f64::INFINITY;
+        let mut cnt = 0usize;
+        for _ in 0..4 {
+            let c = cpu_ns();
+            for &p in &qs {
+                tree.for_each_within(&items, p, r2, |_, _| cnt += 1);
+            }
+            best = best.min((cpu_ns() - c) as f64 / 1e9);
+        }
+        eprintln!(
+            "  within: {:.0} q/s cpu (avg {})",
+            qs.len() as f64 / best,
+            cnt / 4 / qs.len()
+        );
     }
 }
