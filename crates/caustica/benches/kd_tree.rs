@@ -234,7 +234,10 @@ fn bench_build(c: &mut Criterion, d: &Data) {
     g.bench_function(id("kiddo_immutable"), |b| {
         b.iter(|| ImmutableKdTree::<f32, 3>::new_from_slice(&d.points))
     });
-    g.bench_function(id("kiddo_mutable"), |b| b.iter(|| kiddo_mutable(&d.points)));
+    // Skipped at 10M: many seconds per build and pathological on flat data (see queries).
+    if d.n < 10_000_000 {
+        g.bench_function(id("kiddo_mutable"), |b| b.iter(|| kiddo_mutable(&d.points)));
+    }
     g.finish();
 }
 
@@ -270,7 +273,8 @@ fn bench_queries(c: &mut Criterion, d: &Data) {
     let mut items = d.photons.clone();
     let ours = KdTree::build(&mut items);
     let imm = ImmutableKdTree::<f32, 3>::new_from_slice(&d.points);
-    let mutable = kiddo_mutable(&d.points);
+    // kiddo's mutable tree: skipped at 10M (slow to build, very slow on flat data).
+    let mutable = (d.n < 10_000_000).then(|| kiddo_mutable(&d.points));
     cross_check(d, &items, &ours, &imm);
     eprintln!(
         "{} {}: tree overhead {:.2} bytes/point (ours), fixed radius {:.5}",
@@ -323,21 +327,23 @@ fn bench_queries(c: &mut Criterion, d: &Data) {
         // kiddo's mutable tree is very slow on flat data (see the report); fewer queries.
         let few = &d.queries[..QUERIES / 20];
         g.throughput(Throughput::Elements(few.len() as u64));
-        g.bench_function(id("kiddo_mutable"), |b| {
-            b.iter(|| {
-                let mut acc = 0usize;
-                for q in few {
-                    let r = mutable.nearest_n_within::<SquaredEuclidean>(
-                        &q.to_array(),
-                        KNN_MAX_DIST2,
-                        kk,
-                        false,
-                    );
-                    acc += r.len();
-                }
-                acc
-            })
-        });
+        if let Some(mutable) = &mutable {
+            g.bench_function(id("kiddo_mutable"), |b| {
+                b.iter(|| {
+                    let mut acc = 0usize;
+                    for q in few {
+                        let r = mutable.nearest_n_within::<SquaredEuclidean>(
+                            &q.to_array(),
+                            KNN_MAX_DIST2,
+                            kk,
+                            false,
+                        );
+                        acc += r.len();
+                    }
+                    acc
+                })
+            });
+        }
         g.finish();
     }
 
@@ -368,17 +374,19 @@ fn bench_queries(c: &mut Criterion, d: &Data) {
     });
     let few = &d.queries[..QUERIES / 20];
     g.throughput(Throughput::Elements(few.len() as u64));
-    g.bench_function(id("kiddo_mutable"), |b| {
-        b.iter(|| {
-            let mut acc = 0.0f32;
-            for q in few {
-                for n in mutable.within_unsorted::<SquaredEuclidean>(&q.to_array(), r2) {
-                    acc += n.distance;
+    if let Some(mutable) = &mutable {
+        g.bench_function(id("kiddo_mutable"), |b| {
+            b.iter(|| {
+                let mut acc = 0.0f32;
+                for q in few {
+                    for n in mutable.within_unsorted::<SquaredEuclidean>(&q.to_array(), r2) {
+                        acc += n.distance;
+                    }
                 }
-            }
-            acc
-        })
-    });
+                acc
+            })
+        });
+    }
     g.finish();
     black_box((items, ours, imm, mutable));
 }

@@ -133,9 +133,9 @@ impl Bounds {
     #[inline(always)]
     fn grow(mut self, p: Vec3) -> Bounds {
         let p = p.to_array();
-        for a in 0..3 {
-            self.lo[a] = if p[a] < self.lo[a] { p[a] } else { self.lo[a] };
-            self.hi[a] = if p[a] > self.hi[a] { p[a] } else { self.hi[a] };
+        for ((lo, hi), x) in self.lo.iter_mut().zip(&mut self.hi).zip(p) {
+            *lo = if x < *lo { x } else { *lo };
+            *hi = if x > *hi { x } else { *hi };
         }
         self.sum += (p[0] + p[1]) + p[2];
         self
