@@ -1,8 +1,8 @@
 //! A balanced, pointer-free kd-tree over a slice of points, for photon gathering.
 //!
 //! [`KdTree::build`] reorders the caller's items in place into tree order and keeps only one
-//! small record (split value + axis, 8 bytes) per internal node; there are roughly
-//! `n / 6 .. n / 12` internal nodes, so the overhead is about one byte per point.
+//! small record (split value + axis, 8 bytes) per internal node. Leaves hold `LEAF_MAX / 2 ..=
+//! LEAF_MAX` items, so there are `n / 16 .. n / 8` internal nodes: 0.5–1 byte per point.
 //!
 //! # Layout
 //!
@@ -17,9 +17,11 @@
 //! # Queries
 //!
 //! Depth-first, nearer child first, with the far child pruned by the exact squared distance from
-//! the query to the child's cell (per-axis offsets carried down, as in Arya & Mount). The k-NN
-//! result is a max-heap kept in place in the caller's `Vec`, so a query allocates nothing once
-//! that vector has grown to `k`.
+//! the query to the child's cell (per-axis offsets carried down, as in Arya & Mount), computed
+//! with the same rounding as a point distance so pruning never drops a point on the boundary.
+//! k-NN candidates collect in the caller's `Vec` (up to `2k`, then a selection keeps the `k`
+//! nearest and tightens the radius); the result is heapified at the end. A query allocates
+//! nothing once that vector has grown to `2k`.
 
 use std::cmp::Ordering;
 
