@@ -123,7 +123,13 @@ impl Aabb {
 
     /// The ray's entry and exit parameters, if it meets the box within `[t_min, t_max]`.
     #[inline]
-    pub fn intersect(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
+    pub fn intersect(
+        &self,
+        origin: Vec3,
+        inv_dir: Vec3,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(f32, f32)> {
         let t0 = (self.min - origin) * inv_dir;
         let t1 = (self.max - origin) * inv_dir;
         let near = t0.min(t1).max_element().max(t_min);
@@ -208,11 +214,18 @@ mod tests {
 
     #[test]
     fn frame_is_orthonormal() {
-        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.4, 0.866).normalize()] {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::X,
+            Vec3::new(0.3, -0.4, 0.866).normalize(),
+        ] {
             let f = Frame::from_normal(n);
             assert!((f.x.length() - 1.0).abs() < 1e-5);
             assert!((f.y.length() - 1.0).abs() < 1e-5);
-            assert!(f.x.dot(f.y).abs() < 1e-5 && f.x.dot(n).abs() < 1e-5 && f.y.dot(n).abs() < 1e-5);
+            assert!(
+                f.x.dot(f.y).abs() < 1e-5 && f.x.dot(n).abs() < 1e-5 && f.y.dot(n).abs() < 1e-5
+            );
             let v = Vec3::new(0.2, 0.5, -0.7);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
         }

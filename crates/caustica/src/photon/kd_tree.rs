@@ -1,33 +1,281 @@
-//! Placeholder kd-tree (brute force), replaced by the real one.
-#![allow(missing_docs)]
+//! A balanced, pointer-free kd-tree over a slice of points, for photon gathering.
+//!
+//! [`KdTree::build`] reorders the caller's items in place into tree order and keeps only one
+//! small record (split value + axis, 8 bytes) per internal node. Leaves hold `LEAF_MAX / 2 ..=
+//! LEAF_MAX` items, so there are `n / 16 .. n / 8` internal nodes: 0.5–1 byte per point.
+//!
+//! # Layout
+//!
+//! The item range of a node is split at its median (`len / 2`): the left child gets
+//! `[lo, lo + len/2)`, the right child the rest. Sibling sizes at any depth differ by at most
+//! one, so every leaf sits at the same depth `D` (the first depth whose ranges hold at most
+//! [`LEAF_MAX`] items) and the internal nodes form a complete binary tree of `2^D - 1` nodes.
+//! Those are stored in pre-order: a node's subtree is one contiguous run, its left child follows
+//! it and its right child follows the left subtree. Nothing but the split records is stored;
+//! item ranges are recomputed while descending.
+//!
+//! # Queries
+//!
+//! Depth-first, nearer child first, with the far child pruned by the exact squared distance from
+//! the query to the child's cell (per-axis offsets carried down, as in Arya & Mount), computed
+//! with the same rounding as a point distance so pruning never drops a point on the boundary.
+//! k-NN candidates collect in the caller's `Vec` (up to `2k`, then a selection keeps the `k`
+//! nearest and tightens the radius); the result is heapified at the end. A query allocates
+//! nothing once that vector has grown to `2k`.
+
+use std::cmp::Ordering;
+
 use crate::math::Vec3;
 
+/// Something with a position: photons implement it.
 pub trait KdPoint {
+    /// The point's position.
     fn position(&self) -> Vec3;
 }
+
 impl KdPoint for Vec3 {
+    #[inline]
     fn position(&self) -> Vec3 {
         *self
     }
 }
+
+/// One k-NN result: the item's slot in the reordered slice and its squared distance.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Neighbor {
+    /// Index into the slice the tree was built over.
     pub slot: u32,
+    /// Squared distance from the query point.
     pub dist2: f32,
 }
-pub struct KdTree {
-    n: usize,
+
+/// Most items a leaf holds; leaves hold between about `LEAF_MAX / 2` and `LEAF_MAX`.
+pub const LEAF_MAX: usize = 16;
+
+/// Subranges at least this large are built on two rayon tasks.
+const PAR_MIN: usize = 1 << 14;
+
+/// An internal node: items left of the split have `pos[axis] <= split`, right ones `>= split`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Node {
+    split: f32,
+    axis: u32,
 }
+
+/// A balanced kd-tree built in place over a slice; see the [module docs](self).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct KdTree {
+    /// Internal nodes in pre-order; `2^D - 1` of them.
+    nodes: Vec<Node>,
+    /// Number of items the tree was built over.
+    len: u32,
+}
+
+/// Squared distance with a fixed summation order; the cell bounds use the same order, which
+/// keeps pruning exact (never rounds a cell bound above a contained point's distance).
+#[inline(always)]
+fn dist2(a: [f32; 3], b: [f32; 3]) -> f32 {
+    let dx = a[0] - b[0];
+    let dy = a[1] - b[1];
+    let dz = a[2] - b[2];
+    dx * dx + dy * dy + dz * dz
+}
+
+/// Build key: NaN sorts as +inf, so splits are never NaN and NaN items end up in cells that
+/// finite queries prune.
+#[inline(always)]
+fn key(p: Vec3, axis: usize) -> f32 {
+    let v = p.to_array()[axis];
+    if v.is_nan() {
+        f32::INFINITY
+    } else {
+        v
+    }
+}
+
+/// The smallest float above `x` (for `x >= 0`), turning an inclusive bound into a strict one.
+#[inline]
+fn strict_bound(x: f32) -> f32 {
+    if x == f32::INFINITY {
+        x
+    } else if x == 0.0 {
+        f32::from_bits(1)
+    } else {
+        f32::from_bits(x.to_bits() + 1)
+    }
+}
+
+/// Number of internal levels for `n` items: the least `d` with `ceil(n / 2^d) <= LEAF_MAX`.
+fn depth_for(n: usize) -> u32 {
+    let mut d = 0;
+    while n.div_ceil(1usize << d) > LEAF_MAX {
+        d += 1;
+    }
+    d
+}
+
+/// Running bounds of a set of positions.
+#[derive(Clone, Copy)]
+struct Bounds {
+    lo: [f32; 3],
+    hi: [f32; 3],
+    /// Sum of all coordinates: NaN iff some coordinate is NaN (or infinities of both signs,
+    /// which merely takes the slower, NaN-safe path).
+    sum: f32,
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds {
+        lo: [f32::INFINITY; 3],
+        hi: [f32::NEG_INFINITY; 3],
+        sum: 0.0,
+    };
+
+    /// Plain compares (one min/max instruction each) instead of NaN-aware `f32::min`.
+    #[inline(always)]
+    fn grow(mut self, p: Vec3) -> Bounds {
+        let p = p.to_array();
+        for ((lo, hi), x) in self.lo.iter_mut().zip(&mut self.hi).zip(p) {
+            *lo = if x < *lo { x } else { *lo };
+            *hi = if x > *hi { x } else { *hi };
+        }
+        self.sum += (p[0] + p[1]) + p[2];
+        self
+    }
+
+    #[inline]
+    fn union(mut self, o: Bounds) -> Bounds {
+        for a in 0..3 {
+            self.lo[a] = self.lo[a].min(o.lo[a]);
+            self.hi[a] = self.hi[a].max(o.hi[a]);
+        }
+        // Only NaN-ness of the sum matters, so association order does not.
+        self.sum += o.sum;
+        self
+    }
+}
+
+/// Bounds of the items' positions; exact, hence deterministic also when computed in parallel.
+fn bounds<T: KdPoint + Send>(items: &mut [T]) -> Bounds {
+    if items.len() >= PAR_MIN * 4 {
+        use rayon::prelude::*;
+        // `par_iter_mut` only because `T` is `Send` but maybe not `Sync`.
+        items
+            .par_iter_mut()
+            .with_min_len(PAR_MIN)
+            .fold(|| Bounds::EMPTY, |b, it| b.grow(it.position()))
+            .reduce(|| Bounds::EMPTY, Bounds::union)
+    } else {
+        items
+            .iter()
+            .fold(Bounds::EMPTY, |b, it| b.grow(it.position()))
+    }
+}
+
+/// `select_nth_unstable` on a NaN-free key.
+#[inline(always)]
+fn select_by<T: KdPoint>(items: &mut [T], mid: usize, key: impl Fn(Vec3) -> f32) {
+    items.select_nth_unstable_by(mid, |a, b| {
+        let (a, b) = (key(a.position()), key(b.position()));
+        if a < b {
+            Ordering::Less
+        } else if a > b {
+            Ordering::Greater
+        } else {
+            Ordering::Equal
+        }
+    });
+}
+
+fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], items: &mut [T]) {
+    if nodes.is_empty() {
+        return;
+    }
+    let n = items.len();
+    let b = bounds(items);
+    let ext = [0, 1, 2].map(|a| b.hi[a] - b.lo[a]);
+    // Widest axis; a NaN extent never wins a comparison.
+    let mut axis = 0;
+    if ext[1] > ext[0] {
+        axis = 1;
+    }
+    if ext[2] > ext[axis] {
+        axis = 2;
+    }
+    let nan = b.sum.is_nan();
+    let mid = n / 2;
+    if nan {
+        items.select_nth_unstable_by(mid, |a, b| {
+            key(a.position(), axis).total_cmp(&key(b.position(), axis))
+        });
+    } else {
+        // One closure per axis so the comparison is a plain field compare.
+        match axis {
+            0 => select_by(items, mid, |p| p.x),
+            1 => select_by(items, mid, |p| p.y),
+            _ => select_by(items, mid, |p| p.z),
+        }
+    }
+    nodes[0] = Node {
+        split: key(items[mid].position(), axis),
+        axis: axis as u32,
+    };
+    let half = nodes.len() / 2;
+    let (left_nodes, right_nodes) = nodes[1..].split_at_mut(half);
+    let (left_items, right_items) = items.split_at_mut(mid);
+    if n >= PAR_MIN {
+        rayon::join(
+            || build_rec(left_nodes, left_items),
+            || build_rec(right_nodes, right_items),
+        );
+    } else {
+        build_rec(left_nodes, left_items);
+        build_rec(right_nodes, right_items);
+    }
+}
+
 impl KdTree {
+    /// Reorders `items` into tree order and builds the tree over them.
+    ///
+    /// Deterministic: the same input gives the same order and tree for any rayon thread count.
+    /// Items with NaN coordinates are kept but never reported by queries.
+    ///
+    /// # Panics
+    /// If there are more than `u32::MAX` items.
     pub fn build<T: KdPoint + Send>(items: &mut [T]) -> KdTree {
-        KdTree { n: items.len() }
+        let n = items.len();
+        let len = u32::try_from(n).expect("KdTree holds at most u32::MAX items");
+        let depth = depth_for(n);
+        let mut nodes = vec![Node::default(); (1usize << depth) - 1];
+        build_rec(&mut nodes, items);
+        KdTree { nodes, len }
     }
+
+    /// Number of items the tree was built over.
+    #[inline]
     pub fn len(&self) -> usize {
-        self.n
+        self.len as usize
     }
+
+    /// Whether the tree holds no items.
+    #[inline]
     pub fn is_empty(&self) -> bool {
-        self.n == 0
+        self.len == 0
     }
+
+    /// Heap bytes the tree itself owns (the items are the caller's).
+    pub fn heap_bytes(&self) -> usize {
+        self.nodes.capacity() * std::mem::size_of::<Node>()
+    }
+
+    /// The k nearest items within squared distance `max_dist2` (inclusive) of `p`.
+    ///
+    /// `out` is cleared, then holds up to `k` results as a max-heap on `dist2`: `out[0]` is the
+    /// farthest one, the rest are in no particular order. Returns the squared radius that bounds
+    /// them: the k-th distance (`out[0].dist2`) when `k` items were found, else `max_dist2`
+    /// (also for `k == 0`). A NaN query point or `max_dist2` finds nothing.
+    ///
+    /// `items` must be the slice `build` reordered. Allocates only if `out` must grow.
     pub fn k_nearest<T: KdPoint>(
         &self,
         items: &[T],
@@ -37,29 +285,217 @@ impl KdTree {
         out: &mut Vec<Neighbor>,
     ) -> f32 {
         out.clear();
-        for (i, it) in items.iter().enumerate() {
-            let d2 = it.position().distance_squared(p);
-            if d2 <= max_dist2 {
-                out.push(Neighbor {
-                    slot: i as u32,
-                    dist2: d2,
-                });
-            }
+        assert_eq!(items.len(), self.len(), "items are not the tree's slice");
+        if k == 0 || p.is_nan() || max_dist2.is_nan() || max_dist2 < 0.0 {
+            return max_dist2;
         }
-        out.sort_by(|a, b| a.dist2.total_cmp(&b.dist2));
-        out.truncate(k);
-        if out.len() == k && k > 0 {
-            out[k - 1].dist2
+        let cap = k.saturating_mul(2);
+        out.reserve(cap.min(items.len()));
+        let mut q = Knn {
+            items,
+            nodes: &self.nodes,
+            p: p.to_array(),
+            k,
+            cap,
+            bound: strict_bound(max_dist2),
+            out,
+        };
+        q.visit(0, self.nodes.len(), 0, items.len(), [0.0; 3]);
+        if out.len() > k {
+            keep_nearest(out, k);
+        }
+        heapify(out);
+        if out.len() == k {
+            out[0].dist2
         } else {
             max_dist2
         }
     }
-    pub fn for_each_within<T: KdPoint>(&self, items: &[T], p: Vec3, r2: f32, mut f: impl FnMut(u32, f32)) {
-        for (i, it) in items.iter().enumerate() {
-            let d2 = it.position().distance_squared(p);
-            if d2 <= r2 {
-                f(i as u32, d2);
+
+    /// Calls `f(slot, dist2)` for every item within squared distance `r2` (inclusive) of `p`,
+    /// in tree order. A NaN query point or `r2` finds nothing.
+    ///
+    /// `items` must be the slice `build` reordered.
+    pub fn for_each_within<T: KdPoint>(
+        &self,
+        items: &[T],
+        p: Vec3,
+        r2: f32,
+        mut f: impl FnMut(u32, f32),
+    ) {
+        assert_eq!(items.len(), self.len(), "items are not the tree's slice");
+        if p.is_nan() || r2.is_nan() || r2 < 0.0 {
+            return;
+        }
+        let mut q = Within {
+            items,
+            nodes: &self.nodes,
+            p: p.to_array(),
+            bound: strict_bound(r2),
+            f: &mut f,
+        };
+        q.visit(0, self.nodes.len(), 0, items.len(), [0.0; 3]);
+    }
+}
+
+/// State of one k-NN query. `bound` is strict: a candidate must have `dist2 < bound`.
+struct Knn<'a, T> {
+    items: &'a [T],
+    nodes: &'a [Node],
+    p: [f32; 3],
+    k: usize,
+    /// Candidates held before a selection: `2k`.
+    cap: usize,
+    bound: f32,
+    out: &'a mut Vec<Neighbor>,
+}
+
+impl<T: KdPoint> Knn<'_, T> {
+    /// Visits the subtree at `node` (`size` internal nodes) covering items `lo..lo + len`;
+    /// `off` holds the query's per-axis offsets to that subtree's cell.
+    fn visit(&mut self, node: usize, size: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+        if size == 0 {
+            self.leaf(lo, len);
+            return;
+        }
+        let Node { split, axis } = self.nodes[node];
+        let axis = axis as usize;
+        let diff = self.p[axis] - split;
+        let child = size / 2;
+        let half = len / 2;
+        let (left, right) = (node + 1, node + 1 + child);
+        let (near, near_lo, near_len, far, far_lo, far_len) = if diff < 0.0 {
+            (left, lo, half, right, lo + half, len - half)
+        } else {
+            (right, lo + half, len - half, left, lo, half)
+        };
+        self.visit(near, child, near_lo, near_len, off);
+        off[axis] = diff;
+        if dist2(off, [0.0; 3]) < self.bound {
+            self.visit(far, child, far_lo, far_len, off);
+        }
+    }
+
+    #[inline]
+    fn leaf(&mut self, lo: usize, len: usize) {
+        for (i, it) in self.items[lo..lo + len].iter().enumerate() {
+            let d2 = dist2(it.position().to_array(), self.p);
+            if d2 < self.bound {
+                self.push((lo + i) as u32, d2);
             }
         }
     }
+
+    /// Candidates collect unsorted; at `k` the bound drops to their maximum, and every further
+    /// `k` candidates a selection keeps the `k` nearest and tightens the bound. That is O(1)
+    /// amortised per candidate, against O(log k) mispredicted sifts for a heap.
+    #[inline]
+    fn push(&mut self, slot: u32, dist2: f32) {
+        self.out.push(Neighbor { slot, dist2 });
+        let len = self.out.len();
+        if len == self.k {
+            self.bound = self.out.iter().fold(0.0, |m, n| max_f(m, n.dist2));
+        } else if len == self.cap {
+            self.bound = keep_nearest(self.out, self.k);
+        }
+    }
 }
+
+#[inline(always)]
+fn max_f(a: f32, b: f32) -> f32 {
+    if b > a {
+        b
+    } else {
+        a
+    }
+}
+
+/// Keeps the `k` nearest of more than `k` candidates; returns the k-th distance.
+fn keep_nearest(v: &mut Vec<Neighbor>, k: usize) -> f32 {
+    // Distances here are never NaN.
+    let (_, kth, _) = v.select_nth_unstable_by(k - 1, |a, b| {
+        if a.dist2 < b.dist2 {
+            Ordering::Less
+        } else if a.dist2 > b.dist2 {
+            Ordering::Greater
+        } else {
+            Ordering::Equal
+        }
+    });
+    let bound = kth.dist2;
+    v.truncate(k);
+    bound
+}
+
+/// Turns `h` into a max-heap on `dist2`.
+fn heapify(h: &mut [Neighbor]) {
+    for i in (0..h.len() / 2).rev() {
+        sift_down(h, i);
+    }
+}
+
+/// Moves `h[i]` down until its subtree is a max-heap.
+fn sift_down(h: &mut [Neighbor], mut i: usize) {
+    let n = h.len();
+    let x = h[i];
+    loop {
+        let l = 2 * i + 1;
+        if l >= n {
+            break;
+        }
+        let r = l + 1;
+        let c = if r < n && h[r].dist2 > h[l].dist2 {
+            r
+        } else {
+            l
+        };
+        if h[c].dist2 <= x.dist2 {
+            break;
+        }
+        h[i] = h[c];
+        i = c;
+    }
+    h[i] = x;
+}
+
+/// State of one fixed-radius query.
+struct Within<'a, T, F> {
+    items: &'a [T],
+    nodes: &'a [Node],
+    p: [f32; 3],
+    bound: f32,
+    f: &'a mut F,
+}
+
+impl<T: KdPoint, F: FnMut(u32, f32)> Within<'_, T, F> {
+    fn visit(&mut self, node: usize, size: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+        if size == 0 {
+            for (i, it) in self.items[lo..lo + len].iter().enumerate() {
+                let d2 = dist2(it.position().to_array(), self.p);
+                if d2 < self.bound {
+                    (self.f)((lo + i) as u32, d2);
+                }
+            }
+            return;
+        }
+        let Node { split, axis } = self.nodes[node];
+        let axis = axis as usize;
+        let diff = self.p[axis] - split;
+        let child = size / 2;
+        let half = len / 2;
+        let (left, right) = (node + 1, node + 1 + child);
+        let (near, near_lo, near_len, far, far_lo, far_len) = if diff < 0.0 {
+            (left, lo, half, right, lo + half, len - half)
+        } else {
+            (right, lo + half, len - half, left, lo, half)
+        };
+        self.visit(near, child, near_lo, near_len, off);
+        off[axis] = diff;
+        if dist2(off, [0.0; 3]) < self.bound {
+            self.visit(far, child, far_lo, far_len, off);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;
