@@ -220,10 +220,7 @@ fn bench_build(c: &mut Criterion, d: &Data) {
             BatchSize::LargeInput,
         )
     });
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap();
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     g.bench_function(id("ours_1thread"), |b| {
         b.iter_batched_ref(
             || d.photons.clone(),
@@ -261,11 +258,7 @@ fn cross_check(d: &Data, items: &[Photon], ours: &KdTree, imm: &ImmutableKdTree<
         ours.for_each_within(items, q, d.within_r2, |_, _| count += 1);
         let theirs = imm.within_unsorted::<SquaredEuclidean>(&q.to_array(), d.within_r2);
         // Boundary rounding may differ by a point at most rarely.
-        assert!(
-            count.abs_diff(theirs.len()) <= 1,
-            "{count} vs {}",
-            theirs.len()
-        );
+        assert!(count.abs_diff(theirs.len()) <= 1, "{count} vs {}", theirs.len());
     }
 }
 
@@ -304,12 +297,7 @@ fn bench_queries(c: &mut Criterion, d: &Data) {
             b.iter(|| {
                 let mut acc = 0usize;
                 for q in &d.queries {
-                    let r = imm.nearest_n_within::<SquaredEuclidean>(
-                        &q.to_array(),
-                        KNN_MAX_DIST2,
-                        kk,
-                        false,
-                    );
+                    let r = imm.nearest_n_within::<SquaredEuclidean>(&q.to_array(), KNN_MAX_DIST2, kk, false);
                     acc += r.len();
                 }
                 acc
@@ -332,12 +320,7 @@ fn bench_queries(c: &mut Criterion, d: &Data) {
                 b.iter(|| {
                     let mut acc = 0usize;
                     for q in few {
-                        let r = mutable.nearest_n_within::<SquaredEuclidean>(
-                            &q.to_array(),
-                            KNN_MAX_DIST2,
-                            kk,
-                            false,
-                        );
+                        let r = mutable.nearest_n_within::<SquaredEuclidean>(&q.to_array(), KNN_MAX_DIST2, kk, false);
                         acc += r.len();
                     }
                     acc

@@ -91,10 +91,7 @@ impl Error {
     pub fn is_bad_input(&self) -> bool {
         matches!(
             self,
-            Error::Scene { .. }
-                | Error::InvalidSettings(_)
-                | Error::Image { .. }
-                | Error::Io { .. }
+            Error::Scene { .. } | Error::InvalidSettings(_) | Error::Image { .. } | Error::Io { .. }
         )
     }
 }

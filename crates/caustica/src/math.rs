@@ -123,13 +123,7 @@ impl Aabb {
 
     /// The ray's entry and exit parameters, if it meets the box within `[t_min, t_max]`.
     #[inline]
-    pub fn intersect(
-        &self,
-        origin: Vec3,
-        inv_dir: Vec3,
-        t_min: f32,
-        t_max: f32,
-    ) -> Option<(f32, f32)> {
+    pub fn intersect(&self, origin: Vec3, inv_dir: Vec3, t_min: f32, t_max: f32) -> Option<(f32, f32)> {
         let t0 = (self.min - origin) * inv_dir;
         let t1 = (self.max - origin) * inv_dir;
         let near = t0.min(t1).max_element().max(t_min);
@@ -197,8 +191,15 @@ pub fn refract(d: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
 /// it starts on (no fixed epsilon: the offset follows the floating-point error of `p`).
 #[inline]
 pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
-    let scale = 1e-4 * (1.0 + p.abs().max_element()) * 0.0625;
     let n = if ng.dot(dir) >= 0.0 { ng } else { -ng };
+    offset_along(p, n)
+}
+
+/// Moves `p` off its surface to the side the unit normal `n` points to, by the same
+/// magnitude-relative amount as [`offset_origin`].
+#[inline]
+pub fn offset_along(p: Vec3, n: Vec3) -> Vec3 {
+    let scale = 1e-4 * (1.0 + p.abs().max_element()) * 0.0625;
     p + n * scale
 }
 
@@ -214,18 +215,11 @@ mod tests {
 
     #[test]
     fn frame_is_orthonormal() {
-        for n in [
-            Vec3::Z,
-            -Vec3::Z,
-            Vec3::X,
-            Vec3::new(0.3, -0.4, 0.866).normalize(),
-        ] {
+        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.4, 0.866).normalize()] {
             let f = Frame::from_normal(n);
             assert!((f.x.length() - 1.0).abs() < 1e-5);
             assert!((f.y.length() - 1.0).abs() < 1e-5);
-            assert!(
-                f.x.dot(f.y).abs() < 1e-5 && f.x.dot(n).abs() < 1e-5 && f.y.dot(n).abs() < 1e-5
-            );
+            assert!(f.x.dot(f.y).abs() < 1e-5 && f.x.dot(n).abs() < 1e-5 && f.y.dot(n).abs() < 1e-5);
             let v = Vec3::new(0.2, 0.5, -0.7);
             assert!((f.to_world(f.to_local(v)) - v).length() < 1e-5);
         }

@@ -311,10 +311,11 @@ impl Scene {
     }
 
     /// Whether the straight segment between two surface points is free of geometry; each end is
-    /// moved off its surface along the given normal.
+    /// moved off its surface to the side its normal points to (the side it is seen or lit from),
+    /// whatever the segment's direction, so a segment along a floor stays above it.
     pub fn segment_clear(&self, a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> bool {
-        let from = crate::math::offset_origin(a, a_normal, b - a);
-        let to = crate::math::offset_origin(b, b_normal, a - b);
+        let from = crate::math::offset_along(a, a_normal);
+        let to = crate::math::offset_along(b, b_normal);
         let d = to - from;
         let len = d.length();
         if len <= 0.0 {

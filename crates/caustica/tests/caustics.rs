@@ -11,10 +11,10 @@ fn trace(scene: &caustica::scene::Scene, settings: PhotonSettings, k: usize) -> 
     PhotonMap::trace(scene, &settings, k, common::control())
 }
 
-/// For smooth fields: 3000 photons per estimate (noise ≈ 1/√k ≈ 2%) and a box filter.
+/// For smooth fields: 10,000 photons per estimate (noise ≈ 1/√k = 1%) and a box filter.
 fn smooth() -> EstimateSettings {
     EstimateSettings {
-        k: 3000,
+        k: 10_000,
         max_radius: Some(1e3),
         cone_filter: None,
         ..EstimateSettings::default()
@@ -41,7 +41,7 @@ scale(20, square { material = { diffuse = (1, 1, 1); } })
 #[test]
 fn flat_mirror_caustic_is_the_mirror_image_of_the_light() {
     let scene = common::scene(MIRROR);
-    let map = trace(&scene, photons(400_000), 200);
+    let map = trace(&scene, photons(1_000_000), 200);
     let settings = smooth();
     let image = Vec3::new(-2.0, 0.0, 3.0);
     for p in [
@@ -60,9 +60,11 @@ fn flat_mirror_caustic_is_the_mirror_image_of_the_light() {
         );
     }
     // Behind the mirror (x < 0) the floor receives no reflected light.
-    let behind = map
-        .flux_density(&scene, Vec3::new(-1.5, 0.0, 0.0), Vec3::Z, &settings)
-        .x;
+    let near = EstimateSettings {
+        max_radius: Some(0.5),
+        ..EstimateSettings::default()
+    };
+    let behind = map.flux_density(&scene, Vec3::new(-1.5, 0.0, 0.0), Vec3::Z, &near).x;
     assert!(behind < 1e-4, "{behind}");
 }
 
@@ -76,7 +78,7 @@ scale(20, square { material = { diffuse = (1, 1, 1); } })
 #[test]
 fn glass_slab_passes_exactly_the_transmitted_power() {
     let scene = common::scene(SLAB);
-    let map = trace(&scene, photons(200_000), 100);
+    let map = trace(&scene, photons(600_000), 100);
     let settings = smooth();
     for p in [
         Vec3::new(0.0, 0.0, 0.0),
@@ -149,7 +151,7 @@ scale(12, square { material = { diffuse = (1, 1, 1); } })
     let settings = PhotonSettings {
         first_hit: true,
         aim: false,
-        ..photons(1_000_000)
+        ..photons(2_000_000)
     };
     let map = trace(&scene, settings, 300);
     let estimate = smooth();
@@ -193,19 +195,21 @@ scale(20, square { material = { diffuse = (1, 1, 1); } })
     let behind = map
         .flux_density(&scene, Vec3::new(-0.1, 0.0, 0.0), Vec3::Z, &estimate)
         .x;
-    assert!(lit > 0.01, "the lit side receives the mirror's light: {lit}");
+    // The mirror image of the light is at (4.5, 0, 4): irradiance 0.019 at (0.1, 0, 0), of which a
+    // gather disc cut in half by the wall sees at least a good part.
+    assert!(lit > 0.006, "the lit side receives the mirror's light: {lit}");
     assert!(behind < 0.01 * lit, "light bled through the wall: {behind} vs {lit}");
 }
 
 #[test]
 fn aimed_and_uniform_emission_give_the_same_caustic() {
     let scene = common::scene(SLAB);
-    let aimed = trace(&scene, photons(100_000), 100);
+    let aimed = trace(&scene, photons(400_000), 100);
     let uniform = trace(
         &scene,
         PhotonSettings {
             aim: false,
-            ..photons(100_000)
+            ..photons(400_000)
         },
         100,
     );

@@ -166,9 +166,7 @@ fn bounds<T: KdPoint + Send>(items: &mut [T]) -> Bounds {
             .fold(|| Bounds::EMPTY, |b, it| b.grow(it.position()))
             .reduce(|| Bounds::EMPTY, Bounds::union)
     } else {
-        items
-            .iter()
-            .fold(Bounds::EMPTY, |b, it| b.grow(it.position()))
+        items.iter().fold(Bounds::EMPTY, |b, it| b.grow(it.position()))
     }
 }
 
@@ -205,9 +203,7 @@ fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], items: &mut [T]) {
     let nan = b.sum.is_nan();
     let mid = n / 2;
     if nan {
-        items.select_nth_unstable_by(mid, |a, b| {
-            key(a.position(), axis).total_cmp(&key(b.position(), axis))
-        });
+        items.select_nth_unstable_by(mid, |a, b| key(a.position(), axis).total_cmp(&key(b.position(), axis)));
     } else {
         // One closure per axis so the comparison is a plain field compare.
         match axis {
@@ -316,13 +312,7 @@ impl KdTree {
     /// in tree order. A NaN query point or `r2` finds nothing.
     ///
     /// `items` must be the slice `build` reordered.
-    pub fn for_each_within<T: KdPoint>(
-        &self,
-        items: &[T],
-        p: Vec3,
-        r2: f32,
-        mut f: impl FnMut(u32, f32),
-    ) {
+    pub fn for_each_within<T: KdPoint>(&self, items: &[T], p: Vec3, r2: f32, mut f: impl FnMut(u32, f32)) {
         assert_eq!(items.len(), self.len(), "items are not the tree's slice");
         if p.is_nan() || r2.is_nan() || r2 < 0.0 {
             return;
@@ -444,11 +434,7 @@ fn sift_down(h: &mut [Neighbor], mut i: usize) {
             break;
         }
         let r = l + 1;
-        let c = if r < n && h[r].dist2 > h[l].dist2 {
-            r
-        } else {
-            l
-        };
+        let c = if r < n && h[r].dist2 > h[l].dist2 { r } else { l };
         if h[c].dist2 <= x.dist2 {
             break;
         }

@@ -69,9 +69,7 @@ fn clustered(rng: &mut Rng, n: usize) -> Vec<Vec3> {
 
 fn duplicates(rng: &mut Rng, n: usize) -> Vec<Vec3> {
     let distinct: Vec<Vec3> = (0..7).map(|_| rng.vec()).collect();
-    (0..n)
-        .map(|_| distinct[rng.below(distinct.len())])
-        .collect()
+    (0..n).map(|_| distinct[rng.below(distinct.len())]).collect()
 }
 
 fn axis_plane(rng: &mut Rng, n: usize) -> Vec<Vec3> {
@@ -91,13 +89,7 @@ fn collinear(rng: &mut Rng, n: usize) -> Vec<Vec3> {
 /// Integer grid: many exactly tied distances.
 fn grid(rng: &mut Rng, n: usize) -> Vec<Vec3> {
     (0..n)
-        .map(|_| {
-            Vec3::new(
-                rng.below(6) as f32,
-                rng.below(6) as f32,
-                rng.below(3) as f32,
-            )
-        })
+        .map(|_| Vec3::new(rng.below(6) as f32, rng.below(6) as f32, rng.below(3) as f32))
         .collect()
 }
 
@@ -277,10 +269,7 @@ fn larger_random_sets() {
 
 #[test]
 fn empty_one_and_identical() {
-    let mut out = vec![Neighbor {
-        slot: 9,
-        dist2: 9.0,
-    }];
+    let mut out = vec![Neighbor { slot: 9, dist2: 9.0 }];
     let mut empty: Vec<Vec3> = Vec::new();
     let tree = KdTree::build(&mut empty);
     assert!(tree.is_empty());
@@ -294,13 +283,7 @@ fn empty_one_and_identical() {
     assert_eq!(tree.len(), 1);
     assert!(!tree.is_empty());
     let r = tree.k_nearest(&one, Vec3::new(1.0, 2.0, 4.0), 1, 10.0, &mut out);
-    assert_eq!(
-        out,
-        [Neighbor {
-            slot: 0,
-            dist2: 1.0
-        }]
-    );
+    assert_eq!(out, [Neighbor { slot: 0, dist2: 1.0 }]);
     assert_eq!(r, 1.0);
     let r = tree.k_nearest(&one, Vec3::new(1.0, 2.0, 4.0), 3, 10.0, &mut out);
     assert_eq!((out.len(), r), (1, 10.0));
@@ -324,10 +307,7 @@ fn k_zero_returns_nothing() {
     let mut items = uniform(&mut rng, 500);
     let tree = KdTree::build(&mut items);
     let mut out = Vec::new();
-    assert_eq!(
-        tree.k_nearest(&items, Vec3::splat(0.5), 0, 0.3, &mut out),
-        0.3
-    );
+    assert_eq!(tree.k_nearest(&items, Vec3::splat(0.5), 0, 0.3, &mut out), 0.3);
     assert!(out.is_empty());
 }
 
@@ -386,10 +366,7 @@ fn build_is_deterministic_across_thread_counts() {
         .chain(duplicates(&mut rng, 50_000))
         .collect::<Vec<_>>();
     let build_in = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         let mut items = items_of(&pts);
         let tree = pool.install(|| KdTree::build(&mut items));
         (tree, items.iter().map(|i| i.id).collect::<Vec<_>>())
