@@ -1,1 +1,325 @@
-//! BVH
+//! Bounding volume hierarchy over arbitrary primitives, given by their bounds.
+//!
+//! Built as a binned-SAH binary tree and collapsed into 4-wide nodes whose child boxes are
+//! stored as structure-of-arrays, so one node visit tests four boxes with SSE arithmetic.
+//! Traversal is near-first with a fixed-size stack; primitives are handed to a caller's
+//! closure (generic, so it inlines).
+
+mod build;
+#[cfg(test)]
+mod tests;
+mod triangles;
+
+use glam::Vec4;
+
+use crate::math::{Aabb, Ray, Vec3};
+
+pub use triangles::{TriangleBvh, TriangleBvhHit};
+
+/// Child reference flag: the child is a leaf starting at position `ref & !LEAF` of the leaf order.
+const LEAF: u32 = 1 << 31;
+/// Leaf-order flag: this primitive is the last of its leaf.
+const END: u32 = 1 << 31;
+/// Ize's robust slab-test factor `1 + 2γ(3)`: widens exits so rounding cannot lose a box the
+/// ray touches (flat boxes of axis-aligned triangles included).
+const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+/// Stack sizes of the two traversal variants; the small one is used when the tree is shallow
+/// enough (nearly always) because the stack array is initialised on every query.
+const SMALL_STACK: usize = 64;
+const LARGE_STACK: usize = 256;
+
+/// A 4-wide node: child boxes as `[axis][min, max]` lanes, then child references
+/// (inner node index, or `LEAF | first` for leaves). Exactly two cache lines.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub struct Node4 {
+    bounds: [[Vec4; 2]; 3],
+    children: [u32; 4],
+    _pad: [u32; 4],
+}
+
+impl Node4 {
+    /// Unused slots have inverted infinite boxes, which every slab test rejects.
+    const EMPTY: Node4 = Node4 {
+        bounds: [[Vec4::splat(f32::INFINITY), Vec4::splat(f32::NEG_INFINITY)]; 3],
+        children: [0; 4],
+        _pad: [0; 4],
+    };
+
+    fn set_child(&mut self, slot: usize, min: Vec3, max: Vec3, child: u32) {
+        for axis in 0..3 {
+            self.bounds[axis][0][slot] = min[axis];
+            self.bounds[axis][1][slot] = max[axis];
+        }
+        self.children[slot] = child;
+    }
+}
+
+/// Per-ray constants for the slab tests.
+struct RayPre {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    /// Index (0 = min, 1 = max) of the plane entered first on each axis.
+    near: [usize; 3],
+}
+
+impl RayPre {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayPre {
+        // Zero (or denormal) components become the smallest normal float: the inverse stays
+        // finite, so `(plane - origin) * inv` is never 0 · ∞ = NaN.
+        let safe = |d: f32| {
+            if d.abs() < f32::MIN_POSITIVE {
+                f32::MIN_POSITIVE.copysign(d)
+            } else {
+                d
+            }
+        };
+        let inv = [ray.dir.x, ray.dir.y, ray.dir.z].map(|d| 1.0 / safe(d));
+        RayPre {
+            origin: [ray.origin.x, ray.origin.y, ray.origin.z].map(Vec4::splat),
+            inv_dir: inv.map(Vec4::splat),
+            near: inv.map(|i| usize::from(i < 0.0)),
+        }
+    }
+
+    /// Which of the node's four boxes the segment `[0, t_max]` meets, and the entry distances.
+    #[inline(always)]
+    fn hit4(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
+        let slab = |axis: usize, side: usize| {
+            (node.bounds[axis][side & 1] - self.origin[axis]) * self.inv_dir[axis]
+        };
+        let [nx, ny, nz] = self.near;
+        let t_near = slab(0, nx)
+            .max(slab(1, ny))
+            .max(slab(2, nz))
+            .max(Vec4::ZERO);
+        let t_far = (slab(0, nx ^ 1).min(slab(1, ny ^ 1)).min(slab(2, nz ^ 1)) * ROBUST)
+            .min(Vec4::splat(t_max));
+        (t_near.cmple(t_far).bitmask(), t_near)
+    }
+
+    /// Children hit by the ray, nearest last: sort keys are the entry distance's bits (ordered
+    /// like the non-negative floats) with the slot in the two low bits; a sorting network
+    /// avoids data-dependent branches.
+    #[inline(always)]
+    fn order(mask: u32, t_near: Vec4) -> [u32; 4] {
+        let t = t_near.to_array();
+        let key = |i: usize| {
+            if mask >> i & 1 != 0 {
+                (t[i].to_bits() & !3) | i as u32
+            } else {
+                0
+            }
+        };
+        let [mut k0, mut k1, mut k2, mut k3] = [key(0), key(1), key(2), key(3)];
+        let sort2 = |a: &mut u32, b: &mut u32| {
+            let (hi, lo) = ((*a).max(*b), (*a).min(*b));
+            *a = hi;
+            *b = lo;
+        };
+        sort2(&mut k0, &mut k1);
+        sort2(&mut k2, &mut k3);
+        sort2(&mut k0, &mut k2);
+        sort2(&mut k1, &mut k3);
+        sort2(&mut k1, &mut k2);
+        [k0, k1, k2, k3]
+    }
+}
+
+/// A bounding volume hierarchy over primitives given by bounding boxes.
+///
+/// Primitives are referred to by their index in the slice passed to [`Bvh::build`].
+/// Primitives with non-finite or empty bounds are left out and never reported.
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    nodes: Vec<Node4>,
+    /// Primitive ids in leaf order; `END` marks the last of each leaf.
+    order: Vec<u32>,
+    bounds: Aabb,
+    /// Tree depth, which bounds the traversal stack.
+    depth: u32,
+}
+
+impl Bvh {
+    /// Builds over primitive bounds with binned SAH. Deterministic: the same input gives the
+    /// same tree whatever the thread count.
+    ///
+    /// # Panics
+    /// If there are 2^31 or more primitives.
+    pub fn build(prim_bounds: &[Aabb]) -> Bvh {
+        let c = build::collapse(build::build_bvh2(prim_bounds));
+        Bvh {
+            nodes: c.nodes,
+            order: c.order,
+            bounds: c.bounds,
+            depth: c.depth,
+        }
+    }
+
+    /// Bounds of all hittable primitives (empty if there are none).
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    /// Number of (4-wide) nodes.
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Depth of the tree (0 when empty, 1 for a single node).
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// Hittable primitive ids in leaf order: primitives stored in this order are visited with
+    /// good locality.
+    pub fn leaf_order(&self) -> impl ExactSizeIterator<Item = u32> + '_ {
+        self.order.iter().map(|&p| p & !END)
+    }
+
+    /// Whether the small traversal stack suffices (each level pushes at most three entries,
+    /// and a node's three pushes are written before the count is known).
+    #[inline(always)]
+    fn small_stack(&self) -> bool {
+        3 * self.depth as usize + 3 <= SMALL_STACK
+    }
+
+    /// Closest hit. `intersect(prim, t_max)` tests primitive `prim` (an index into the bounds
+    /// given to [`Bvh::build`]) and returns `Some(t)` if it is hit at `t < t_max` (the closure
+    /// keeps its own hit record). Returns the closest `(t, prim)`.
+    #[inline]
+    pub fn closest_hit<F: FnMut(u32, f32) -> Option<f32>>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        intersect: F,
+    ) -> Option<(f32, u32)> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        if self.small_stack() {
+            self.closest_impl::<SMALL_STACK, F>(ray, t_max, intersect)
+        } else {
+            self.closest_impl::<LARGE_STACK, F>(ray, t_max, intersect)
+        }
+    }
+
+    /// Any-hit / filtered shadow query: calls `visit(prim, t_max)` for primitives whose leaf
+    /// bounds the segment `[0, t_max]` meets; stops and returns `true` as soon as `visit`
+    /// returns `true` (an opaque blocker). Visits each primitive at most once; order unspecified.
+    #[inline]
+    pub fn any_hit<F: FnMut(u32, f32) -> bool>(&self, ray: &Ray, t_max: f32, visit: F) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        if self.small_stack() {
+            self.any_impl::<SMALL_STACK, F>(ray, t_max, visit)
+        } else {
+            self.any_impl::<LARGE_STACK, F>(ray, t_max, visit)
+        }
+    }
+
+    #[inline(always)]
+    fn closest_impl<const N: usize, F: FnMut(u32, f32) -> Option<f32>>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut intersect: F,
+    ) -> Option<(f32, u32)> {
+        let mut best = None;
+        let mut t_max = t_max;
+        self.traverse::<N>(ray, &mut t_max, |order, first, t_max| {
+            let mut i = first;
+            loop {
+                let p = order[i];
+                let prim = p & !END;
+                if let Some(t) = intersect(prim, *t_max) {
+                    if t < *t_max {
+                        *t_max = t;
+                        best = Some(prim);
+                    }
+                }
+                if p & END != 0 {
+                    return false;
+                }
+                i += 1;
+            }
+        });
+        best.map(|prim| (t_max, prim))
+    }
+
+    #[inline(always)]
+    fn any_impl<const N: usize, F: FnMut(u32, f32) -> bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut visit: F,
+    ) -> bool {
+        let mut t_max = t_max;
+        self.traverse::<N>(ray, &mut t_max, |order, first, t_max| {
+            let mut i = first;
+            loop {
+                let p = order[i];
+                if visit(p & !END, *t_max) {
+                    return true;
+                }
+                if p & END != 0 {
+                    return false;
+                }
+                i += 1;
+            }
+        })
+    }
+
+    /// Near-first traversal. `leaf(order, first, t_max)` handles the leaf starting at `first`
+    /// and may shrink `t_max`; returning `true` ends the traversal (and this returns `true`).
+    #[inline(always)]
+    fn traverse<const N: usize>(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        mut leaf: impl FnMut(&[u32], usize, &mut f32) -> bool,
+    ) -> bool {
+        // Non-finite rays could turn slab tests into NaN, which min/max would drop.
+        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+            return false;
+        }
+        let r = RayPre::new(ray);
+        let mut stack = [(0u32, 0f32); N];
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let (mask, t_near) = r.hit4(node, *t_max);
+                if mask != 0 {
+                    let keys = RayPre::order(mask, t_near);
+                    let entry = |k: u32| (node.children[(k & 3) as usize], f32::from_bits(k & !3));
+                    // All three writes happen; only `count - 1` of them are kept.
+                    stack[sp] = entry(keys[0]);
+                    stack[sp + 1] = entry(keys[1]);
+                    stack[sp + 2] = entry(keys[2]);
+                    let count = mask.count_ones() as usize;
+                    cur = node.children[(keys[(count - 1) & 3] & 3) as usize];
+                    sp += count - 1;
+                    continue;
+                }
+            } else if leaf(&self.order, (cur & !LEAF) as usize, t_max) {
+                return true;
+            }
+            // Pop the nearest pending child that can still beat `t_max`.
+            loop {
+                if sp == 0 {
+                    return false;
+                }
+                sp -= 1;
+                let (child, t_near) = stack[sp];
+                if t_near <= *t_max {
+                    cur = child;
+                    break;
+                }
+            }
+        }
+    }
+}

@@ -1,1 +1,349 @@
-//! triangle
+//! Triangles and a watertight ray–triangle test.
+//!
+//! The test follows Woop, Benthin and Wald, "Watertight Ray/Triangle Intersection" (JCGT
+//! 2013): vertices are translated to the ray origin and sheared so the ray runs along +z, then
+//! the three 2D edge functions decide the hit. Each vertex is transformed the same way in
+//! every triangle that shares it, and a 2D edge function `a·b − c·d` evaluated in floats has
+//! the exact sign or is zero (rounding is monotone); zeros are redone in `f64`, where the
+//! products are exact. So a ray through a shared edge or vertex always hits one of the
+//! triangles (edges count as inside, so it may hit both).
+
+use crate::math::{Aabb, Ray, Vec3};
+
+/// A triangle ready for intersection: its three world-space vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// First vertex.
+    pub a: Vec3,
+    /// Second vertex.
+    pub b: Vec3,
+    /// Third vertex.
+    pub c: Vec3,
+}
+
+/// A ray–triangle hit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    /// Ray parameter of the hit, in units of the ray direction.
+    pub t: f32,
+    /// Barycentric weight of vertex `b`.
+    pub u: f32,
+    /// Barycentric weight of vertex `c`.
+    pub v: f32,
+}
+
+/// Per-ray constants of the triangle test; computing them once per ray and calling
+/// [`Triangle::intersect_pre`] saves work when one ray meets many triangles.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleRay {
+    origin: Vec3,
+    /// Axis of the largest direction component; the other two are sheared against it.
+    kz: u8,
+    /// Shear: `dir[kx] / dir[kz]`, `dir[ky] / dir[kz]`, `1 / dir[kz]`.
+    shear: Vec3,
+}
+
+impl TriangleRay {
+    /// Precomputes the shear for `ray`. A zero direction hits nothing.
+    #[inline]
+    pub fn new(ray: &Ray) -> TriangleRay {
+        let d = ray.dir.abs();
+        let kz = if d.x > d.y && d.x > d.z {
+            0
+        } else if d.y > d.z {
+            1
+        } else {
+            2
+        };
+        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        let dz = ray.dir[kz];
+        TriangleRay {
+            origin: ray.origin,
+            kz: kz as u8,
+            shear: Vec3::new(ray.dir[kx] / dz, ray.dir[ky] / dz, 1.0 / dz),
+        }
+    }
+}
+
+impl Triangle {
+    /// A triangle from three world-space vertices.
+    #[inline]
+    pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Triangle {
+        Triangle { a, b, c }
+    }
+
+    /// The hit with `0 < t < t_max`, if any. Both faces are hit; points on edges and vertices
+    /// count as inside. Degenerate triangles and rays in the triangle's plane miss.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<TriangleHit> {
+        self.intersect_pre(&TriangleRay::new(ray), t_max)
+    }
+
+    /// [`Triangle::intersect`] with the per-ray constants computed once by the caller.
+    #[inline]
+    pub fn intersect_pre(&self, ray: &TriangleRay, t_max: f32) -> Option<TriangleHit> {
+        // Axes as constants, so the permutation costs nothing inside the test.
+        match ray.kz {
+            0 => self.sheared::<1, 2, 0>(ray, t_max),
+            1 => self.sheared::<2, 0, 1>(ray, t_max),
+            _ => self.sheared::<0, 1, 2>(ray, t_max),
+        }
+    }
+
+    #[inline(always)]
+    fn sheared<const KX: usize, const KY: usize, const KZ: usize>(
+        &self,
+        ray: &TriangleRay,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        let s = ray.shear;
+        let a = self.a - ray.origin;
+        let b = self.b - ray.origin;
+        let c = self.c - ray.origin;
+        let (ax, ay) = (a[KX] - s.x * a[KZ], a[KY] - s.y * a[KZ]);
+        let (bx, by) = (b[KX] - s.x * b[KZ], b[KY] - s.y * b[KZ]);
+        let (cx, cy) = (c[KX] - s.x * c[KZ], c[KY] - s.y * c[KZ]);
+        // Edge functions, each the (unnormalised) barycentric weight of the opposite vertex.
+        let mut wa = cx * by - cy * bx;
+        let mut wb = ax * cy - ay * cx;
+        let mut wc = bx * ay - by * ax;
+        if wa == 0.0 || wb == 0.0 || wc == 0.0 {
+            let e = |px: f32, py: f32, qx: f32, qy: f32| {
+                (px as f64 * qy as f64 - py as f64 * qx as f64) as f32
+            };
+            wa = e(cx, cy, bx, by);
+            wb = e(ax, ay, cx, cy);
+            wc = e(bx, by, ax, ay);
+        }
+        if (wa < 0.0 || wb < 0.0 || wc < 0.0) && (wa > 0.0 || wb > 0.0 || wc > 0.0) {
+            return None;
+        }
+        let det = wa + wb + wc;
+        if det == 0.0 {
+            return None;
+        }
+        let t_scaled = s.z * (wa * a[KZ] + wb * b[KZ] + wc * c[KZ]);
+        let t = t_scaled / det;
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let inv = 1.0 / det;
+        Some(TriangleHit {
+            t,
+            u: wb * inv,
+            v: wc * inv,
+        })
+    }
+
+    /// Bounding box of the three vertices.
+    #[inline]
+    pub fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.a.min(self.b).min(self.c),
+            max: self.a.max(self.b).max(self.c),
+        }
+    }
+
+    /// Unit normal `normalize((b − a) × (c − a))`; zero for a degenerate triangle.
+    #[inline]
+    pub fn geometric_normal(&self) -> Vec3 {
+        (self.b - self.a).cross(self.c - self.a).normalize_or_zero()
+    }
+
+    /// The point with barycentric weights `u` (of `b`) and `v` (of `c`).
+    #[inline]
+    pub fn point(&self, u: f32, v: f32) -> Vec3 {
+        self.a * (1.0 - u - v) + self.b * u + self.c * v
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri() -> Triangle {
+        Triangle::new(
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+        )
+    }
+
+    /// Small deterministic generator (xorshift64*), so tests need no extra crate.
+    struct Rng(u64);
+    impl Rng {
+        fn f(&mut self) -> f32 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    #[test]
+    fn hit_matches_analytic_answer() {
+        let ray = Ray::new(Vec3::new(0.5, 0.25, 3.0), Vec3::new(0.0, 0.0, -2.0));
+        let h = tri().intersect(&ray, f32::INFINITY).unwrap();
+        assert!((h.t - 1.5).abs() < 1e-6, "{h:?}");
+        assert!(
+            (h.u - 0.25).abs() < 1e-6 && (h.v - 0.125).abs() < 1e-6,
+            "{h:?}"
+        );
+        // Back face, oblique, non-unit direction.
+        let o = Vec3::new(-1.0, -2.0, -4.0);
+        let target = tri().point(0.3, 0.5);
+        let ray = Ray::new(o, (target - o) * 0.25);
+        let h = tri().intersect(&ray, f32::INFINITY).unwrap();
+        assert!(
+            (h.t - 4.0).abs() < 1e-5 && (h.u - 0.3).abs() < 1e-5 && (h.v - 0.5).abs() < 1e-5,
+            "{h:?}"
+        );
+    }
+
+    #[test]
+    fn misses_outside_behind_beyond_and_parallel() {
+        let t = tri();
+        let down = Vec3::new(0.0, 0.0, -1.0);
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(1.5, 1.5, 1.0), down), 10.0)
+            .is_none());
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(-0.1, 0.5, 1.0), down), 10.0)
+            .is_none());
+        // Behind the origin.
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(0.5, 0.5, -1.0), down), 10.0)
+            .is_none());
+        // Beyond t_max, and exactly at t_max (exclusive).
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), down), 0.5)
+            .is_none());
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), down), 1.0)
+            .is_none());
+        // Parallel above and within the plane.
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(-1.0, 0.5, 1.0), Vec3::X), 10.0)
+            .is_none());
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(-1.0, 0.5, 0.0), Vec3::X), 10.0)
+            .is_none());
+        // Zero direction.
+        assert!(t
+            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), Vec3::ZERO), 10.0)
+            .is_none());
+        // Degenerate triangles never hit.
+        let line = Triangle::new(Vec3::ZERO, Vec3::X, Vec3::X * 2.0);
+        assert!(line
+            .intersect(&Ray::new(Vec3::new(0.5, 0.0, 1.0), down), 10.0)
+            .is_none());
+        let point = Triangle::new(Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
+        assert!(point
+            .intersect(&Ray::new(Vec3::new(0.0, 0.0, 1.0), down), 10.0)
+            .is_none());
+        assert_eq!(point.geometric_normal(), Vec3::ZERO);
+    }
+
+    #[test]
+    fn edges_and_vertices_count_as_hits() {
+        let t = tri();
+        let down = Vec3::new(0.0, 0.0, -1.0);
+        for p in [
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(0.0, 1.0, 1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        ] {
+            let h = t.intersect(&Ray::new(p, down), 10.0);
+            assert!(h.is_some(), "{p}");
+            assert!((h.unwrap().t - 1.0).abs() < 1e-6);
+        }
+    }
+
+    #[test]
+    fn bounds_and_normal() {
+        let t = tri();
+        assert_eq!(t.bounds(), Aabb::new(Vec3::ZERO, Vec3::new(2.0, 2.0, 0.0)));
+        assert_eq!(t.geometric_normal(), Vec3::Z);
+    }
+
+    /// Rays through the shared edges and vertices of a tessellated, irregular grid must hit at
+    /// least one triangle: no cracks.
+    #[test]
+    fn tessellated_grid_is_watertight() {
+        let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+        let n = 24;
+        let mut verts = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let jitter = |r: &mut Rng| (r.f() - 0.5) * 0.6;
+                let x = i as f32
+                    + if 0 < i && i < n {
+                        jitter(&mut rng)
+                    } else {
+                        0.0
+                    };
+                let y = j as f32
+                    + if 0 < j && j < n {
+                        jitter(&mut rng)
+                    } else {
+                        0.0
+                    };
+                let z = (x * 0.37).sin() * 2.0 + (y * 0.23).cos() * 1.5;
+                verts.push(Vec3::new(x, y, z) * 0.173);
+            }
+        }
+        let idx = |i: usize, j: usize| j * (n + 1) + i;
+        let mut tris = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (a, b, c, d) = (
+                    verts[idx(i, j)],
+                    verts[idx(i + 1, j)],
+                    verts[idx(i + 1, j + 1)],
+                    verts[idx(i, j + 1)],
+                );
+                // Alternate diagonals and windings so shared edges appear in both orders.
+                if (i + j) % 2 == 0 {
+                    tris.push(Triangle::new(a, b, c));
+                    tris.push(Triangle::new(a, c, d));
+                } else {
+                    tris.push(Triangle::new(b, d, a));
+                    tris.push(Triangle::new(c, d, b));
+                }
+            }
+        }
+        let mut targets = Vec::new();
+        for j in 1..n {
+            for i in 1..n {
+                let p = verts[idx(i, j)];
+                targets.push(p); // interior vertex
+                targets.push(p.lerp(verts[idx(i + 1, j)], rng.f())); // horizontal edge
+                targets.push(p.lerp(verts[idx(i, j + 1)], rng.f())); // vertical edge
+                let (d0, d1) = if (i + j) % 2 == 0 {
+                    (p, verts[idx(i + 1, j + 1)])
+                } else {
+                    (verts[idx(i + 1, j)], verts[idx(i, j + 1)])
+                };
+                targets.push(d0.lerp(d1, rng.f())); // diagonal edge
+            }
+        }
+        let mut tested = 0;
+        for &target in &targets {
+            for _ in 0..8 {
+                // Steeper than any facet (slopes stay below 0.9), so no ray merely grazes a
+                // silhouette vertex.
+                let dir =
+                    Vec3::new(rng.f() - 0.5, rng.f() - 0.5, -1.2 - rng.f()) * (0.5 + 4.0 * rng.f());
+                let origin = target - dir * (1.0 + 3.0 * rng.f());
+                let ray = Ray::new(origin, target - origin);
+                let hit = tris
+                    .iter()
+                    .any(|t| t.intersect(&ray, f32::INFINITY).is_some());
+                assert!(hit, "crack at {target} for ray {ray:?}");
+                tested += 1;
+            }
+        }
+        assert!(tested > 10_000);
+    }
+}
