@@ -22,7 +22,8 @@ const LEAF: u32 = 1 << 31;
 const END: u32 = 1 << 31;
 /// Ize's robust slab-test factor `1 + 2γ(3)`: widens exits so rounding cannot lose a box the
 /// ray touches (flat boxes of axis-aligned triangles included).
-const ROBUST: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+/// Applied to the inverse direction, so it also covers that product's rounding.
+const ROBUST: f32 = 1.0 + 4.0 * f32::EPSILON;
 /// Stack sizes of the two traversal variants; the small one is used when the tree is shallow
 /// enough (nearly always) because the stack array is initialised on every query.
 const SMALL_STACK: usize = 64;
@@ -59,6 +60,8 @@ impl Node4 {
 struct RayPre {
     origin: [Vec4; 3],
     inv_dir: [Vec4; 3],
+    /// `inv_dir` widened by [`ROBUST`], for exit distances.
+    inv_dir_far: [Vec4; 3],
     /// Index (0 = min, 1 = max) of the plane entered first on each axis.
     near: [usize; 3],
 }
@@ -79,32 +82,36 @@ impl RayPre {
         RayPre {
             origin: [ray.origin.x, ray.origin.y, ray.origin.z].map(Vec4::splat),
             inv_dir: inv.map(Vec4::splat),
+            inv_dir_far: inv.map(|i| Vec4::splat(i * ROBUST)),
             near: inv.map(|i| usize::from(i < 0.0)),
         }
     }
 
     /// Which of the node's four boxes the segment `[0, t_max]` meets, and the entry distances.
+    /// Reductions are balanced trees: traversal is bound by this dependency chain.
     #[inline(always)]
     fn hit4(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
-        let slab = |axis: usize, side: usize| {
+        let [nx, ny, nz] = self.near;
+        let near = |axis: usize, side: usize| {
             (node.bounds[axis][side & 1] - self.origin[axis]) * self.inv_dir[axis]
         };
-        let [nx, ny, nz] = self.near;
-        let t_near = slab(0, nx)
-            .max(slab(1, ny))
-            .max(slab(2, nz))
-            .max(Vec4::ZERO);
-        let t_far = (slab(0, nx ^ 1).min(slab(1, ny ^ 1)).min(slab(2, nz ^ 1)) * ROBUST)
-            .min(Vec4::splat(t_max));
+        let far = |axis: usize, side: usize| {
+            (node.bounds[axis][side & 1] - self.origin[axis]) * self.inv_dir_far[axis]
+        };
+        let t_near = near(0, nx)
+            .max(near(1, ny))
+            .max(near(2, nz).max(Vec4::ZERO));
+        let t_far = far(0, nx ^ 1)
+            .min(far(1, ny ^ 1))
+            .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
         (t_near.cmple(t_far).bitmask(), t_near)
     }
 
-    /// Children hit by the ray, nearest last: sort keys are the entry distance's bits (ordered
-    /// like the non-negative floats) with the slot in the two low bits; a sorting network
-    /// avoids data-dependent branches.
+    /// Three or four hit children, nearest last: sort keys are the entry distance's bits
+    /// (ordered like the non-negative floats) with the slot in the two low bits; a sorting
+    /// network avoids data-dependent branches.
     #[inline(always)]
-    fn order(mask: u32, t_near: Vec4) -> [u32; 4] {
-        let t = t_near.to_array();
+    fn order(mask: u32, t: &[f32; 4]) -> [u32; 4] {
         let key = |i: usize| {
             if mask >> i & 1 != 0 {
                 (t[i].to_bits() & !3) | i as u32
@@ -294,7 +301,25 @@ impl Bvh {
                 let node = &self.nodes[cur as usize];
                 let (mask, t_near) = r.hit4(node, *t_max);
                 if mask != 0 {
-                    let keys = RayPre::order(mask, t_near);
+                    // Most visits hit one or two children: handle those without sorting.
+                    let first = mask.trailing_zeros() as usize & 3;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = node.children[first];
+                        continue;
+                    }
+                    let t = t_near.to_array();
+                    if rest & (rest - 1) == 0 {
+                        let second = rest.trailing_zeros() as usize & 3;
+                        let (c0, c1) = (node.children[first], node.children[second]);
+                        let (t0, t1) = (t[first], t[second]);
+                        let (near, far, far_t) = if t1 < t0 { (c1, c0, t0) } else { (c0, c1, t1) };
+                        stack[sp] = (far, far_t);
+                        sp += 1;
+                        cur = near;
+                        continue;
+                    }
+                    let keys = RayPre::order(mask, &t);
                     let entry = |k: u32| (node.children[(k & 3) as usize], f32::from_bits(k & !3));
                     // All three writes happen; only `count - 1` of them are kept.
                     stack[sp] = entry(keys[0]);

@@ -8,17 +8,16 @@
 //! products are exact. So a ray through a shared edge or vertex always hits one of the
 //! triangles (edges count as inside, so it may hit both).
 
+use glam::{Vec4, Vec4Swizzles};
+
 use crate::math::{Aabb, Ray, Vec3};
 
-/// A triangle ready for intersection: its three world-space vertices.
+/// A triangle ready for intersection: per axis, the coordinates of its vertices `a`, `b`, `c`
+/// in the first three lanes (the fourth repeats `a`), so the test runs on all three vertices at
+/// once.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle {
-    /// First vertex.
-    pub a: Vec3,
-    /// Second vertex.
-    pub b: Vec3,
-    /// Third vertex.
-    pub c: Vec3,
+    v: [Vec4; 3],
 }
 
 /// A ray–triangle hit.
@@ -36,11 +35,13 @@ pub struct TriangleHit {
 /// [`Triangle::intersect_pre`] saves work when one ray meets many triangles.
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleRay {
-    origin: Vec3,
-    /// Axis of the largest direction component; the other two are sheared against it.
-    kz: u8,
-    /// Shear: `dir[kx] / dir[kz]`, `dir[ky] / dir[kz]`, `1 / dir[kz]`.
-    shear: Vec3,
+    /// Axes permuted so `dir[kz]` is the largest component.
+    k: [usize; 3],
+    /// Origin components in permuted order, splatted.
+    origin: [Vec4; 3],
+    /// Shear `dir[kx] / dir[kz]`, `dir[ky] / dir[kz]`, and `1 / dir[kz]`, splatted.
+    shear: [Vec4; 2],
+    inv_dz: f32,
 }
 
 impl TriangleRay {
@@ -55,12 +56,16 @@ impl TriangleRay {
         } else {
             2
         };
-        let (kx, ky) = ((kz + 1) % 3, (kz + 2) % 3);
+        let k = [(kz + 1) % 3, (kz + 2) % 3, kz];
         let dz = ray.dir[kz];
         TriangleRay {
-            origin: ray.origin,
-            kz: kz as u8,
-            shear: Vec3::new(ray.dir[kx] / dz, ray.dir[ky] / dz, 1.0 / dz),
+            k,
+            origin: k.map(|i| Vec4::splat(ray.origin[i])),
+            shear: [
+                Vec4::splat(ray.dir[k[0]] / dz),
+                Vec4::splat(ray.dir[k[1]] / dz),
+            ],
+            inv_dz: 1.0 / dz,
         }
     }
 }
@@ -69,7 +74,16 @@ impl Triangle {
     /// A triangle from three world-space vertices.
     #[inline]
     pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Triangle {
-        Triangle { a, b, c }
+        Triangle {
+            v: [0, 1, 2].map(|i| Vec4::new(a[i], b[i], c[i], a[i])),
+        }
+    }
+
+    /// The three vertices `[a, b, c]`.
+    #[inline]
+    pub fn vertices(&self) -> [Vec3; 3] {
+        let [x, y, z] = self.v;
+        [0, 1, 2].map(|i| Vec3::new(x[i], y[i], z[i]))
     }
 
     /// The hit with `0 < t < t_max`, if any. Both faces are hit; points on edges and vertices
@@ -82,79 +96,68 @@ impl Triangle {
     /// [`Triangle::intersect`] with the per-ray constants computed once by the caller.
     #[inline]
     pub fn intersect_pre(&self, ray: &TriangleRay, t_max: f32) -> Option<TriangleHit> {
-        // Axes as constants, so the permutation costs nothing inside the test.
-        match ray.kz {
-            0 => self.sheared::<1, 2, 0>(ray, t_max),
-            1 => self.sheared::<2, 0, 1>(ray, t_max),
-            _ => self.sheared::<0, 1, 2>(ray, t_max),
+        let [kx, ky, kz] = ray.k;
+        // Vertex coordinates relative to the origin, sheared so the ray runs along +z; lanes
+        // are the vertices a, b, c.
+        let z = self.v[kz] - ray.origin[2];
+        let x = (self.v[kx] - ray.origin[0]) - ray.shear[0] * z;
+        let y = (self.v[ky] - ray.origin[1]) - ray.shear[1] * z;
+        // Edge functions: lane i is the (unnormalised) barycentric weight of vertex i.
+        let mut w = x.zxyw() * y.yzxw() - y.zxyw() * x.yzxw();
+        if w.cmpeq(Vec4::ZERO).bitmask() & 7 != 0 {
+            w = exact_edges(x, y);
         }
-    }
-
-    #[inline(always)]
-    fn sheared<const KX: usize, const KY: usize, const KZ: usize>(
-        &self,
-        ray: &TriangleRay,
-        t_max: f32,
-    ) -> Option<TriangleHit> {
-        let s = ray.shear;
-        let a = self.a - ray.origin;
-        let b = self.b - ray.origin;
-        let c = self.c - ray.origin;
-        let (ax, ay) = (a[KX] - s.x * a[KZ], a[KY] - s.y * a[KZ]);
-        let (bx, by) = (b[KX] - s.x * b[KZ], b[KY] - s.y * b[KZ]);
-        let (cx, cy) = (c[KX] - s.x * c[KZ], c[KY] - s.y * c[KZ]);
-        // Edge functions, each the (unnormalised) barycentric weight of the opposite vertex.
-        let mut wa = cx * by - cy * bx;
-        let mut wb = ax * cy - ay * cx;
-        let mut wc = bx * ay - by * ax;
-        if wa == 0.0 || wb == 0.0 || wc == 0.0 {
-            let e = |px: f32, py: f32, qx: f32, qy: f32| {
-                (px as f64 * qy as f64 - py as f64 * qx as f64) as f32
-            };
-            wa = e(cx, cy, bx, by);
-            wb = e(ax, ay, cx, cy);
-            wc = e(bx, by, ax, ay);
-        }
-        if (wa < 0.0 || wb < 0.0 || wc < 0.0) && (wa > 0.0 || wb > 0.0 || wc > 0.0) {
+        let neg = w.cmplt(Vec4::ZERO).bitmask() & 7;
+        let pos = w.cmpgt(Vec4::ZERO).bitmask() & 7;
+        if neg != 0 && pos != 0 {
             return None;
         }
-        let det = wa + wb + wc;
-        if det == 0.0 {
-            return None;
-        }
-        let t_scaled = s.z * (wa * a[KZ] + wb * b[KZ] + wc * c[KZ]);
-        let t = t_scaled / det;
+        let det = w.x + w.y + w.z;
+        let p = w * z;
+        let t = (p.x + p.y + p.z) * ray.inv_dz / det;
+        // Also rejects det == 0 (t is then infinite or NaN).
         if !(t > 0.0 && t < t_max) {
             return None;
         }
         let inv = 1.0 / det;
         Some(TriangleHit {
             t,
-            u: wb * inv,
-            v: wc * inv,
+            u: w.y * inv,
+            v: w.z * inv,
         })
     }
 
     /// Bounding box of the three vertices.
     #[inline]
     pub fn bounds(&self) -> Aabb {
+        let [x, y, z] = self.v;
         Aabb {
-            min: self.a.min(self.b).min(self.c),
-            max: self.a.max(self.b).max(self.c),
+            min: Vec3::new(x.min_element(), y.min_element(), z.min_element()),
+            max: Vec3::new(x.max_element(), y.max_element(), z.max_element()),
         }
     }
 
     /// Unit normal `normalize((b − a) × (c − a))`; zero for a degenerate triangle.
     #[inline]
     pub fn geometric_normal(&self) -> Vec3 {
-        (self.b - self.a).cross(self.c - self.a).normalize_or_zero()
+        let [a, b, c] = self.vertices();
+        (b - a).cross(c - a).normalize_or_zero()
     }
 
     /// The point with barycentric weights `u` (of `b`) and `v` (of `c`).
     #[inline]
     pub fn point(&self, u: f32, v: f32) -> Vec3 {
-        self.a * (1.0 - u - v) + self.b * u + self.c * v
+        let [a, b, c] = self.vertices();
+        a * (1.0 - u - v) + b * u + c * v
     }
+}
+
+/// Edge functions in `f64`, where the products are exact, to settle the sign of zeros.
+#[cold]
+fn exact_edges(x: Vec4, y: Vec4) -> Vec4 {
+    let (x, y) = (x.to_array().map(f64::from), y.to_array().map(f64::from));
+    let e = |i: usize, j: usize| (x[j] * y[i] - y[j] * x[i]) as f32;
+    Vec4::new(e(1, 2), e(2, 0), e(0, 1), 0.0)
 }
 
 #[cfg(test)]
