@@ -1,7 +1,7 @@
 //! Bounding volume hierarchy over arbitrary primitives, given by their bounds.
 //!
-//! Built as a binned-SAH binary tree and collapsed into 4-wide nodes whose child boxes are
-//! stored as structure-of-arrays, so one node visit tests four boxes with SSE arithmetic.
+//! Built as a binned-SAH binary tree and collapsed into wide nodes whose child boxes are
+//! stored as structure-of-arrays, so one node visit tests its boxes with SSE arithmetic.
 //! Traversal is near-first with a fixed-size stack; primitives are handed to a caller's
 //! closure (generic, so it inlines).
 
@@ -24,35 +24,51 @@ const END: u32 = 1 << 31;
 /// ray touches (flat boxes of axis-aligned triangles included).
 /// Applied to the inverse direction, so it also covers that product's rounding.
 const ROBUST: f32 = 1.0 + 4.0 * f32::EPSILON;
+/// Children per node.
+const WIDTH: usize = 4;
+/// Four-lane vectors per row of child bounds.
+const HALVES: usize = WIDTH / 4;
 /// Stack sizes of the two traversal variants; the small one is used when the tree is shallow
 /// enough (nearly always) because the stack array is initialised on every query.
 const SMALL_STACK: usize = 64;
-const LARGE_STACK: usize = 256;
+const LARGE_STACK: usize = 512;
 
-/// A 4-wide node: child boxes as `[axis][min, max]` lanes, then child references
-/// (inner node index, or `LEAF | first` for leaves). Exactly two cache lines.
+/// A wide node: child boxes as `[axis][min, max]` rows of lanes, then child references
+/// (inner node index, or `LEAF | first` for leaves). A whole number of cache lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub struct Node4 {
-    bounds: [[Vec4; 2]; 3],
-    children: [u32; 4],
-    _pad: [u32; 4],
+pub struct Node {
+    bounds: [[[Vec4; HALVES]; 2]; 3],
+    children: [u32; WIDTH],
+    _pad: [u32; WIDTH],
 }
 
-impl Node4 {
+impl Node {
     /// Unused slots have inverted infinite boxes, which every slab test rejects.
-    const EMPTY: Node4 = Node4 {
-        bounds: [[Vec4::splat(f32::INFINITY), Vec4::splat(f32::NEG_INFINITY)]; 3],
-        children: [0; 4],
-        _pad: [0; 4],
+    const EMPTY: Node = Node {
+        bounds: [[
+            [Vec4::splat(f32::INFINITY); HALVES],
+            [Vec4::splat(f32::NEG_INFINITY); HALVES],
+        ]; 3],
+        children: [0; WIDTH],
+        _pad: [0; WIDTH],
     };
 
     fn set_child(&mut self, slot: usize, min: Vec3, max: Vec3, child: u32) {
         for axis in 0..3 {
-            self.bounds[axis][0][slot] = min[axis];
-            self.bounds[axis][1][slot] = max[axis];
+            self.bounds[axis][0][slot / 4][slot % 4] = min[axis];
+            self.bounds[axis][1][slot / 4][slot % 4] = max[axis];
         }
         self.children[slot] = child;
+    }
+
+    /// Box of child `slot` (inverted for unused slots).
+    #[cfg(test)]
+    fn child_box(&self, slot: usize) -> (Vec3, Vec3) {
+        let get = |side: usize| {
+            Vec3::from_array([0, 1, 2].map(|axis| self.bounds[axis][side][slot / 4][slot % 4]))
+        };
+        (get(0), get(1))
     }
 }
 
@@ -87,50 +103,30 @@ impl RayPre {
         }
     }
 
-    /// Which of the node's four boxes the segment `[0, t_max]` meets, and the entry distances.
-    /// Reductions are balanced trees: traversal is bound by this dependency chain.
+    /// Which of the node's boxes the segment `[0, t_max]` meets (bit per slot), and the entry
+    /// distances. Reductions are balanced trees: traversal is bound by this dependency chain.
     #[inline(always)]
-    fn hit4(&self, node: &Node4, t_max: f32) -> (u32, Vec4) {
+    fn hit(&self, node: &Node, t_max: f32) -> (u32, [Vec4; HALVES]) {
         let [nx, ny, nz] = self.near;
-        let near = |axis: usize, side: usize| {
-            (node.bounds[axis][side & 1] - self.origin[axis]) * self.inv_dir[axis]
-        };
-        let far = |axis: usize, side: usize| {
-            (node.bounds[axis][side & 1] - self.origin[axis]) * self.inv_dir_far[axis]
-        };
-        let t_near = near(0, nx)
-            .max(near(1, ny))
-            .max(near(2, nz).max(Vec4::ZERO));
-        let t_far = far(0, nx ^ 1)
-            .min(far(1, ny ^ 1))
-            .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
-        (t_near.cmple(t_far).bitmask(), t_near)
-    }
-
-    /// Three or four hit children, nearest last: sort keys are the entry distance's bits
-    /// (ordered like the non-negative floats) with the slot in the two low bits; a sorting
-    /// network avoids data-dependent branches.
-    #[inline(always)]
-    fn order(mask: u32, t: &[f32; 4]) -> [u32; 4] {
-        let key = |i: usize| {
-            if mask >> i & 1 != 0 {
-                (t[i].to_bits() & !3) | i as u32
-            } else {
-                0
-            }
-        };
-        let [mut k0, mut k1, mut k2, mut k3] = [key(0), key(1), key(2), key(3)];
-        let sort2 = |a: &mut u32, b: &mut u32| {
-            let (hi, lo) = ((*a).max(*b), (*a).min(*b));
-            *a = hi;
-            *b = lo;
-        };
-        sort2(&mut k0, &mut k1);
-        sort2(&mut k2, &mut k3);
-        sort2(&mut k0, &mut k2);
-        sort2(&mut k1, &mut k3);
-        sort2(&mut k1, &mut k2);
-        [k0, k1, k2, k3]
+        let mut mask = 0;
+        let mut t_nears = [Vec4::ZERO; HALVES];
+        for (h, t_near_out) in t_nears.iter_mut().enumerate() {
+            let near = |axis: usize, side: usize| {
+                (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir[axis]
+            };
+            let far = |axis: usize, side: usize| {
+                (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir_far[axis]
+            };
+            let t_near = near(0, nx)
+                .max(near(1, ny))
+                .max(near(2, nz).max(Vec4::ZERO));
+            let t_far = far(0, nx ^ 1)
+                .min(far(1, ny ^ 1))
+                .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
+            mask |= t_near.cmple(t_far).bitmask() << (4 * h);
+            *t_near_out = t_near;
+        }
+        (mask, t_nears)
     }
 }
 
@@ -140,7 +136,7 @@ impl RayPre {
 /// Primitives with non-finite or empty bounds are left out and never reported.
 #[derive(Clone, Debug)]
 pub struct Bvh {
-    nodes: Vec<Node4>,
+    nodes: Vec<Node>,
     /// Primitive ids in leaf order; `END` marks the last of each leaf.
     order: Vec<u32>,
     bounds: Aabb,
@@ -169,7 +165,7 @@ impl Bvh {
         self.bounds
     }
 
-    /// Number of (4-wide) nodes.
+    /// Number of (wide) nodes.
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
@@ -185,11 +181,10 @@ impl Bvh {
         self.order.iter().map(|&p| p & !END)
     }
 
-    /// Whether the small traversal stack suffices (each level pushes at most three entries,
-    /// and a node's three pushes are written before the count is known).
+    /// Whether the small traversal stack suffices (each level pushes at most `WIDTH - 1`).
     #[inline(always)]
     fn small_stack(&self) -> bool {
-        3 * self.depth as usize + 3 <= SMALL_STACK
+        (WIDTH - 1) * self.depth as usize <= SMALL_STACK
     }
 
     /// Closest hit. `intersect(prim, t_max)` tests primitive `prim` (an index into the bounds
@@ -299,18 +294,18 @@ impl Bvh {
         loop {
             if cur & LEAF == 0 {
                 let node = &self.nodes[cur as usize];
-                let (mask, t_near) = r.hit4(node, *t_max);
+                let (mask, t_near) = r.hit(node, *t_max);
                 if mask != 0 {
                     // Most visits hit one or two children: handle those without sorting.
-                    let first = mask.trailing_zeros() as usize & 3;
+                    let first = mask.trailing_zeros() as usize % WIDTH;
                     let rest = mask & (mask - 1);
                     if rest == 0 {
                         cur = node.children[first];
                         continue;
                     }
-                    let t = t_near.to_array();
+                    let t: [f32; WIDTH] = std::array::from_fn(|i| t_near[i / 4][i % 4]);
                     if rest & (rest - 1) == 0 {
-                        let second = rest.trailing_zeros() as usize & 3;
+                        let second = rest.trailing_zeros() as usize % WIDTH;
                         let (c0, c1) = (node.children[first], node.children[second]);
                         let (t0, t1) = (t[first], t[second]);
                         let (near, far, far_t) = if t1 < t0 { (c1, c0, t0) } else { (c0, c1, t1) };
@@ -319,15 +314,32 @@ impl Bvh {
                         cur = near;
                         continue;
                     }
-                    let keys = RayPre::order(mask, &t);
-                    let entry = |k: u32| (node.children[(k & 3) as usize], f32::from_bits(k & !3));
-                    // All three writes happen; only `count - 1` of them are kept.
-                    stack[sp] = entry(keys[0]);
-                    stack[sp + 1] = entry(keys[1]);
-                    stack[sp + 2] = entry(keys[2]);
-                    let count = mask.count_ones() as usize;
-                    cur = node.children[(keys[(count - 1) & 3] & 3) as usize];
-                    sp += count - 1;
+                    // Three or more: insertion-sort keys (distance bits, which order like
+                    // non-negative floats, with the slot in the low bits), farthest first.
+                    let mut keys = [0u32; WIDTH];
+                    let mut count = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let slot = m.trailing_zeros();
+                        m &= m - 1;
+                        let key = (t[slot as usize % WIDTH].to_bits() & !(WIDTH as u32 - 1)) | slot;
+                        let mut j = count;
+                        while j > 0 && keys[j - 1] < key {
+                            keys[j] = keys[j - 1];
+                            j -= 1;
+                        }
+                        keys[j % WIDTH] = key;
+                        count += 1;
+                    }
+                    for &key in &keys[..count - 1] {
+                        let slot = (key as usize) % WIDTH;
+                        stack[sp] = (
+                            node.children[slot],
+                            f32::from_bits(key & !(WIDTH as u32 - 1)),
+                        );
+                        sp += 1;
+                    }
+                    cur = node.children[(keys[(count - 1) % WIDTH] as usize) % WIDTH];
                     continue;
                 }
             } else if leaf(&self.order, (cur & !LEAF) as usize, t_max) {

@@ -1,10 +1,10 @@
 //! Construction: a binned-SAH binary BVH built top-down (in parallel, deterministically), then
-//! collapsed into the 4-wide node layout used for traversal.
+//! collapsed into the wide node layout used for traversal.
 
 use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
-use super::{Node4, END, LEAF};
+use super::{Node, END, LEAF, WIDTH};
 use crate::math::Aabb;
 
 /// SAH bins per axis.
@@ -16,6 +16,8 @@ pub(super) const MAX_LEAF: usize = 8;
 /// Beyond this depth splits become object medians, so the depth stays below about
 /// `MEDIAN_DEPTH + log2(n)` and the traversal stack stays bounded.
 const MEDIAN_DEPTH: u32 = 40;
+/// Nodes with at most this many primitives use an exact SAH sweep instead of bins.
+const SWEEP_MAX: usize = 32;
 /// Subtrees with fewer primitives than this are built on the current thread.
 const PARALLEL_MIN: usize = 4096;
 /// Binning runs in parallel chunks of this many primitives for large nodes.
@@ -298,7 +300,16 @@ fn build_node(
     }
     let degenerate = (cbounds.hi - cbounds.lo).truncate().max_element() <= 0.0;
     let mut split_at = None;
-    if depth < MEDIAN_DEPTH && !degenerate {
+    if n <= SWEEP_MAX && depth < MEDIAN_DEPTH {
+        let (m, cost) = sweep_split(refs);
+        let split_cost = TRAVERSAL_COST + cost / bounds.half_area();
+        if n <= MAX_LEAF && (split_cost >= n as f32 || split_cost.is_nan()) {
+            nodes[0] = leaf;
+            return;
+        }
+        let (lr, rr) = refs.split_at(m);
+        split_at = Some((m, range_bounds(lr), range_bounds(rr)));
+    } else if depth < MEDIAN_DEPTH && !degenerate {
         let binner = Binner::new(&cbounds);
         let bins = if n >= 4 * BIN_CHUNK {
             refs.par_chunks(BIN_CHUNK)
@@ -320,21 +331,25 @@ fn build_node(
             }));
         }
     }
-    let m = match split_at {
-        Some(m) => m,
+    let parallel = n >= PARALLEL_MIN;
+    let (m, (lb, lc), (rb, rc)) = match split_at {
+        Some(split) => split,
         None if n <= MAX_LEAF => {
             nodes[0] = leaf;
             return;
         }
-        None => median_split(refs, &cbounds),
+        None => {
+            let m = median_split(refs, &cbounds);
+            let (lr, rr) = refs.split_at_mut(m);
+            let (l, r) = if parallel {
+                rayon::join(|| range_bounds(lr), || range_bounds(rr))
+            } else {
+                (range_bounds(lr), range_bounds(rr))
+            };
+            (m, l, r)
+        }
     };
     let (lr, rr) = refs.split_at_mut(m);
-    let parallel = n >= PARALLEL_MIN;
-    let ((lb, lc), (rb, rc)) = if parallel {
-        rayon::join(|| range_bounds(lr), || range_bounds(rr))
-    } else {
-        (range_bounds(lr), range_bounds(rr))
-    };
     let (root, rest) = nodes.split_first_mut().expect("slot for the node");
     let (ln, rn) = rest.split_at_mut(2 * m - 1);
     *root = Node2 {
@@ -363,18 +378,66 @@ fn build_node(
     }
 }
 
-/// Moves references satisfying `left` to the front; returns how many there are.
-fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> usize {
+/// Exact SAH over all object splits along each axis (for small nodes, where it is cheaper
+/// than binning); leaves `refs` ordered for the best split and returns its left size and cost.
+fn sweep_split(refs: &mut [PrimRef]) -> (usize, f32) {
+    let n = refs.len();
+    let mut best = (f32::INFINITY, 0, 1);
+    let mut right_cost = [0.0f32; SWEEP_MAX];
+    for axis in 0..3 {
+        sort_axis(refs, axis);
+        let mut acc = Box4::EMPTY;
+        for i in (1..n).rev() {
+            acc.grow(refs[i].lo, refs[i].hi);
+            right_cost[i] = acc.half_area() * (n - i) as f32;
+        }
+        let mut acc = Box4::EMPTY;
+        for i in 1..n {
+            acc.grow(refs[i - 1].lo, refs[i - 1].hi);
+            let cost = acc.half_area() * i as f32 + right_cost[i];
+            // Ties (e.g. identical boxes) go to the most balanced split.
+            let balance = |m: usize| m.abs_diff(n / 2);
+            if cost < best.0 || (cost == best.0 && balance(i) < balance(best.2)) {
+                best = (cost, axis, i);
+            }
+        }
+    }
+    sort_axis(refs, best.1);
+    (best.2, best.0)
+}
+
+/// Sorts by centroid along `axis`, ties by id (deterministic).
+fn sort_axis(refs: &mut [PrimRef], axis: usize) {
+    refs.sort_unstable_by(|a, b| {
+        a.centroid2()[axis]
+            .total_cmp(&b.centroid2()[axis])
+            .then(a.id().cmp(&b.id()))
+    });
+}
+
+/// Moves references satisfying `left` to the front; returns how many there are, and the
+/// bounds and centroid bounds of both sides (gathered here to save a pass over the data).
+fn partition(
+    refs: &mut [PrimRef],
+    left: impl Fn(&PrimRef) -> bool,
+) -> (usize, (Box4, Box4), (Box4, Box4)) {
     let (mut i, mut j) = (0, refs.len());
+    let (mut lb, mut lc, mut rb, mut rc) = (Box4::EMPTY, Box4::EMPTY, Box4::EMPTY, Box4::EMPTY);
     while i < j {
-        if left(&refs[i]) {
+        let r = refs[i];
+        let c = r.centroid2();
+        if left(&r) {
+            lb.grow(r.lo, r.hi);
+            lc.grow(c, c);
             i += 1;
         } else {
+            rb.grow(r.lo, r.hi);
+            rc.grow(c, c);
             j -= 1;
             refs.swap(i, j);
         }
     }
-    i
+    (i, (lb, lc), (rb, rc))
 }
 
 /// Object median along the widest centroid axis (ties broken by id, so deterministic).
@@ -396,13 +459,13 @@ fn median_split(refs: &mut [PrimRef], cbounds: &Box4) -> usize {
     m
 }
 
-/// The traversal tree: 4-wide nodes collapsed from the binary tree, and the leaf order with
+/// The traversal tree: wide nodes collapsed from the binary tree, and the leaf order with
 /// the last primitive of each leaf flagged by `END`.
 pub(super) struct Collapsed {
-    pub(super) nodes: Vec<Node4>,
+    pub(super) nodes: Vec<Node>,
     pub(super) order: Vec<u32>,
     pub(super) bounds: Aabb,
-    /// Depth of the 4-wide tree (root = 1).
+    /// Depth of the wide tree (root = 1).
     pub(super) depth: u32,
 }
 
@@ -426,9 +489,9 @@ pub(super) fn collapse(bvh2: Bvh2) -> Collapsed {
     }
 }
 
-/// Emits the 4-wide node for binary node `i` and its subtree (pre-order); returns the depth.
-fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node4>, ids: &mut [u32]) -> u32 {
-    let mut kids = [0usize; 4];
+/// Emits the wide node for binary node `i` and its subtree (pre-order); returns the depth.
+fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node>, ids: &mut [u32]) -> u32 {
+    let mut kids = [0usize; WIDTH];
     let mut k;
     if n2[i].count > 0 {
         // Only a leaf root gets here.
@@ -439,7 +502,7 @@ fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node4>, ids: &mut [u32]) -> u32 {
         kids[1] = n2[i].b as usize;
         k = 2;
         // Open the inner child with the largest area until the node is full.
-        while k < 4 {
+        while k < WIDTH {
             let best =
                 (0..k)
                     .filter(|&s| n2[kids[s]].count == 0)
@@ -460,7 +523,7 @@ fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node4>, ids: &mut [u32]) -> u32 {
         }
     }
     let me = out.len();
-    out.push(Node4::EMPTY);
+    out.push(Node::EMPTY);
     let mut depth = 1;
     for (slot, &kid) in kids[..k].iter().enumerate() {
         let node = &n2[kid];

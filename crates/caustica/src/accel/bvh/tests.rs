@@ -368,8 +368,8 @@ fn sphere(rings: usize, segments: usize) -> Vec<Triangle> {
 
 #[test]
 fn node_layout() {
-    assert_eq!(std::mem::size_of::<Node4>(), 128);
-    assert_eq!(std::mem::align_of::<Node4>(), 64);
+    assert_eq!(std::mem::size_of::<Node>(), 32 * WIDTH);
+    assert_eq!(std::mem::align_of::<Node>(), 64);
 }
 
 fn snapshot(bvh: &Bvh) -> (Vec<u32>, Vec<u32>, u32) {
@@ -379,6 +379,7 @@ fn snapshot(bvh: &Bvh) -> (Vec<u32>, Vec<u32>, u32) {
         .flat_map(|n| {
             n.bounds
                 .iter()
+                .flatten()
                 .flatten()
                 .flat_map(|v| v.to_array())
                 .map(f32::to_bits)
@@ -425,17 +426,8 @@ fn bounds_contain_children() {
     let mut leaves = 0;
     while let Some(n) = stack.pop() {
         let node = &bvh.nodes[n as usize];
-        for slot in 0..4 {
-            let lo = Vec3::new(
-                node.bounds[0][0][slot],
-                node.bounds[1][0][slot],
-                node.bounds[2][0][slot],
-            );
-            let hi = Vec3::new(
-                node.bounds[0][1][slot],
-                node.bounds[1][1][slot],
-                node.bounds[2][1][slot],
-            );
+        for slot in 0..WIDTH {
+            let (lo, hi) = node.child_box(slot);
             if lo.x > hi.x {
                 continue;
             }
