@@ -37,7 +37,7 @@ const LARGE_STACK: usize = 512;
 /// (inner node index, or `LEAF | first` for leaves). A whole number of cache lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub struct Node {
+pub(crate) struct Node {
     bounds: [[[Vec4; HALVES]; 2]; 3],
     children: [u32; WIDTH],
     _pad: [u32; WIDTH],

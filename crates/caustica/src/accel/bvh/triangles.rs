@@ -2,7 +2,7 @@
 //! from consecutive memory instead of through the primitive index.
 
 use super::{Bvh, END, SMALL_STACK};
-use crate::geometry::triangle::Triangle;
+use crate::geometry::triangle::{Triangle, TriangleRay};
 use crate::math::{Aabb, Ray};
 
 /// Closest hit in a [`TriangleBvh`].
@@ -58,10 +58,11 @@ impl TriangleBvh {
             return false;
         }
         let mut t = t_max;
+        let tr = TriangleRay::new(ray);
         let leaf = |order: &[u32], first: usize, t_max: &mut f32| {
             let mut i = first;
             loop {
-                if self.tris[i].intersect(ray, *t_max).is_some() {
+                if self.tris[i].intersect_pre(&tr, *t_max).is_some() {
                     return true;
                 }
                 if order[i] & END != 0 {
@@ -82,10 +83,11 @@ impl TriangleBvh {
     fn closest_impl<const N: usize>(&self, ray: &Ray, t_max: f32) -> Option<TriangleBvhHit> {
         let mut t = t_max;
         let mut best = None;
+        let tr = TriangleRay::new(ray);
         self.bvh.traverse::<N>(ray, &mut t, |order, first, t_max| {
             let mut i = first;
             loop {
-                if let Some(h) = self.tris[i].intersect(ray, *t_max) {
+                if let Some(h) = self.tris[i].intersect_pre(&tr, *t_max) {
                     *t_max = h.t;
                     best = Some((i, h.u, h.v));
                 }
