@@ -1,1 +1,413 @@
-fn main() {}
+//! BVH build time and single-thread ray throughput, against the `obvhs` crate.
+//!
+//! `cargo bench --bench bvh` runs criterion (rays/s as throughput).
+//! `BVH_BENCH_QUICK=1 cargo bench --bench bvh` skips criterion and prints a table of the best
+//! of a few timed batches per case (about a minute in all).
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use caustica::accel::bvh::{Bvh, TriangleBvh};
+use caustica::geometry::triangle::{Triangle, TriangleRay};
+use caustica::math::{Aabb, Ray, Vec3};
+use criterion::{BenchmarkId, Criterion, Throughput};
+
+/// Rays per timed batch (`BVH_BENCH_RAYS` overrides).
+fn ray_count() -> usize {
+    std::env::var("BVH_BENCH_RAYS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(1 << 18)
+}
+
+/// splitmix64: deterministic inputs without another dependency.
+struct Rng(u64);
+
+impl Rng {
+    fn f(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// A latitude–longitude sphere of `2 · rings · segments` triangles, radially displaced by
+/// `bumps` (0 = smooth).
+fn sphere(rings: usize, segments: usize, bumps: f32) -> Vec<Triangle> {
+    let point = |i: usize, j: usize| {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        let phi = std::f32::consts::TAU * (j % segments) as f32 / segments as f32;
+        let r = 1.0
+            + bumps
+                * (0.08 * (9.0 * theta).sin() * (7.0 * phi).cos()
+                    + 0.03 * (31.0 * theta + 17.0 * phi).sin()
+                    + 0.01 * (97.0 * theta).cos() * (83.0 * phi).sin());
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        ) * r
+    };
+    let mut tris = Vec::with_capacity(2 * rings * segments);
+    for i in 0..rings {
+        for j in 0..segments {
+            tris.push(Triangle::new(
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+            ));
+            tris.push(Triangle::new(
+                point(i, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            ));
+        }
+    }
+    tris
+}
+
+fn mesh_bounds(tris: &[Triangle]) -> Aabb {
+    tris.iter().fold(Aabb::EMPTY, |b, t| b.union(t.bounds()))
+}
+
+/// Pinhole camera framing the mesh, rays in scanline order.
+fn primary_rays(bounds: Aabb, n: usize) -> Vec<Ray> {
+    let side = (n as f32).sqrt() as usize;
+    let center = bounds.center();
+    let radius = bounds.extent().length() * 0.5;
+    let eye = center + Vec3::new(0.4, 0.5, 1.0).normalize() * radius * 2.6;
+    let forward = (center - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let half = (22.5f32).to_radians().tan();
+    let mut rays = Vec::with_capacity(side * side);
+    for y in 0..side {
+        for x in 0..side {
+            let sx = (2.0 * (x as f32 + 0.5) / side as f32 - 1.0) * half;
+            let sy = (1.0 - 2.0 * (y as f32 + 0.5) / side as f32) * half;
+            rays.push(Ray::new(eye, forward + right * sx + up * sy));
+        }
+    }
+    rays
+}
+
+/// Origins uniform in the mesh bounds, directions uniform on the sphere.
+fn incoherent_rays(bounds: Aabb, n: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng(seed);
+    (0..n)
+        .map(|_| {
+            let o = bounds.min + bounds.extent() * Vec3::new(rng.f(), rng.f(), rng.f());
+            let z = 2.0 * rng.f() - 1.0;
+            let phi = std::f32::consts::TAU * rng.f();
+            let s = (1.0 - z * z).max(0.0).sqrt();
+            Ray::new(o, Vec3::new(s * phi.cos(), s * phi.sin(), z))
+        })
+        .collect()
+}
+
+/// Everything built for one mesh.
+struct Scene {
+    name: &'static str,
+    tris: Vec<Triangle>,
+    bvh: Bvh,
+    tri_bvh: TriangleBvh,
+    ob: obvhs::cwbvh::CwBvh,
+    ob_tris: Vec<obvhs::triangle::Triangle>,
+    /// `ob_tris` in the comparison BVH's leaf order (its fast layout).
+    ob_tris_ordered: Vec<obvhs::triangle::Triangle>,
+}
+
+fn to_ob(t: &Triangle) -> obvhs::triangle::Triangle {
+    let [a, b, c] = t.vertices();
+    obvhs::triangle::Triangle {
+        v0: a.to_array().into(),
+        v1: b.to_array().into(),
+        v2: c.to_array().into(),
+    }
+}
+
+fn to_ob_ray(r: &Ray) -> obvhs::ray::Ray {
+    obvhs::ray::Ray::new_inf(r.origin.to_array().into(), r.dir.to_array().into())
+}
+
+fn build_ob(tris: &[obvhs::triangle::Triangle]) -> obvhs::cwbvh::CwBvh {
+    obvhs::cwbvh::builder::build_cwbvh_from_tris(
+        tris,
+        obvhs::BvhBuildParams::medium_build(),
+        &mut Duration::default(),
+    )
+}
+
+impl Scene {
+    fn new(name: &'static str, tris: Vec<Triangle>) -> Scene {
+        let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
+        let bvh = Bvh::build(&bounds);
+        let tri_bvh = TriangleBvh::new(&tris);
+        let ob_tris: Vec<_> = tris.iter().map(to_ob).collect();
+        let ob = build_ob(&ob_tris);
+        let ob_tris_ordered = ob
+            .primitive_indices
+            .iter()
+            .map(|&i| ob_tris[i as usize])
+            .collect();
+        Scene {
+            name,
+            tris,
+            bvh,
+            tri_bvh,
+            ob,
+            ob_tris,
+            ob_tris_ordered,
+        }
+    }
+}
+
+/// A traversal variant: hits and the sum of hit distances (as a cross-check).
+type Tracer = fn(&Scene, &[Ray]) -> (usize, f64);
+
+fn generic(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        let hit = s.bvh.closest_hit(ray, f32::INFINITY, |p, t| {
+            s.tris[p as usize].intersect(ray, t).map(|h| h.t)
+        });
+        if let Some((t, _)) = black_box(hit) {
+            acc = (acc.0 + 1, acc.1 + t as f64);
+        }
+    }
+    acc
+}
+
+fn generic_pre(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        let tr = TriangleRay::new(ray);
+        let hit = s.bvh.closest_hit(ray, f32::INFINITY, |p, t| {
+            s.tris[p as usize].intersect_pre(&tr, t).map(|h| h.t)
+        });
+        if let Some((t, _)) = black_box(hit) {
+            acc = (acc.0 + 1, acc.1 + t as f64);
+        }
+    }
+    acc
+}
+
+fn triangle_bvh(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        if let Some(h) = black_box(s.tri_bvh.closest_hit(ray, f32::INFINITY)) {
+            acc = (acc.0 + 1, acc.1 + h.t as f64);
+        }
+    }
+    acc
+}
+
+fn shadow(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut n = 0;
+    for ray in rays {
+        let tr = TriangleRay::new(ray);
+        n += usize::from(black_box(s.bvh.any_hit(ray, f32::INFINITY, |p, t| {
+            s.tris[p as usize].intersect_pre(&tr, t).is_some()
+        })));
+    }
+    (n, 0.0)
+}
+
+fn obvhs_indexed(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        let mut hit = obvhs::ray::RayHit::none();
+        let idx = &s.ob.primitive_indices;
+        if black_box(s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
+            s.ob_tris[idx[id] as usize].intersect(r)
+        })) {
+            acc = (acc.0 + 1, acc.1 + hit.t as f64);
+        }
+    }
+    acc
+}
+
+fn obvhs_ordered(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        let mut hit = obvhs::ray::RayHit::none();
+        if black_box(s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
+            s.ob_tris_ordered[id].intersect(r)
+        })) {
+            acc = (acc.0 + 1, acc.1 + hit.t as f64);
+        }
+    }
+    acc
+}
+
+/// The comparison BVH with our (watertight) triangle test, to separate BVH from triangle cost.
+fn obvhs_our_triangle(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        let mut hit = obvhs::ray::RayHit::none();
+        let tr = TriangleRay::new(ray);
+        let idx = &s.ob.primitive_indices;
+        let found = s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
+            s.tris[idx[id] as usize]
+                .intersect_pre(&tr, r.tmax)
+                .map_or(f32::INFINITY, |h| h.t)
+        });
+        if black_box(found) {
+            acc = (acc.0 + 1, acc.1 + hit.t as f64);
+        }
+    }
+    acc
+}
+
+const TRACERS: [(&str, Tracer); 7] = [
+    ("closure", generic),
+    ("closure+pre", generic_pre),
+    ("TriangleBvh", triangle_bvh),
+    ("any_hit", shadow),
+    ("obvhs", obvhs_indexed),
+    ("obvhs-ordered", obvhs_ordered),
+    ("obvhs+our-tri", obvhs_our_triangle),
+];
+
+/// The meshes whose name matches `filter` (or all).
+fn scenes(filter: &str) -> Vec<Scene> {
+    let mut out = Vec::new();
+    if filter.is_empty() || filter.contains("1M") || !filter.contains("37k") {
+        // 2 · 500 · 1000 = 1,000,000 triangles.
+        out.push(Scene::new("bumpy-1M", sphere(500, 1000, 1.0)));
+    }
+    if filter.is_empty() || filter.contains("37k") || !filter.contains("1M") {
+        // 2 · 96 · 192 = 36,864 triangles (the Embree comparison case).
+        out.push(Scene::new("sphere-37k", sphere(96, 192, 0.0)));
+    }
+    out
+}
+
+fn ray_sets(s: &Scene) -> [(&'static str, Vec<Ray>); 2] {
+    let b = mesh_bounds(&s.tris);
+    [
+        ("primary", primary_rays(b, ray_count())),
+        ("incoherent", incoherent_rays(b, ray_count(), 7)),
+    ]
+}
+
+/// CPU time of this thread (Linux schedstat, ns), so numbers survive a machine shared with
+/// other jobs; `None` elsewhere.
+fn thread_cpu_time() -> Option<Duration> {
+    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+    Some(Duration::from_nanos(
+        s.split_whitespace().next()?.parse().ok()?,
+    ))
+}
+
+/// Best wall time and best CPU time of `runs` runs.
+fn best_of<T>(runs: usize, mut f: impl FnMut() -> T) -> (Duration, Duration, T) {
+    let (mut wall, mut cpu) = (Duration::MAX, Duration::MAX);
+    let mut out = None;
+    for _ in 0..runs {
+        let (start, start_cpu) = (Instant::now(), thread_cpu_time());
+        let r = f();
+        wall = wall.min(start.elapsed());
+        if let (Some(a), Some(b)) = (start_cpu, thread_cpu_time()) {
+            cpu = cpu.min(b - a);
+        }
+        out = Some(r);
+    }
+    (wall, cpu, out.expect("at least one run"))
+}
+
+fn quick() {
+    let filter = std::env::var("BVH_BENCH_FILTER").unwrap_or_default();
+    let runs = std::env::var("BVH_BENCH_RUNS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(5);
+    if filter.is_empty() || filter.contains("build") {
+        let tris = sphere(500, 1000, 1.0);
+        let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
+        let (t, _, bvh) = best_of(3, || Bvh::build(&bounds));
+        println!(
+            "build 1M: {:>7.1} ms  ({} threads; {} nodes, depth {})",
+            t.as_secs_f64() * 1e3,
+            rayon::current_num_threads(),
+            bvh.node_count(),
+            bvh.depth()
+        );
+        let (t, _, _) = best_of(3, || TriangleBvh::new(&tris));
+        println!("build 1M TriangleBvh: {:>7.1} ms", t.as_secs_f64() * 1e3);
+        let ob_tris: Vec<_> = tris.iter().map(to_ob).collect();
+        let (t, _, _) = best_of(3, || build_ob(&ob_tris));
+        println!(
+            "build 1M obvhs (medium_build): {:>7.1} ms",
+            t.as_secs_f64() * 1e3
+        );
+    }
+
+    println!(
+        "\nMrays/s, best of {runs}: by wall time, and by this thread's CPU time (robust to load)"
+    );
+    println!("| mesh | rays | variant | Mrays/s wall | Mrays/s cpu | hits | mean t |\n|---|---|---|---|---|---|---|");
+    for s in scenes(&filter) {
+        eprintln!(
+            "{}: {} nodes, depth {}",
+            s.name,
+            s.bvh.node_count(),
+            s.bvh.depth()
+        );
+        for (kind, rays) in ray_sets(&s) {
+            for (name, f) in TRACERS {
+                let label = format!("{}/{kind}/{name}", s.name);
+                if !label.contains(&filter) && !filter.is_empty() {
+                    continue;
+                }
+                let (wall, cpu, (hits, sum)) = best_of(runs, || f(&s, &rays));
+                let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64() / 1e6;
+                println!(
+                    "| {} | {kind} | {name} | {:.2} | {:.2} | {hits} | {:.4} |",
+                    s.name,
+                    rate(wall),
+                    rate(cpu),
+                    sum / hits.max(1) as f64
+                );
+            }
+        }
+    }
+}
+
+fn main() {
+    if std::env::var_os("BVH_BENCH_QUICK").is_some() {
+        quick();
+        return;
+    }
+    let mut c = Criterion::default()
+        .sample_size(10)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(4))
+        .configure_from_args();
+
+    let tris = sphere(500, 1000, 1.0);
+    let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
+    let ob_tris: Vec<_> = tris.iter().map(to_ob).collect();
+    let mut g = c.benchmark_group("build-1M");
+    g.throughput(Throughput::Elements(tris.len() as u64));
+    g.bench_function("Bvh::build", |b| b.iter(|| Bvh::build(black_box(&bounds))));
+    g.bench_function("obvhs-medium", |b| b.iter(|| build_ob(black_box(&ob_tris))));
+    g.finish();
+    drop((tris, bounds, ob_tris));
+
+    for s in scenes("") {
+        for (kind, rays) in ray_sets(&s) {
+            let mut g = c.benchmark_group(format!("{}/{kind}", s.name));
+            g.throughput(Throughput::Elements(rays.len() as u64));
+            for (name, f) in TRACERS {
+                g.bench_with_input(BenchmarkId::from_parameter(name), &rays, |b, rays| {
+                    b.iter(|| f(&s, rays))
+                });
+            }
+            g.finish();
+        }
+    }
+    c.final_summary();
+}

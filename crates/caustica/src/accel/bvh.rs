@@ -1,50 +1,362 @@
-//! Placeholder BVH (brute force), replaced by the real one.
-#![allow(missing_docs)]
-use crate::math::{Aabb, Ray};
+//! Bounding volume hierarchy over arbitrary primitives, given by their bounds.
+//!
+//! Built as a binned-SAH binary tree and collapsed into wide nodes whose child boxes are
+//! stored as structure-of-arrays, so one node visit tests its boxes with SSE arithmetic.
+//! Traversal is near-first with a fixed-size stack; primitives are handed to a caller's
+//! closure (generic, so it inlines).
 
-pub struct Bvh {
-    bounds: Vec<Aabb>,
-    all: Aabb,
+mod build;
+#[cfg(test)]
+mod tests;
+mod triangles;
+
+use glam::Vec4;
+
+use crate::math::{Aabb, Ray, Vec3};
+
+pub use triangles::{TriangleBvh, TriangleBvhHit};
+
+/// Child reference flag: the child is a leaf starting at position `ref & !LEAF` of the leaf order.
+const LEAF: u32 = 1 << 31;
+/// Leaf-order flag: this primitive is the last of its leaf.
+const END: u32 = 1 << 31;
+/// Ize's robust slab-test factor `1 + 2γ(3)`: widens exits so rounding cannot lose a box the
+/// ray touches (flat boxes of axis-aligned triangles included).
+/// Applied to the inverse direction, so it also covers that product's rounding.
+const ROBUST: f32 = 1.0 + 4.0 * f32::EPSILON;
+/// Children per node.
+const WIDTH: usize = 4;
+/// Four-lane vectors per row of child bounds.
+const HALVES: usize = WIDTH / 4;
+/// Stack sizes of the two traversal variants; the small one is used when the tree is shallow
+/// enough (nearly always) because the stack array is initialised on every query.
+const SMALL_STACK: usize = 64;
+const LARGE_STACK: usize = 512;
+
+/// A wide node: child boxes as `[axis][min, max]` rows of lanes, then child references
+/// (inner node index, or `LEAF | first` for leaves). A whole number of cache lines.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+pub(crate) struct Node {
+    bounds: [[[Vec4; HALVES]; 2]; 3],
+    children: [u32; WIDTH],
+    _pad: [u32; WIDTH],
 }
-impl Bvh {
-    pub fn build(prim_bounds: &[Aabb]) -> Bvh {
-        let all = prim_bounds.iter().fold(Aabb::EMPTY, |a, b| a.union(*b));
-        Bvh {
-            bounds: prim_bounds.to_vec(),
-            all,
+
+impl Node {
+    /// Unused slots have inverted infinite boxes, which every slab test rejects.
+    const EMPTY: Node = Node {
+        bounds: [[
+            [Vec4::splat(f32::INFINITY); HALVES],
+            [Vec4::splat(f32::NEG_INFINITY); HALVES],
+        ]; 3],
+        children: [0; WIDTH],
+        _pad: [0; WIDTH],
+    };
+
+    fn set_child(&mut self, slot: usize, min: Vec3, max: Vec3, child: u32) {
+        for axis in 0..3 {
+            self.bounds[axis][0][slot / 4][slot % 4] = min[axis];
+            self.bounds[axis][1][slot / 4][slot % 4] = max[axis];
+        }
+        self.children[slot] = child;
+    }
+
+    /// Box of child `slot` (inverted for unused slots).
+    #[cfg(test)]
+    fn child_box(&self, slot: usize) -> (Vec3, Vec3) {
+        let get = |side: usize| {
+            Vec3::from_array([0, 1, 2].map(|axis| self.bounds[axis][side][slot / 4][slot % 4]))
+        };
+        (get(0), get(1))
+    }
+}
+
+/// Per-ray constants for the slab tests.
+struct RayPre {
+    origin: [Vec4; 3],
+    inv_dir: [Vec4; 3],
+    /// `inv_dir` widened by [`ROBUST`], for exit distances.
+    inv_dir_far: [Vec4; 3],
+    /// Index (0 = min, 1 = max) of the plane entered first on each axis.
+    near: [usize; 3],
+}
+
+impl RayPre {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayPre {
+        // Zero (or denormal) components become the smallest normal float: the inverse stays
+        // finite, so `(plane - origin) * inv` is never 0 · ∞ = NaN.
+        let safe = |d: f32| {
+            if d.abs() < f32::MIN_POSITIVE {
+                f32::MIN_POSITIVE.copysign(d)
+            } else {
+                d
+            }
+        };
+        let inv = [ray.dir.x, ray.dir.y, ray.dir.z].map(|d| 1.0 / safe(d));
+        RayPre {
+            origin: [ray.origin.x, ray.origin.y, ray.origin.z].map(Vec4::splat),
+            inv_dir: inv.map(Vec4::splat),
+            inv_dir_far: inv.map(|i| Vec4::splat(i * ROBUST)),
+            near: inv.map(|i| usize::from(i < 0.0)),
         }
     }
+
+    /// Which of the node's boxes the segment `[0, t_max]` meets (bit per slot), and the entry
+    /// distances. Reductions are balanced trees: traversal is bound by this dependency chain.
+    #[inline(always)]
+    fn hit(&self, node: &Node, t_max: f32) -> (u32, [Vec4; HALVES]) {
+        let [nx, ny, nz] = self.near;
+        let mut mask = 0;
+        let mut t_nears = [Vec4::ZERO; HALVES];
+        for (h, t_near_out) in t_nears.iter_mut().enumerate() {
+            let near = |axis: usize, side: usize| {
+                (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir[axis]
+            };
+            let far = |axis: usize, side: usize| {
+                (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir_far[axis]
+            };
+            let t_near = near(0, nx)
+                .max(near(1, ny))
+                .max(near(2, nz).max(Vec4::ZERO));
+            let t_far = far(0, nx ^ 1)
+                .min(far(1, ny ^ 1))
+                .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
+            mask |= t_near.cmple(t_far).bitmask() << (4 * h);
+            *t_near_out = t_near;
+        }
+        (mask, t_nears)
+    }
+}
+
+/// A bounding volume hierarchy over primitives given by bounding boxes.
+///
+/// Primitives are referred to by their index in the slice passed to [`Bvh::build`].
+/// Primitives with non-finite or empty bounds are left out and never reported.
+#[derive(Clone, Debug)]
+pub struct Bvh {
+    nodes: Vec<Node>,
+    /// Primitive ids in leaf order; `END` marks the last of each leaf.
+    order: Vec<u32>,
+    bounds: Aabb,
+    /// Tree depth, which bounds the traversal stack.
+    depth: u32,
+}
+
+impl Bvh {
+    /// Builds over primitive bounds with binned SAH. Deterministic: the same input gives the
+    /// same tree whatever the thread count.
+    ///
+    /// # Panics
+    /// If there are 2^31 or more primitives.
+    pub fn build(prim_bounds: &[Aabb]) -> Bvh {
+        let c = build::collapse(build::build_bvh2(prim_bounds));
+        Bvh {
+            nodes: c.nodes,
+            order: c.order,
+            bounds: c.bounds,
+            depth: c.depth,
+        }
+    }
+
+    /// Bounds of all hittable primitives (empty if there are none).
     pub fn bounds(&self) -> Aabb {
-        self.all
+        self.bounds
     }
+
+    /// Number of (wide) nodes.
     pub fn node_count(&self) -> usize {
-        1
+        self.nodes.len()
     }
+
+    /// Depth of the tree (0 when empty, 1 for a single node).
+    pub fn depth(&self) -> u32 {
+        self.depth
+    }
+
+    /// Hittable primitive ids in leaf order: primitives stored in this order are visited with
+    /// good locality.
+    pub fn leaf_order(&self) -> impl ExactSizeIterator<Item = u32> + '_ {
+        self.order.iter().map(|&p| p & !END)
+    }
+
+    /// Whether the small traversal stack suffices (each level pushes at most `WIDTH - 1`).
+    #[inline(always)]
+    fn small_stack(&self) -> bool {
+        (WIDTH - 1) * self.depth as usize <= SMALL_STACK
+    }
+
+    /// Closest hit. `intersect(prim, t_max)` tests primitive `prim` (an index into the bounds
+    /// given to [`Bvh::build`]) and returns `Some(t)` if it is hit at `t < t_max` (the closure
+    /// keeps its own hit record). Returns the closest `(t, prim)`.
+    #[inline]
     pub fn closest_hit<F: FnMut(u32, f32) -> Option<f32>>(
         &self,
-        _ray: &Ray,
+        ray: &Ray,
+        t_max: f32,
+        intersect: F,
+    ) -> Option<(f32, u32)> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        if self.small_stack() {
+            self.closest_impl::<SMALL_STACK, F>(ray, t_max, intersect)
+        } else {
+            self.closest_impl::<LARGE_STACK, F>(ray, t_max, intersect)
+        }
+    }
+
+    /// Any-hit / filtered shadow query: calls `visit(prim, t_max)` for primitives whose leaf
+    /// bounds the segment `[0, t_max]` meets; stops and returns `true` as soon as `visit`
+    /// returns `true` (an opaque blocker). Visits each primitive at most once; order unspecified.
+    #[inline]
+    pub fn any_hit<F: FnMut(u32, f32) -> bool>(&self, ray: &Ray, t_max: f32, visit: F) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        if self.small_stack() {
+            self.any_impl::<SMALL_STACK, F>(ray, t_max, visit)
+        } else {
+            self.any_impl::<LARGE_STACK, F>(ray, t_max, visit)
+        }
+    }
+
+    #[inline(always)]
+    fn closest_impl<const N: usize, F: FnMut(u32, f32) -> Option<f32>>(
+        &self,
+        ray: &Ray,
         t_max: f32,
         mut intersect: F,
     ) -> Option<(f32, u32)> {
         let mut best = None;
-        let mut t = t_max;
-        for i in 0..self.bounds.len() as u32 {
-            if let Some(h) = intersect(i, t) {
-                if h < t {
-                    t = h;
-                    best = Some((h, i));
+        let mut t_max = t_max;
+        self.traverse::<N>(ray, &mut t_max, |order, first, t_max| {
+            let mut i = first;
+            loop {
+                let p = order[i];
+                let prim = p & !END;
+                if let Some(t) = intersect(prim, *t_max) {
+                    if t < *t_max {
+                        *t_max = t;
+                        best = Some(prim);
+                    }
+                }
+                if p & END != 0 {
+                    return false;
+                }
+                i += 1;
+            }
+        });
+        best.map(|prim| (t_max, prim))
+    }
+
+    #[inline(always)]
+    fn any_impl<const N: usize, F: FnMut(u32, f32) -> bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut visit: F,
+    ) -> bool {
+        let mut t_max = t_max;
+        self.traverse::<N>(ray, &mut t_max, |order, first, t_max| {
+            let mut i = first;
+            loop {
+                let p = order[i];
+                if visit(p & !END, *t_max) {
+                    return true;
+                }
+                if p & END != 0 {
+                    return false;
+                }
+                i += 1;
+            }
+        })
+    }
+
+    /// Near-first traversal. `leaf(order, first, t_max)` handles the leaf starting at `first`
+    /// and may shrink `t_max`; returning `true` ends the traversal (and this returns `true`).
+    #[inline(always)]
+    fn traverse<const N: usize>(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        mut leaf: impl FnMut(&[u32], usize, &mut f32) -> bool,
+    ) -> bool {
+        // Non-finite rays could turn slab tests into NaN, which min/max would drop.
+        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+            return false;
+        }
+        let r = RayPre::new(ray);
+        let mut stack = [(0u32, 0f32); N];
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            if cur & LEAF == 0 {
+                let node = &self.nodes[cur as usize];
+                let (mask, t_near) = r.hit(node, *t_max);
+                if mask != 0 {
+                    // Most visits hit one or two children: handle those without sorting.
+                    let first = mask.trailing_zeros() as usize % WIDTH;
+                    let rest = mask & (mask - 1);
+                    if rest == 0 {
+                        cur = node.children[first];
+                        continue;
+                    }
+                    let t: [f32; WIDTH] = std::array::from_fn(|i| t_near[i / 4][i % 4]);
+                    if rest & (rest - 1) == 0 {
+                        let second = rest.trailing_zeros() as usize % WIDTH;
+                        let (c0, c1) = (node.children[first], node.children[second]);
+                        let (t0, t1) = (t[first], t[second]);
+                        let (near, far, far_t) = if t1 < t0 { (c1, c0, t0) } else { (c0, c1, t1) };
+                        stack[sp] = (far, far_t);
+                        sp += 1;
+                        cur = near;
+                        continue;
+                    }
+                    // Three or more: insertion-sort keys (distance bits, which order like
+                    // non-negative floats, with the slot in the low bits), farthest first.
+                    let mut keys = [0u32; WIDTH];
+                    let mut count = 0;
+                    let mut m = mask;
+                    while m != 0 {
+                        let slot = m.trailing_zeros();
+                        m &= m - 1;
+                        let key = (t[slot as usize % WIDTH].to_bits() & !(WIDTH as u32 - 1)) | slot;
+                        let mut j = count;
+                        while j > 0 && keys[j - 1] < key {
+                            keys[j] = keys[j - 1];
+                            j -= 1;
+                        }
+                        keys[j % WIDTH] = key;
+                        count += 1;
+                    }
+                    for &key in &keys[..count - 1] {
+                        let slot = (key as usize) % WIDTH;
+                        stack[sp] = (
+                            node.children[slot],
+                            f32::from_bits(key & !(WIDTH as u32 - 1)),
+                        );
+                        sp += 1;
+                    }
+                    cur = node.children[(keys[(count - 1) % WIDTH] as usize) % WIDTH];
+                    continue;
+                }
+            } else if leaf(&self.order, (cur & !LEAF) as usize, t_max) {
+                return true;
+            }
+            // Pop the nearest pending child that can still beat `t_max`.
+            loop {
+                if sp == 0 {
+                    return false;
+                }
+                sp -= 1;
+                let (child, t_near) = stack[sp];
+                if t_near <= *t_max {
+                    cur = child;
+                    break;
                 }
             }
         }
-        best
-    }
-    pub fn any_hit<F: FnMut(u32, f32) -> bool>(&self, _ray: &Ray, t_max: f32, mut visit: F) -> bool {
-        (0..self.bounds.len() as u32).any(|i| visit(i, t_max))
-    }
-    pub fn any_overlap<F: FnMut(u32) -> bool>(&self, query: &Aabb, mut f: F) -> bool {
-        (0..self.bounds.len() as u32).any(|i| {
-            let b = self.bounds[i as usize];
-            b.min.cmple(query.max).all() && b.max.cmpge(query.min).all() && f(i)
-        })
     }
 }

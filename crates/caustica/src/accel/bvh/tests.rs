@@ -1,0 +1,452 @@
+use std::collections::HashSet;
+
+use super::*;
+use crate::geometry::triangle::Triangle;
+
+/// xorshift64*: deterministic and dependency-free.
+struct Rng(u64);
+
+impl Rng {
+    fn f(&mut self) -> f32 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
+    }
+    fn v(&mut self) -> Vec3 {
+        Vec3::new(self.f(), self.f(), self.f())
+    }
+    fn dir(&mut self) -> Vec3 {
+        // Non-unit lengths, and sometimes exactly axis-aligned or with zero components.
+        let mut d = (self.v() - 0.5) * (0.1 + 3.0 * self.f());
+        match (self.f() * 8.0) as u32 {
+            0 => d.x = 0.0,
+            1 => {
+                d.y = 0.0;
+                d.z = 0.0;
+            }
+            2 => d.z = -0.0,
+            _ => {}
+        }
+        d
+    }
+}
+
+/// Random triangles of mixed sizes, with degenerate ones (points, lines, axis-aligned flats,
+/// duplicates) mixed in.
+fn random_triangles(rng: &mut Rng, n: usize) -> Vec<Triangle> {
+    let mut tris = Vec::with_capacity(n);
+    while tris.len() < n {
+        let p = rng.v() * 10.0;
+        let s = if rng.f() < 0.1 { 4.0 } else { 0.6 };
+        let t = match tris.len() % 13 {
+            0 => Triangle::new(p, p, p),
+            1 => Triangle::new(p, p + Vec3::X * s, p + Vec3::X * 2.0 * s),
+            2 => Triangle::new(p, p + Vec3::X * s, p + Vec3::Y * s),
+            3 if !tris.is_empty() => tris[tris.len() - 1],
+            _ => Triangle::new(p, p + (rng.v() - 0.5) * s, p + (rng.v() - 0.5) * s),
+        };
+        tris.push(t);
+    }
+    tris
+}
+
+fn brute_closest(tris: &[Triangle], ray: &Ray, t_max: f32) -> Option<(f32, u32)> {
+    let mut best = None;
+    let mut t_max = t_max;
+    for (i, tri) in tris.iter().enumerate() {
+        if let Some(h) = tri.intersect(ray, t_max) {
+            t_max = h.t;
+            best = Some((h.t, i as u32));
+        }
+    }
+    best
+}
+
+/// Equal, or a near-tie between different primitives (traversal order may pick either).
+fn same_hit(tris: &[Triangle], ray: &Ray, a: Option<(f32, u32)>, b: Option<(f32, u32)>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some((ta, pa)), Some((tb, pb))) => {
+            pa == pb && ta == tb
+                || ((ta - tb).abs() <= 1e-5 * ta.abs().max(1.0)
+                    && tris[pa as usize]
+                        .intersect(ray, f32::INFINITY)
+                        .is_some_and(|h| h.t == ta))
+        }
+        _ => false,
+    }
+}
+
+/// Half the rays are aimed at a random point of a random triangle, so hits are common.
+fn random_ray(rng: &mut Rng, tris: &[Triangle]) -> Ray {
+    let origin = rng.v() * 14.0 - 2.0;
+    if rng.f() < 0.5 {
+        let tri = tris[(rng.f() * tris.len() as f32) as usize % tris.len()];
+        let (u, v) = (rng.f(), rng.f());
+        let (u, v) = if u + v > 1.0 {
+            (1.0 - u, 1.0 - v)
+        } else {
+            (u, v)
+        };
+        Ray::new(origin, (tri.point(u, v) - origin) * (0.2 + rng.f()))
+    } else {
+        Ray::new(origin, rng.dir())
+    }
+}
+
+fn check_against_brute_force(tris: &[Triangle], rng: &mut Rng, rays: usize) {
+    let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
+    let bvh = Bvh::build(&bounds);
+    let tbvh = TriangleBvh::new(tris);
+    let mut hits = 0;
+    for _ in 0..rays {
+        let ray = random_ray(rng, tris);
+        let t_max = if rng.f() < 0.3 {
+            1.0 + rng.f() * 5.0
+        } else {
+            f32::INFINITY
+        };
+        let expect = brute_closest(tris, &ray, t_max);
+        let got = bvh.closest_hit(&ray, t_max, |p, t| {
+            tris[p as usize].intersect(&ray, t).map(|h| h.t)
+        });
+        assert!(
+            same_hit(tris, &ray, got, expect),
+            "closest {ray:?} t_max {t_max}: {got:?} vs {expect:?}"
+        );
+        let fast = tbvh.closest_hit(&ray, t_max).map(|h| (h.t, h.prim));
+        assert!(
+            same_hit(tris, &ray, fast, expect),
+            "triangle bvh {ray:?}: {fast:?} vs {expect:?}"
+        );
+        if let Some(h) = tbvh.closest_hit(&ray, t_max) {
+            let e = tris[h.prim as usize]
+                .intersect(&ray, f32::INFINITY)
+                .unwrap();
+            assert_eq!((h.u, h.v), (e.u, e.v));
+        }
+        hits += usize::from(expect.is_some());
+
+        let mut seen = HashSet::new();
+        let occluded = bvh.any_hit(&ray, t_max, |p, t| {
+            assert!(seen.insert(p), "primitive {p} visited twice");
+            assert_eq!(t, t_max);
+            tris[p as usize].intersect(&ray, t).is_some()
+        });
+        assert_eq!(occluded, expect.is_some(), "any_hit {ray:?}");
+        assert_eq!(
+            tbvh.any_hit(&ray, t_max),
+            expect.is_some(),
+            "triangle any_hit {ray:?}"
+        );
+    }
+    assert!(
+        tris.len() < 3 || hits > rays / 10,
+        "too few hits ({hits}) for a meaningful test"
+    );
+}
+
+#[test]
+fn closest_and_any_hit_match_brute_force() {
+    let mut rng = Rng(0x1234_5678_9abc_def1);
+    for n in [1, 2, 3, 5, 9, 40, 300, 3000] {
+        let tris = random_triangles(&mut rng, n);
+        check_against_brute_force(&tris, &mut rng, if n < 100 { 500 } else { 3000 });
+    }
+}
+
+#[test]
+fn all_identical_boxes() {
+    let mut rng = Rng(7);
+    let t = Triangle::new(
+        Vec3::new(1.0, 1.0, 1.0),
+        Vec3::new(9.0, 2.0, 3.0),
+        Vec3::new(4.0, 9.0, 8.0),
+    );
+    let tris = vec![t; 1000];
+    check_against_brute_force(&tris, &mut rng, 2000);
+    let bvh = Bvh::build(&vec![t.bounds(); 1000]);
+    assert!(bvh.depth() <= 12, "depth {}", bvh.depth());
+}
+
+/// Exponentially spaced primitives make SAH peel one at a time; the depth cap must keep the
+/// traversal stack bounded.
+#[test]
+fn pathological_depth_is_capped() {
+    let mut rng = Rng(99);
+    let tris: Vec<Triangle> = (0..300)
+        .map(|i| {
+            let x = 1.07f32.powi(i) - 1.0;
+            Triangle::new(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x, 1.0, 0.0),
+                Vec3::new(x, 0.0, 1.0),
+            )
+        })
+        .collect();
+    let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
+    let bvh = Bvh::build(&bounds);
+    assert!(bvh.depth() < 80, "depth {}", bvh.depth());
+    for _ in 0..2000 {
+        let o = Vec3::new(-1.0, rng.f(), rng.f());
+        let ray = Ray::new(
+            o,
+            Vec3::new(1.0, (rng.f() - 0.5) * 0.01, (rng.f() - 0.5) * 0.01),
+        );
+        let expect = brute_closest(&tris, &ray, f32::INFINITY);
+        let got = bvh.closest_hit(&ray, f32::INFINITY, |p, t| {
+            tris[p as usize].intersect(&ray, t).map(|h| h.t)
+        });
+        assert!(same_hit(&tris, &ray, got, expect), "{got:?} vs {expect:?}");
+    }
+}
+
+#[test]
+fn empty_and_single() {
+    let ray = Ray::new(Vec3::ZERO, Vec3::X);
+    let empty = Bvh::build(&[]);
+    assert_eq!(empty.node_count(), 0);
+    assert!(empty.bounds().is_empty());
+    assert_eq!(
+        empty.closest_hit(&ray, f32::INFINITY, |_, _| panic!("no primitives")),
+        None
+    );
+    assert!(!empty.any_hit(&ray, f32::INFINITY, |_, _| panic!("no primitives")));
+    assert!(TriangleBvh::new(&[]).closest_hit(&ray, 1.0).is_none());
+
+    let b = Aabb::new(Vec3::new(2.0, -1.0, -1.0), Vec3::new(3.0, 1.0, 1.0));
+    let one = Bvh::build(&[b]);
+    assert_eq!(one.node_count(), 1);
+    assert_eq!(one.bounds(), b);
+    assert_eq!(
+        one.closest_hit(&ray, f32::INFINITY, |p, _| Some(2.5 + p as f32)),
+        Some((2.5, 0))
+    );
+    assert_eq!(
+        one.closest_hit(&ray, 1.5, |_, _| panic!("box is beyond t_max")),
+        None
+    );
+    assert!(one.any_hit(&ray, 10.0, |p, _| p == 0));
+    let back = Ray::new(Vec3::ZERO, -Vec3::X);
+    assert!(!one.any_hit(&back, f32::INFINITY, |_, _| panic!("box is behind the ray")));
+}
+
+#[test]
+fn non_finite_bounds_are_skipped() {
+    let good = Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0));
+    let nan = Aabb {
+        min: Vec3::splat(f32::NAN),
+        max: Vec3::ONE,
+    };
+    let inf = Aabb {
+        min: Vec3::splat(f32::NEG_INFINITY),
+        max: Vec3::splat(f32::INFINITY),
+    };
+    let bounds = [
+        nan,
+        good,
+        inf,
+        Aabb::EMPTY,
+        good,
+        Aabb {
+            min: Vec3::ONE,
+            max: -Vec3::ONE,
+        },
+    ];
+    let bvh = Bvh::build(&bounds);
+    assert_eq!(bvh.bounds(), good);
+    let mut seen = Vec::new();
+    let ray = Ray::new(Vec3::new(-5.0, 0.0, 0.0), Vec3::X);
+    assert!(!bvh.any_hit(&ray, f32::INFINITY, |p, _| {
+        seen.push(p);
+        false
+    }));
+    seen.sort();
+    assert_eq!(seen, [1, 4]);
+    let only_bad = Bvh::build(&[nan, inf, Aabb::EMPTY]);
+    assert_eq!(only_bad.node_count(), 0);
+    assert!(only_bad.bounds().is_empty());
+}
+
+#[test]
+fn odd_rays_do_not_panic_or_hang() {
+    let mut rng = Rng(3);
+    let tris = random_triangles(&mut rng, 500);
+    let tbvh = TriangleBvh::new(&tris);
+    let nasty = [
+        0.0,
+        -0.0,
+        f32::NAN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        1e-40,
+        1e30,
+        5.0,
+    ];
+    for &o in &nasty {
+        for &d in &nasty {
+            for ray in [
+                Ray::new(Vec3::new(o, 5.0, 5.0), Vec3::new(d, 0.0, 1.0)),
+                Ray::new(Vec3::splat(o), Vec3::splat(d)),
+            ] {
+                for t_max in [f32::INFINITY, f32::NAN, -1.0, 0.0, 10.0] {
+                    let _ = tbvh.closest_hit(&ray, t_max);
+                    let _ = tbvh.any_hit(&ray, t_max);
+                }
+            }
+        }
+    }
+    // Zero direction: nothing is hit.
+    assert!(tbvh
+        .closest_hit(&Ray::new(Vec3::splat(5.0), Vec3::ZERO), f32::INFINITY)
+        .is_none());
+}
+
+/// A ray grazing the face of a flat (zero-thickness) box must still find the box.
+#[test]
+fn flat_boxes_are_hit() {
+    let tri = Triangle::new(
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(0.0, 1.0, 1.0),
+    );
+    let bvh = Bvh::build(&[tri.bounds()]);
+    let mut rng = Rng(5);
+    for _ in 0..1000 {
+        let target = tri.point(rng.f() * 0.5, rng.f() * 0.5);
+        let o = target + Vec3::new(rng.f() - 0.5, rng.f() - 0.5, 1.0) * (1.0 + 10.0 * rng.f());
+        let ray = Ray::new(o, target - o);
+        assert!(
+            bvh.closest_hit(&ray, f32::INFINITY, |_, t| tri
+                .intersect(&ray, t)
+                .map(|h| h.t))
+                .is_some(),
+            "{ray:?}"
+        );
+    }
+}
+
+#[test]
+fn closed_mesh_does_not_leak() {
+    let tris = sphere(40, 80);
+    let tbvh = TriangleBvh::new(&tris);
+    let mut rng = Rng(11);
+    for _ in 0..20_000 {
+        let ray = Ray::new((rng.v() - 0.5) * 0.5, rng.dir());
+        if ray.dir == Vec3::ZERO {
+            continue;
+        }
+        assert!(
+            tbvh.closest_hit(&ray, f32::INFINITY).is_some(),
+            "escaped: {ray:?}"
+        );
+    }
+}
+
+fn sphere(rings: usize, segments: usize) -> Vec<Triangle> {
+    let p = |i: usize, j: usize| {
+        let (theta, phi) = (
+            std::f32::consts::PI * i as f32 / rings as f32,
+            std::f32::consts::TAU * (j % segments) as f32 / segments as f32,
+        );
+        Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.sin() * phi.sin(),
+            theta.cos(),
+        )
+    };
+    let mut tris = Vec::new();
+    for i in 0..rings {
+        for j in 0..segments {
+            tris.push(Triangle::new(p(i, j), p(i + 1, j), p(i + 1, j + 1)));
+            tris.push(Triangle::new(p(i, j), p(i + 1, j + 1), p(i, j + 1)));
+        }
+    }
+    tris
+}
+
+#[test]
+fn node_layout() {
+    assert_eq!(std::mem::size_of::<Node>(), 32 * WIDTH);
+    assert_eq!(std::mem::align_of::<Node>(), 64);
+}
+
+fn snapshot(bvh: &Bvh) -> (Vec<u32>, Vec<u32>, u32) {
+    let bits = bvh
+        .nodes
+        .iter()
+        .flat_map(|n| {
+            n.bounds
+                .iter()
+                .flatten()
+                .flatten()
+                .flat_map(|v| v.to_array())
+                .map(f32::to_bits)
+                .chain(n.children)
+        })
+        .collect();
+    (bits, bvh.order.clone(), bvh.depth)
+}
+
+#[test]
+fn build_is_deterministic_across_thread_counts() {
+    let mut rng = Rng(42);
+    // Large enough for parallel subtrees and parallel binning.
+    let bounds: Vec<Aabb> = (0..200_000)
+        .map(|_| {
+            let p = rng.v() * 100.0;
+            Aabb::new(p, p + rng.v())
+        })
+        .collect();
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| snapshot(&Bvh::build(&bounds)))
+    };
+    let one = run(1);
+    assert_eq!(one, run(3));
+    assert_eq!(one, run(2));
+    // Every primitive appears exactly once in the leaf order.
+    let mut ids: Vec<u32> = one.1.iter().map(|p| p & !END).collect();
+    ids.sort_unstable();
+    assert!(ids.iter().copied().eq(0..200_000));
+}
+
+#[test]
+fn bounds_contain_children() {
+    let mut rng = Rng(8);
+    let tris = random_triangles(&mut rng, 5000);
+    let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
+    let bvh = Bvh::build(&bounds);
+    // Walk the tree: each leaf's primitives lie inside the leaf box.
+    let mut stack = vec![0u32];
+    let mut leaves = 0;
+    while let Some(n) = stack.pop() {
+        let node = &bvh.nodes[n as usize];
+        for slot in 0..WIDTH {
+            let (lo, hi) = node.child_box(slot);
+            if lo.x > hi.x {
+                continue;
+            }
+            let c = node.children[slot];
+            if c & LEAF == 0 {
+                stack.push(c);
+                continue;
+            }
+            leaves += 1;
+            let mut i = (c & !LEAF) as usize;
+            loop {
+                let b = bounds[(bvh.order[i] & !END) as usize];
+                assert!(b.min.cmpge(lo).all() && b.max.cmple(hi).all());
+                if bvh.order[i] & END != 0 {
+                    break;
+                }
+                i += 1;
+            }
+        }
+    }
+    assert!(leaves > 5000 / build::MAX_LEAF);
+}
