@@ -44,25 +44,13 @@ fn sphere(rings: usize, segments: usize, bumps: f32) -> Vec<Triangle> {
                 * (0.08 * (9.0 * theta).sin() * (7.0 * phi).cos()
                     + 0.03 * (31.0 * theta + 17.0 * phi).sin()
                     + 0.01 * (97.0 * theta).cos() * (83.0 * phi).sin());
-        Vec3::new(
-            theta.sin() * phi.cos(),
-            theta.sin() * phi.sin(),
-            theta.cos(),
-        ) * r
+        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos()) * r
     };
     let mut tris = Vec::with_capacity(2 * rings * segments);
     for i in 0..rings {
         for j in 0..segments {
-            tris.push(Triangle::new(
-                point(i, j),
-                point(i + 1, j),
-                point(i + 1, j + 1),
-            ));
-            tris.push(Triangle::new(
-                point(i, j),
-                point(i + 1, j + 1),
-                point(i, j + 1),
-            ));
+            tris.push(Triangle::new(point(i, j), point(i + 1, j), point(i + 1, j + 1)));
+            tris.push(Triangle::new(point(i, j), point(i + 1, j + 1), point(i, j + 1)));
         }
     }
     tris
@@ -133,11 +121,7 @@ fn to_ob_ray(r: &Ray) -> obvhs::ray::Ray {
 }
 
 fn build_ob(tris: &[obvhs::triangle::Triangle]) -> obvhs::cwbvh::CwBvh {
-    obvhs::cwbvh::builder::build_cwbvh_from_tris(
-        tris,
-        obvhs::BvhBuildParams::medium_build(),
-        &mut Duration::default(),
-    )
+    obvhs::cwbvh::builder::build_cwbvh_from_tris(tris, obvhs::BvhBuildParams::medium_build(), &mut Duration::default())
 }
 
 impl Scene {
@@ -147,11 +131,7 @@ impl Scene {
         let tri_bvh = TriangleBvh::new(&tris);
         let ob_tris: Vec<_> = tris.iter().map(to_ob).collect();
         let ob = build_ob(&ob_tris);
-        let ob_tris_ordered = ob
-            .primitive_indices
-            .iter()
-            .map(|&i| ob_tris[i as usize])
-            .collect();
+        let ob_tris_ordered = ob.primitive_indices.iter().map(|&i| ob_tris[i as usize]).collect();
         Scene {
             name,
             tris,
@@ -233,9 +213,7 @@ fn obvhs_ordered(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     let mut acc = (0, 0.0);
     for ray in rays {
         let mut hit = obvhs::ray::RayHit::none();
-        if black_box(s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
-            s.ob_tris_ordered[id].intersect(r)
-        })) {
+        if black_box(s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| s.ob_tris_ordered[id].intersect(r))) {
             acc = (acc.0 + 1, acc.1 + hit.t as f64);
         }
     }
@@ -297,9 +275,7 @@ fn ray_sets(s: &Scene) -> [(&'static str, Vec<Ray>); 2] {
 /// other jobs; `None` elsewhere.
 fn thread_cpu_time() -> Option<Duration> {
     let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(Duration::from_nanos(
-        s.split_whitespace().next()?.parse().ok()?,
-    ))
+    Some(Duration::from_nanos(s.split_whitespace().next()?.parse().ok()?))
 }
 
 /// Best wall time and best CPU time of `runs` runs.
@@ -339,23 +315,13 @@ fn quick() {
         println!("build 1M TriangleBvh: {:>7.1} ms", t.as_secs_f64() * 1e3);
         let ob_tris: Vec<_> = tris.iter().map(to_ob).collect();
         let (t, _, _) = best_of(3, || build_ob(&ob_tris));
-        println!(
-            "build 1M obvhs (medium_build): {:>7.1} ms",
-            t.as_secs_f64() * 1e3
-        );
+        println!("build 1M obvhs (medium_build): {:>7.1} ms", t.as_secs_f64() * 1e3);
     }
 
-    println!(
-        "\nMrays/s, best of {runs}: by wall time, and by this thread's CPU time (robust to load)"
-    );
+    println!("\nMrays/s, best of {runs}: by wall time, and by this thread's CPU time (robust to load)");
     println!("| mesh | rays | variant | Mrays/s wall | Mrays/s cpu | hits | mean t |\n|---|---|---|---|---|---|---|");
     for s in scenes(&filter) {
-        eprintln!(
-            "{}: {} nodes, depth {}",
-            s.name,
-            s.bvh.node_count(),
-            s.bvh.depth()
-        );
+        eprintln!("{}: {} nodes, depth {}", s.name, s.bvh.node_count(), s.bvh.depth());
         for (kind, rays) in ray_sets(&s) {
             for (name, f) in TRACERS {
                 let label = format!("{}/{kind}/{name}", s.name);

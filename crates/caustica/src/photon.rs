@@ -85,7 +85,7 @@ impl kd_tree::KdPoint for Photon {
 fn encode_rgbe(c: Vec3) -> [u8; 4] {
     let c = c.max(Vec3::ZERO);
     let m = c.max_element();
-    if !(m > 1e-32) || !m.is_finite() {
+    if m.is_nan() || m <= 1e-32 || !m.is_finite() {
         return [0; 4];
     }
     let mut e = m.log2().floor() as i32 + 1;

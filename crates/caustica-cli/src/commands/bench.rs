@@ -145,7 +145,7 @@ fn run_case(exe: &Path, case: &Case, threads: Option<usize>) -> Result<Summary> 
     let number = |key: &str| -> f64 {
         json.split(&format!("\"{key}\":"))
             .nth(1)
-            .and_then(|rest| rest.split(|c: char| c == ',' || c == '}').next())
+            .and_then(|rest| rest.split([',', '}']).next())
             .and_then(|v| v.trim().parse().ok())
             .unwrap_or(f64::NAN)
     };

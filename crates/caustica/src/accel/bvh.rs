@@ -65,9 +65,7 @@ impl Node {
     /// Box of child `slot` (inverted for unused slots).
     #[cfg(test)]
     fn child_box(&self, slot: usize) -> (Vec3, Vec3) {
-        let get = |side: usize| {
-            Vec3::from_array([0, 1, 2].map(|axis| self.bounds[axis][side][slot / 4][slot % 4]))
-        };
+        let get = |side: usize| Vec3::from_array([0, 1, 2].map(|axis| self.bounds[axis][side][slot / 4][slot % 4]));
         (get(0), get(1))
     }
 }
@@ -111,15 +109,12 @@ impl RayPre {
         let mut mask = 0;
         let mut t_nears = [Vec4::ZERO; HALVES];
         for (h, t_near_out) in t_nears.iter_mut().enumerate() {
-            let near = |axis: usize, side: usize| {
-                (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir[axis]
-            };
+            let near =
+                |axis: usize, side: usize| (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir[axis];
             let far = |axis: usize, side: usize| {
                 (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir_far[axis]
             };
-            let t_near = near(0, nx)
-                .max(near(1, ny))
-                .max(near(2, nz).max(Vec4::ZERO));
+            let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
             let t_far = far(0, nx ^ 1)
                 .min(far(1, ny ^ 1))
                 .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
@@ -222,6 +217,49 @@ impl Bvh {
         }
     }
 
+    /// Calls `visit(prim)` for primitives whose leaf boxes overlap `query`, until `visit` returns
+    /// true; returns whether it did. Visits each primitive at most once; order unspecified.
+    pub fn any_overlap<F: FnMut(u32) -> bool>(&self, query: &Aabb, mut visit: F) -> bool {
+        if self.nodes.is_empty() || query.is_empty() {
+            return false;
+        }
+        let (qmin, qmax) = (query.min.to_array(), query.max.to_array());
+        let mut stack = [0u32; LARGE_STACK * WIDTH];
+        let mut sp = 1usize;
+        stack[0] = 0;
+        while sp > 0 {
+            sp -= 1;
+            let current = stack[sp];
+            if current & LEAF != 0 {
+                let mut i = (current & !LEAF) as usize;
+                loop {
+                    let p = self.order[i];
+                    if visit(p & !END) {
+                        return true;
+                    }
+                    if p & END != 0 {
+                        break;
+                    }
+                    i += 1;
+                }
+                continue;
+            }
+            let node = &self.nodes[current as usize];
+            for slot in 0..WIDTH {
+                let overlaps = (0..3).all(|axis| {
+                    let lo = node.bounds[axis][0][slot / 4][slot % 4];
+                    let hi = node.bounds[axis][1][slot / 4][slot % 4];
+                    lo <= qmax[axis] && hi >= qmin[axis]
+                });
+                if overlaps && sp < stack.len() {
+                    stack[sp] = node.children[slot];
+                    sp += 1;
+                }
+            }
+        }
+        false
+    }
+
     #[inline(always)]
     fn closest_impl<const N: usize, F: FnMut(u32, f32) -> Option<f32>>(
         &self,
@@ -252,12 +290,7 @@ impl Bvh {
     }
 
     #[inline(always)]
-    fn any_impl<const N: usize, F: FnMut(u32, f32) -> bool>(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        mut visit: F,
-    ) -> bool {
+    fn any_impl<const N: usize, F: FnMut(u32, f32) -> bool>(&self, ray: &Ray, t_max: f32, mut visit: F) -> bool {
         let mut t_max = t_max;
         self.traverse::<N>(ray, &mut t_max, |order, first, t_max| {
             let mut i = first;
@@ -333,10 +366,7 @@ impl Bvh {
                     }
                     for &key in &keys[..count - 1] {
                         let slot = (key as usize) % WIDTH;
-                        stack[sp] = (
-                            node.children[slot],
-                            f32::from_bits(key & !(WIDTH as u32 - 1)),
-                        );
+                        stack[sp] = (node.children[slot], f32::from_bits(key & !(WIDTH as u32 - 1)));
                         sp += 1;
                     }
                     cur = node.children[(keys[(count - 1) % WIDTH] as usize) % WIDTH];

@@ -61,10 +61,7 @@ impl TriangleRay {
         TriangleRay {
             k,
             origin: k.map(|i| Vec4::splat(ray.origin[i])),
-            shear: [
-                Vec4::splat(ray.dir[k[0]] / dz),
-                Vec4::splat(ray.dir[k[1]] / dz),
-            ],
+            shear: [Vec4::splat(ray.dir[k[0]] / dz), Vec4::splat(ray.dir[k[1]] / dz)],
             inv_dz: 1.0 / dz,
         }
     }
@@ -188,10 +185,7 @@ mod tests {
         let ray = Ray::new(Vec3::new(0.5, 0.25, 3.0), Vec3::new(0.0, 0.0, -2.0));
         let h = tri().intersect(&ray, f32::INFINITY).unwrap();
         assert!((h.t - 1.5).abs() < 1e-6, "{h:?}");
-        assert!(
-            (h.u - 0.25).abs() < 1e-6 && (h.v - 0.125).abs() < 1e-6,
-            "{h:?}"
-        );
+        assert!((h.u - 0.25).abs() < 1e-6 && (h.v - 0.125).abs() < 1e-6, "{h:?}");
         // Back face, oblique, non-unit direction.
         let o = Vec3::new(-1.0, -2.0, -4.0);
         let target = tri().point(0.3, 0.5);
@@ -207,23 +201,13 @@ mod tests {
     fn misses_outside_behind_beyond_and_parallel() {
         let t = tri();
         let down = Vec3::new(0.0, 0.0, -1.0);
-        assert!(t
-            .intersect(&Ray::new(Vec3::new(1.5, 1.5, 1.0), down), 10.0)
-            .is_none());
-        assert!(t
-            .intersect(&Ray::new(Vec3::new(-0.1, 0.5, 1.0), down), 10.0)
-            .is_none());
+        assert!(t.intersect(&Ray::new(Vec3::new(1.5, 1.5, 1.0), down), 10.0).is_none());
+        assert!(t.intersect(&Ray::new(Vec3::new(-0.1, 0.5, 1.0), down), 10.0).is_none());
         // Behind the origin.
-        assert!(t
-            .intersect(&Ray::new(Vec3::new(0.5, 0.5, -1.0), down), 10.0)
-            .is_none());
+        assert!(t.intersect(&Ray::new(Vec3::new(0.5, 0.5, -1.0), down), 10.0).is_none());
         // Beyond t_max, and exactly at t_max (exclusive).
-        assert!(t
-            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), down), 0.5)
-            .is_none());
-        assert!(t
-            .intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), down), 1.0)
-            .is_none());
+        assert!(t.intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), down), 0.5).is_none());
+        assert!(t.intersect(&Ray::new(Vec3::new(0.5, 0.5, 1.0), down), 1.0).is_none());
         // Parallel above and within the plane.
         assert!(t
             .intersect(&Ray::new(Vec3::new(-1.0, 0.5, 1.0), Vec3::X), 10.0)
@@ -280,18 +264,8 @@ mod tests {
         for j in 0..=n {
             for i in 0..=n {
                 let jitter = |r: &mut Rng| (r.f() - 0.5) * 0.6;
-                let x = i as f32
-                    + if 0 < i && i < n {
-                        jitter(&mut rng)
-                    } else {
-                        0.0
-                    };
-                let y = j as f32
-                    + if 0 < j && j < n {
-                        jitter(&mut rng)
-                    } else {
-                        0.0
-                    };
+                let x = i as f32 + if 0 < i && i < n { jitter(&mut rng) } else { 0.0 };
+                let y = j as f32 + if 0 < j && j < n { jitter(&mut rng) } else { 0.0 };
                 let z = (x * 0.37).sin() * 2.0 + (y * 0.23).cos() * 1.5;
                 verts.push(Vec3::new(x, y, z) * 0.173);
             }
@@ -336,13 +310,10 @@ mod tests {
             for _ in 0..8 {
                 // Steeper than any facet (slopes stay below 0.9), so no ray merely grazes a
                 // silhouette vertex.
-                let dir =
-                    Vec3::new(rng.f() - 0.5, rng.f() - 0.5, -1.2 - rng.f()) * (0.5 + 4.0 * rng.f());
+                let dir = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, -1.2 - rng.f()) * (0.5 + 4.0 * rng.f());
                 let origin = target - dir * (1.0 + 3.0 * rng.f());
                 let ray = Ray::new(origin, target - origin);
-                let hit = tris
-                    .iter()
-                    .any(|t| t.intersect(&ray, f32::INFINITY).is_some());
+                let hit = tris.iter().any(|t| t.intersect(&ray, f32::INFINITY).is_some());
                 assert!(hit, "crack at {target} for ray {ray:?}");
                 tested += 1;
             }

@@ -122,7 +122,7 @@ impl Emitter {
 
     fn finish(kind: Kind, color: Vec3, weights: Vec<f32>, power: f32) -> Option<Emitter> {
         let total: f32 = weights.iter().sum();
-        if !(total > 0.0) || !total.is_finite() || color.max_element() <= 0.0 {
+        if total.is_nan() || total <= 0.0 || !total.is_finite() || color.max_element() <= 0.0 {
             return None;
         }
         let weights: Vec<f32> = weights.iter().map(|w| w / total).collect();

@@ -132,7 +132,7 @@ impl PhotonMap {
             return Vec3::ZERO;
         }
         let max_r = settings.max_radius.unwrap_or(self.auto_radius);
-        if !(max_r > 0.0) {
+        if max_r.is_nan() || max_r <= 0.0 {
             return Vec3::ZERO;
         }
         NEIGHBORS.with(|cell| {
@@ -140,7 +140,7 @@ impl PhotonMap {
             let r2 = self
                 .tree
                 .k_nearest(&self.photons, point, settings.k, max_r * max_r, &mut neighbors);
-            if neighbors.is_empty() || !(r2 > 0.0) {
+            if neighbors.is_empty() || r2.is_nan() || r2 <= 0.0 {
                 return Vec3::ZERO;
             }
             let r = r2.sqrt();

@@ -144,10 +144,7 @@ impl Binner {
         let extent = cb.hi - cb.lo;
         let k = BINS as f32 * (1.0 - 1e-6);
         let scale = Vec4::from_array(extent.to_array().map(|e| if e > 0.0 { k / e } else { 0.0 }));
-        Binner {
-            origin: cb.lo,
-            scale,
-        }
+        Binner { origin: cb.lo, scale }
     }
     #[inline]
     fn bins(&self, c: Vec4) -> [usize; 3] {
@@ -223,10 +220,9 @@ fn range_bounds(refs: &[PrimRef]) -> (Box4, Box4) {
         (b, c)
     };
     if refs.len() >= 4 * BIN_CHUNK {
-        refs.par_chunks(BIN_CHUNK).map(one).reduce(
-            || (Box4::EMPTY, Box4::EMPTY),
-            |x, y| (x.0.union(y.0), x.1.union(y.1)),
-        )
+        refs.par_chunks(BIN_CHUNK)
+            .map(one)
+            .reduce(|| (Box4::EMPTY, Box4::EMPTY), |x, y| (x.0.union(y.0), x.1.union(y.1)))
     } else {
         one(refs)
     }
@@ -256,11 +252,7 @@ pub(super) fn build_bvh2(prim_bounds: &[Aabb]) -> Bvh2 {
         })
     };
     let mut refs: Vec<PrimRef> = if prim_bounds.len() >= 4 * BIN_CHUNK {
-        prim_bounds
-            .par_iter()
-            .enumerate()
-            .filter_map(make)
-            .collect()
+        prim_bounds.par_iter().enumerate().filter_map(make).collect()
     } else {
         prim_bounds.iter().enumerate().filter_map(make).collect()
     };
@@ -326,9 +318,7 @@ fn build_node(
                 nodes[0] = leaf;
                 return;
             }
-            split_at = Some(partition(refs, |r| {
-                binner.bin(r.centroid2(), split.axis) < split.bin
-            }));
+            split_at = Some(partition(refs, |r| binner.bin(r.centroid2(), split.axis) < split.bin));
         }
     }
     let parallel = n >= PARALLEL_MIN;
@@ -417,10 +407,7 @@ fn sort_axis(refs: &mut [PrimRef], axis: usize) {
 
 /// Moves references satisfying `left` to the front; returns how many there are, and the
 /// bounds and centroid bounds of both sides (gathered here to save a pass over the data).
-fn partition(
-    refs: &mut [PrimRef],
-    left: impl Fn(&PrimRef) -> bool,
-) -> (usize, (Box4, Box4), (Box4, Box4)) {
+fn partition(refs: &mut [PrimRef], left: impl Fn(&PrimRef) -> bool) -> (usize, (Box4, Box4), (Box4, Box4)) {
     let (mut i, mut j) = (0, refs.len());
     let (mut lb, mut lc, mut rb, mut rc) = (Box4::EMPTY, Box4::EMPTY, Box4::EMPTY, Box4::EMPTY);
     while i < j {
@@ -503,17 +490,12 @@ fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node>, ids: &mut [u32]) -> u32 {
         k = 2;
         // Open the inner child with the largest area until the node is full.
         while k < WIDTH {
-            let best =
-                (0..k)
-                    .filter(|&s| n2[kids[s]].count == 0)
-                    .fold(None, |best: Option<usize>, s| match best {
-                        Some(b)
-                            if n2[kids[b]].bounds.half_area() >= n2[kids[s]].bounds.half_area() =>
-                        {
-                            Some(b)
-                        }
-                        _ => Some(s),
-                    });
+            let best = (0..k)
+                .filter(|&s| n2[kids[s]].count == 0)
+                .fold(None, |best: Option<usize>, s| match best {
+                    Some(b) if n2[kids[b]].bounds.half_area() >= n2[kids[s]].bounds.half_area() => Some(b),
+                    _ => Some(s),
+                });
             let Some(s) = best else { break };
             let node = n2[kids[s]];
             kids.copy_within(s + 1..k, s + 2);
@@ -535,12 +517,7 @@ fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node>, ids: &mut [u32]) -> u32 {
             depth = depth.max(1 + emit(n2, kid, out, ids));
             index
         };
-        out[me].set_child(
-            slot,
-            node.bounds.lo.truncate(),
-            node.bounds.hi.truncate(),
-            child,
-        );
+        out[me].set_child(slot, node.bounds.lo.truncate(), node.bounds.hi.truncate(), child);
     }
     depth
 }

@@ -84,11 +84,7 @@ fn random_ray(rng: &mut Rng, tris: &[Triangle]) -> Ray {
     if rng.f() < 0.5 {
         let tri = tris[(rng.f() * tris.len() as f32) as usize % tris.len()];
         let (u, v) = (rng.f(), rng.f());
-        let (u, v) = if u + v > 1.0 {
-            (1.0 - u, 1.0 - v)
-        } else {
-            (u, v)
-        };
+        let (u, v) = if u + v > 1.0 { (1.0 - u, 1.0 - v) } else { (u, v) };
         Ray::new(origin, (tri.point(u, v) - origin) * (0.2 + rng.f()))
     } else {
         Ray::new(origin, rng.dir())
@@ -108,9 +104,7 @@ fn check_against_brute_force(tris: &[Triangle], rng: &mut Rng, rays: usize) {
             f32::INFINITY
         };
         let expect = brute_closest(tris, &ray, t_max);
-        let got = bvh.closest_hit(&ray, t_max, |p, t| {
-            tris[p as usize].intersect(&ray, t).map(|h| h.t)
-        });
+        let got = bvh.closest_hit(&ray, t_max, |p, t| tris[p as usize].intersect(&ray, t).map(|h| h.t));
         assert!(
             same_hit(tris, &ray, got, expect),
             "closest {ray:?} t_max {t_max}: {got:?} vs {expect:?}"
@@ -121,9 +115,7 @@ fn check_against_brute_force(tris: &[Triangle], rng: &mut Rng, rays: usize) {
             "triangle bvh {ray:?}: {fast:?} vs {expect:?}"
         );
         if let Some(h) = tbvh.closest_hit(&ray, t_max) {
-            let e = tris[h.prim as usize]
-                .intersect(&ray, f32::INFINITY)
-                .unwrap();
+            let e = tris[h.prim as usize].intersect(&ray, f32::INFINITY).unwrap();
             assert_eq!((h.u, h.v), (e.u, e.v));
         }
         hits += usize::from(expect.is_some());
@@ -135,11 +127,7 @@ fn check_against_brute_force(tris: &[Triangle], rng: &mut Rng, rays: usize) {
             tris[p as usize].intersect(&ray, t).is_some()
         });
         assert_eq!(occluded, expect.is_some(), "any_hit {ray:?}");
-        assert_eq!(
-            tbvh.any_hit(&ray, t_max),
-            expect.is_some(),
-            "triangle any_hit {ray:?}"
-        );
+        assert_eq!(tbvh.any_hit(&ray, t_max), expect.is_some(), "triangle any_hit {ray:?}");
     }
     assert!(
         tris.len() < 3 || hits > rays / 10,
@@ -178,11 +166,7 @@ fn pathological_depth_is_capped() {
     let tris: Vec<Triangle> = (0..300)
         .map(|i| {
             let x = 1.07f32.powi(i) - 1.0;
-            Triangle::new(
-                Vec3::new(x, 0.0, 0.0),
-                Vec3::new(x, 1.0, 0.0),
-                Vec3::new(x, 0.0, 1.0),
-            )
+            Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0))
         })
         .collect();
     let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
@@ -190,10 +174,7 @@ fn pathological_depth_is_capped() {
     assert!(bvh.depth() < 80, "depth {}", bvh.depth());
     for _ in 0..2000 {
         let o = Vec3::new(-1.0, rng.f(), rng.f());
-        let ray = Ray::new(
-            o,
-            Vec3::new(1.0, (rng.f() - 0.5) * 0.01, (rng.f() - 0.5) * 0.01),
-        );
+        let ray = Ray::new(o, Vec3::new(1.0, (rng.f() - 0.5) * 0.01, (rng.f() - 0.5) * 0.01));
         let expect = brute_closest(&tris, &ray, f32::INFINITY);
         let got = bvh.closest_hit(&ray, f32::INFINITY, |p, t| {
             tris[p as usize].intersect(&ray, t).map(|h| h.t)
@@ -223,10 +204,7 @@ fn empty_and_single() {
         one.closest_hit(&ray, f32::INFINITY, |p, _| Some(2.5 + p as f32)),
         Some((2.5, 0))
     );
-    assert_eq!(
-        one.closest_hit(&ray, 1.5, |_, _| panic!("box is beyond t_max")),
-        None
-    );
+    assert_eq!(one.closest_hit(&ray, 1.5, |_, _| panic!("box is beyond t_max")), None);
     assert!(one.any_hit(&ray, 10.0, |p, _| p == 0));
     let back = Ray::new(Vec3::ZERO, -Vec3::X);
     assert!(!one.any_hit(&back, f32::INFINITY, |_, _| panic!("box is behind the ray")));
@@ -274,16 +252,7 @@ fn odd_rays_do_not_panic_or_hang() {
     let mut rng = Rng(3);
     let tris = random_triangles(&mut rng, 500);
     let tbvh = TriangleBvh::new(&tris);
-    let nasty = [
-        0.0,
-        -0.0,
-        f32::NAN,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-        1e-40,
-        1e30,
-        5.0,
-    ];
+    let nasty = [0.0, -0.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e-40, 1e30, 5.0];
     for &o in &nasty {
         for &d in &nasty {
             for ray in [
@@ -318,9 +287,7 @@ fn flat_boxes_are_hit() {
         let o = target + Vec3::new(rng.f() - 0.5, rng.f() - 0.5, 1.0) * (1.0 + 10.0 * rng.f());
         let ray = Ray::new(o, target - o);
         assert!(
-            bvh.closest_hit(&ray, f32::INFINITY, |_, t| tri
-                .intersect(&ray, t)
-                .map(|h| h.t))
+            bvh.closest_hit(&ray, f32::INFINITY, |_, t| tri.intersect(&ray, t).map(|h| h.t))
                 .is_some(),
             "{ray:?}"
         );
@@ -337,10 +304,7 @@ fn closed_mesh_does_not_leak() {
         if ray.dir == Vec3::ZERO {
             continue;
         }
-        assert!(
-            tbvh.closest_hit(&ray, f32::INFINITY).is_some(),
-            "escaped: {ray:?}"
-        );
+        assert!(tbvh.closest_hit(&ray, f32::INFINITY).is_some(), "escaped: {ray:?}");
     }
 }
 
@@ -350,11 +314,7 @@ fn sphere(rings: usize, segments: usize) -> Vec<Triangle> {
             std::f32::consts::PI * i as f32 / rings as f32,
             std::f32::consts::TAU * (j % segments) as f32 / segments as f32,
         );
-        Vec3::new(
-            theta.sin() * phi.cos(),
-            theta.sin() * phi.sin(),
-            theta.cos(),
-        )
+        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
     };
     let mut tris = Vec::new();
     for i in 0..rings {
@@ -400,10 +360,7 @@ fn build_is_deterministic_across_thread_counts() {
         })
         .collect();
     let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| snapshot(&Bvh::build(&bounds)))
     };
     let one = run(1);
@@ -449,4 +406,40 @@ fn bounds_contain_children() {
         }
     }
     assert!(leaves > 5000 / build::MAX_LEAF);
+}
+
+#[test]
+fn box_overlap_query_matches_brute_force() {
+    let mut rng = Rng(99);
+    let tris = random_triangles(&mut rng, 3000);
+    let bounds: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
+    let bvh = Bvh::build(&bounds);
+    for _ in 0..300 {
+        let c = rng.v() * 10.0;
+        let h = Vec3::splat(rng.f() * 2.0);
+        let query = Aabb::new(c - h, c + h);
+        let mut found = HashSet::new();
+        let stopped = bvh.any_overlap(&query, |p| {
+            assert!(found.insert(p), "visited twice");
+            false
+        });
+        assert!(!stopped);
+        let expected: HashSet<u32> = bounds
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| {
+                b.min.is_finite()
+                    && b.max.is_finite()
+                    && b.min.cmple(b.max).all()
+                    && b.min.cmple(query.max).all()
+                    && b.max.cmpge(query.min).all()
+            })
+            .map(|(i, _)| i as u32)
+            .collect();
+        // Leaf boxes may be looser than one primitive's box: everything expected is found.
+        assert!(expected.is_subset(&found));
+        if let Some(&first) = expected.iter().next() {
+            assert!(bvh.any_overlap(&query, |p| p == first));
+        }
+    }
 }

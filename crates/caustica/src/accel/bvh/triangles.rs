@@ -74,8 +74,7 @@ impl TriangleBvh {
         if self.bvh.small_stack() {
             self.bvh.traverse::<SMALL_STACK>(ray, &mut t, leaf)
         } else {
-            self.bvh
-                .traverse::<{ super::LARGE_STACK }>(ray, &mut t, leaf)
+            self.bvh.traverse::<{ super::LARGE_STACK }>(ray, &mut t, leaf)
         }
     }
 

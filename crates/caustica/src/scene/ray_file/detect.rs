@@ -95,7 +95,13 @@ pub(crate) fn parse_auto(text: &str, scene_dir: &Path) -> Result<SceneDescriptio
     };
     match dictionary_dialect::parse(text, scene_dir) {
         Ok(scene) => {
+            // A key close to any keyword of the format is a misspelling in a T file, not an
+            // old modeller's extra key: report it rather than reading the file as dialect O.
+            let misspelt = text
+                .get(t_error.span.clone())
+                .is_some_and(|word| super::suggest::nearest(word, super::keywords::RESERVED.iter().copied()).is_some());
             let stopped_at_ignored_key = t_error.help.is_none()
+                && !misspelt
                 && scene
                     .warnings
                     .iter()
