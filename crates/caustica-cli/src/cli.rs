@@ -133,6 +133,9 @@ pub struct RenderArgs {
     /// Cone filter constant (≥ 1); 0 turns the filter off.
     #[arg(long, default_value_t = 1.1)]
     pub cone_filter: f32,
+    /// Compute the caustic estimate for every sample instead of sharing a pixel's first one.
+    #[arg(long)]
+    pub no_estimate_reuse: bool,
     #[command(flatten)]
     pub scene_args: SceneArgs,
 }

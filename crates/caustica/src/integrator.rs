@@ -61,11 +61,13 @@ pub struct ImageSettings {
 
 const TILE: usize = 16;
 
-/// Renders every pixel with `sample(camera ray's screen point, rng)`, averaging N×N stratified
-/// samples. Returns the film and whether it is complete (false when cancelled).
-pub fn render_tiles<F>(settings: &ImageSettings, control: Control, phase: &str, sample: F) -> (Film, bool)
+/// Renders every pixel with `sample(screen point, rng, pixel state)`, averaging N×N stratified
+/// samples; the state starts as `S::default()` for each pixel and is shared by its samples.
+/// Returns the film and whether it is complete (false when cancelled).
+pub fn render_tiles<S, F>(settings: &ImageSettings, control: Control, phase: &str, sample: F) -> (Film, bool)
 where
-    F: Fn(f32, f32, &mut Rng) -> crate::math::Vec3 + Sync,
+    S: Default,
+    F: Fn(f32, f32, &mut Rng, &mut S) -> crate::math::Vec3 + Sync,
 {
     let (w, h) = (settings.width, settings.height);
     let tiles_x = w.div_ceil(TILE);
@@ -85,6 +87,7 @@ where
             for y in y0..y1 {
                 for x in x0..x1 {
                     let mut rng = Rng::new(settings.seed, (y * w + x) as u64);
+                    let mut state = S::default();
                     let mut sum = crate::math::Vec3::ZERO;
                     for sy in 0..aa {
                         for sx in 0..aa {
@@ -96,7 +99,7 @@ where
                             let px = x as f32 + (sx as f32 + jx) / aa as f32;
                             let py = y as f32 + (sy as f32 + jy) / aa as f32;
                             // Screen y runs upwards; film rows run downwards.
-                            sum += sample(px / w as f32, 1.0 - py / h as f32, &mut rng);
+                            sum += sample(px / w as f32, 1.0 - py / h as f32, &mut rng, &mut state);
                         }
                     }
                     out.push(sum * inv_samples);

@@ -51,6 +51,38 @@ pub enum ObjectRef {
     Mesh(u32),
 }
 
+/// A short list of primitives near a point; past its capacity it only records that it overflowed.
+#[derive(Clone, Debug, Default)]
+pub struct Occluders {
+    prims: [u32; OCCLUDER_CAPACITY],
+    len: usize,
+    overflowed: bool,
+}
+
+/// Few primitives come near one gather; past this many, testing the whole BVH is as cheap.
+const OCCLUDER_CAPACITY: usize = 8;
+
+impl Occluders {
+    fn push(&mut self, prim: u32) {
+        if self.len < OCCLUDER_CAPACITY {
+            self.prims[self.len] = prim;
+            self.len += 1;
+        } else {
+            self.overflowed = true;
+        }
+    }
+
+    /// The primitives found (all of them unless overflowed).
+    pub fn prims(&self) -> &[u32] {
+        &self.prims[..self.len]
+    }
+
+    /// Whether no primitive came near.
+    pub fn is_empty(&self) -> bool {
+        self.len == 0 && !self.overflowed
+    }
+}
+
 /// A scene ready to render.
 pub struct Scene {
     /// The camera.
@@ -303,11 +335,45 @@ impl Scene {
         }
     }
 
-    /// Whether any primitive other than `except` comes within the cube of half-size `r` around
-    /// `point`: only then can something stand between the point and photons gathered nearby.
-    pub fn has_geometry_near(&self, point: Vec3, r: f32, except: u32) -> bool {
+    /// The primitives other than `except` whose bounds come within the cube of half-size `r`
+    /// around `point`: only they can stand between the point and photons gathered nearby.
+    pub fn occluders_near(&self, point: Vec3, r: f32, except: u32) -> Occluders {
         let query = Aabb::new(point - Vec3::splat(r), point + Vec3::splat(r));
-        self.bvh.any_overlap(&query, |prim| prim != except)
+        let mut found = Occluders::default();
+        self.bvh.any_overlap(&query, |prim| {
+            if prim != except {
+                found.push(prim);
+            }
+            found.overflowed
+        });
+        found
+    }
+
+    /// Whether the segment between two surface points misses every primitive in `occluders`
+    /// (every primitive of the scene when the list overflowed); ends are offset as in
+    /// [`Scene::segment_clear`].
+    pub fn segment_clear_of(&self, occluders: &Occluders, a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> bool {
+        if occluders.overflowed {
+            return self.segment_clear(a, a_normal, b, b_normal);
+        }
+        let from = crate::math::offset_along(a, a_normal);
+        let to = crate::math::offset_along(b, b_normal);
+        let d = to - from;
+        let len = d.length();
+        if len <= 0.0 {
+            return true;
+        }
+        let ray = Ray::new(from, d / len);
+        let n_shapes = self.shapes.len() as u32;
+        !occluders.prims().iter().any(|&prim| {
+            if prim < n_shapes {
+                self.shapes[prim as usize].intersect(&ray, len).is_some()
+            } else {
+                self.triangles[(prim - n_shapes) as usize]
+                    .intersect(&ray, len)
+                    .is_some()
+            }
+        })
     }
 
     /// Whether the straight segment between two surface points is free of geometry; each end is

@@ -271,3 +271,43 @@ translate(0, 0, 2, scale(30, square { material = { diffuse = (1, 1, 1); } }))
     assert!(map.stats.cap_reached);
     assert!(map.stats.emitted <= 50_000);
 }
+
+#[test]
+fn sharing_a_pixels_caustic_estimate_changes_the_image_only_slightly() {
+    use caustica::integrator::whitted::{render, WhittedSettings};
+    use caustica::integrator::ImageSettings;
+    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/ring.ray")).unwrap();
+    let scene = common::scene(&text);
+    let map = trace(&scene, photons(100_000), 100);
+    let estimate = EstimateSettings::default();
+    let image = ImageSettings {
+        width: 96,
+        height: 96,
+        aa: 3,
+        seed: 1,
+    };
+    let run = |reuse| {
+        let settings = WhittedSettings {
+            reuse_caustic_estimates: reuse,
+            ..WhittedSettings::default()
+        };
+        render(&scene, Some((&map, &estimate)), &settings, &image, common::control()).0
+    };
+    let (shared, fresh) = (run(true), run(false));
+    let mean = |f: &caustica::film::Film| f.pixels.iter().map(|p| p.element_sum()).sum::<f32>() / f.pixels.len() as f32;
+    let diff: f32 = shared
+        .pixels
+        .iter()
+        .zip(&fresh.pixels)
+        .map(|(a, b)| (*a - *b).abs().element_sum())
+        .sum::<f32>()
+        / shared.pixels.len() as f32;
+    assert!(
+        common::rel(mean(&shared), mean(&fresh)) < 0.005,
+        "{} vs {}",
+        mean(&shared),
+        mean(&fresh)
+    );
+    assert!(diff < 0.01 * mean(&fresh), "mean absolute difference {diff}");
+    assert!(shared != fresh, "the reuse took effect");
+}

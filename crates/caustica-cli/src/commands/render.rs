@@ -93,6 +93,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     };
     let settings = WhittedSettings {
         max_depth: args.depth,
+        reuse_caustic_estimates: !args.no_estimate_reuse,
         ..WhittedSettings::default()
     };
     let t_render = Instant::now();

@@ -16,6 +16,9 @@ pub struct WhittedSettings {
     pub internal_reflection: bool,
     /// Add highlights where a transmissive surface is seen from its back (expected: false).
     pub backface_specular: bool,
+    /// Let a pixel's samples share the caustic estimate of its first hit where that is safe
+    /// (see [`render`]).
+    pub reuse_caustic_estimates: bool,
 }
 
 impl Default for WhittedSettings {
@@ -24,6 +27,7 @@ impl Default for WhittedSettings {
             max_depth: 5,
             internal_reflection: false,
             backface_specular: false,
+            reuse_caustic_estimates: true,
         }
     }
 }
@@ -34,18 +38,19 @@ const MAX_CROSSINGS_PER_SHAPE: usize = 4;
 /// Recursion stops once a path's weight falls below this: it could not change an 8-bit pixel.
 const MIN_PATH_WEIGHT: f32 = 1.0 / 1024.0;
 
-/// Radiance along `ray` (unit direction). `caustic(hit, wo, n)` adds light estimated from photons
-/// at a surface point, given the direction to the viewer and the normal facing it.
+/// Radiance along `ray` (unit direction). `caustic(hit, wo, n, depth)` adds light estimated from
+/// photons at a surface point, given the direction to the viewer, the normal facing it and the
+/// recursion depth (0 for the camera ray's own hit).
 pub fn radiance<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, caustic: &C) -> Vec3
 where
-    C: Fn(&SurfaceHit, Vec3, Vec3) -> Vec3,
+    C: Fn(&SurfaceHit, Vec3, Vec3, u32) -> Vec3,
 {
     trace(scene, settings, ray, 0, Vec3::ONE, caustic)
 }
 
 fn trace<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, depth: u32, weight: Vec3, caustic: &C) -> Vec3
 where
-    C: Fn(&SurfaceHit, Vec3, Vec3) -> Vec3,
+    C: Fn(&SurfaceHit, Vec3, Vec3, u32) -> Vec3,
 {
     let Some(isect) = scene.intersect(ray, f32::INFINITY) else {
         return Vec3::ZERO;
@@ -71,7 +76,7 @@ where
     };
     if local.diffuse != Vec3::ZERO || local.specular != Vec3::ZERO {
         color += direct_light(scene, &hit, &local, n, wo);
-        color += caustic(&hit, wo, n);
+        color += caustic(&hit, wo, n, depth);
     }
 
     if depth >= settings.max_depth {
@@ -159,7 +164,21 @@ pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec
     }
 }
 
+/// The caustic estimate of a pixel's first camera-ray hit, reused by its other samples.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PixelCaustic {
+    entry: Option<(u32, Vec3, f32, Vec3)>,
+}
+
+/// Reuse only within this fraction of the gather radius: the estimate is a kernel average over
+/// that radius, so it barely changes across so small a step.
+const REUSE_FRACTION: f32 = 0.25;
+
 /// Renders the Whitted image, adding the photon map's caustics where a map is given.
+///
+/// With `settings.reuse_caustic_estimates` (see docs/radiometry.md), the samples of one pixel share the caustic estimate of
+/// its first camera-ray hit when they land on the same primitive of a receiver without a
+/// specular lobe, within a quarter of the gather radius; every other estimate is computed afresh.
 pub fn render(
     scene: &Scene,
     caustics: Option<(&crate::photon::PhotonMap, &crate::photon::EstimateSettings)>,
@@ -168,16 +187,42 @@ pub fn render(
     control: super::Control,
 ) -> (crate::film::Film, bool) {
     let camera = &scene.camera;
-    super::render_tiles(image, control, "render", |sx, sy, _rng| {
+    let reuse = settings.reuse_caustic_estimates;
+    super::render_tiles(image, control, "render", |sx, sy, _rng, pixel: &mut PixelCaustic| {
         let ray = camera.generate_ray(sx, sy);
-        match caustics {
-            Some((map, estimate)) => radiance(scene, settings, &ray, &|hit: &SurfaceHit, wo: Vec3, n: Vec3| {
-                if hit.params.diffuse == Vec3::ZERO && hit.params.specular == Vec3::ZERO {
+        let Some((map, estimate)) = caustics else {
+            return radiance(scene, settings, &ray, &|_: &SurfaceHit, _: Vec3, _: Vec3, _: u32| {
+                Vec3::ZERO
+            });
+        };
+        let cache = std::cell::Cell::new(*pixel);
+        let color = radiance(
+            scene,
+            settings,
+            &ray,
+            &|hit: &SurfaceHit, wo: Vec3, n: Vec3, depth: u32| {
+                let p = &hit.params;
+                if p.diffuse == Vec3::ZERO && p.specular == Vec3::ZERO {
                     return Vec3::ZERO;
                 }
-                map.radiance(scene, hit, n, wo, estimate)
-            }),
-            None => radiance(scene, settings, &ray, &|_: &SurfaceHit, _: Vec3, _: Vec3| Vec3::ZERO),
-        }
+                if !reuse || depth > 0 || p.specular != Vec3::ZERO {
+                    return map.radiance(scene, hit, n, wo, estimate);
+                }
+                if let Some((prim, point, r, flux)) = cache.get().entry {
+                    if prim == hit.prim && point.distance(hit.point) <= REUSE_FRACTION * r {
+                        return p.diffuse * flux;
+                    }
+                }
+                let (flux, r) = map.irradiance(scene, hit, n, estimate);
+                if cache.get().entry.is_none() {
+                    cache.set(PixelCaustic {
+                        entry: Some((hit.prim, hit.point, r, flux)),
+                    });
+                }
+                p.diffuse * flux
+            },
+        );
+        *pixel = cache.get();
+        color
     })
 }

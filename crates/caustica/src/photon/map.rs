@@ -126,14 +126,40 @@ impl PhotonMap {
     /// unit normal facing `wo`. Where other geometry comes within the gather radius, photons the
     /// point cannot see in a straight line (behind a wall, across a ring's rim) are left out.
     pub fn radiance(&self, scene: &Scene, hit: &SurfaceHit, n: Vec3, wo: Vec3, settings: &EstimateSettings) -> Vec3 {
-        let point = hit.point;
         let params = &hit.params;
+        self.gather(scene, hit, n, settings, |wi| params.phong_reflectance(n, wo, wi))
+            .0
+    }
+
+    /// Photon flux per area arriving at a surface point from the side `n` faces (the reflected
+    /// radiance of a white Lambertian receiver, kd = 1), and the gather radius used. Multiplied
+    /// by kd it equals [`PhotonMap::radiance`] on any receiver without a specular lobe.
+    pub fn irradiance(&self, scene: &Scene, hit: &SurfaceHit, n: Vec3, settings: &EstimateSettings) -> (Vec3, f32) {
+        self.gather(scene, hit, n, settings, |wi| {
+            if n.dot(wi) > 0.0 {
+                Vec3::ONE
+            } else {
+                Vec3::ZERO
+            }
+        })
+    }
+
+    /// Σ f(ωi) Φ w / (π r² norm) over the accepted photons near `hit`, and the radius r.
+    fn gather(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        n: Vec3,
+        settings: &EstimateSettings,
+        reflectance: impl Fn(Vec3) -> Vec3,
+    ) -> (Vec3, f32) {
+        let point = hit.point;
         if self.photons.is_empty() || settings.k == 0 {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, 0.0);
         }
         let max_r = settings.max_radius.unwrap_or(self.auto_radius);
         if max_r.is_nan() || max_r <= 0.0 {
-            return Vec3::ZERO;
+            return (Vec3::ZERO, 0.0);
         }
         NEIGHBORS.with(|cell| {
             let mut neighbors = cell.borrow_mut();
@@ -141,10 +167,10 @@ impl PhotonMap {
                 .tree
                 .k_nearest(&self.photons, point, settings.k, max_r * max_r, &mut neighbors);
             if neighbors.is_empty() || r2.is_nan() || r2 <= 0.0 {
-                return Vec3::ZERO;
+                return (Vec3::ZERO, 0.0);
             }
             let r = r2.sqrt();
-            let check_visibility = scene.has_geometry_near(point, r, hit.prim);
+            let occluders = scene.occluders_near(point, r, hit.prim);
             let mut sum = Vec3::ZERO;
             for nb in neighbors.iter() {
                 let photon = &self.photons[nb.slot as usize];
@@ -155,12 +181,13 @@ impl PhotonMap {
                 if photon.normal().dot(n) < settings.min_normal_cosine {
                     continue;
                 }
-                let wi = -photon.direction();
-                let f = params.phong_reflectance(n, wo, wi);
+                let f = reflectance(-photon.direction());
                 if f == Vec3::ZERO {
                     continue;
                 }
-                if check_visibility && !scene.segment_clear(point, n, photon.position, photon.normal()) {
+                if !occluders.is_empty()
+                    && !scene.segment_clear_of(&occluders, point, n, photon.position, photon.normal())
+                {
                     continue;
                 }
                 let weight = match settings.cone_filter {
@@ -173,7 +200,7 @@ impl PhotonMap {
                 Some(k) => 1.0 - 2.0 / (3.0 * k),
                 None => 1.0,
             };
-            sum / (PI * r2 * normalisation)
+            (sum / (PI * r2 * normalisation), r)
         })
     }
 
