@@ -164,11 +164,15 @@ pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec
     }
 }
 
-/// The caustic estimate of a pixel's first camera-ray hit, reused by its other samples.
+/// The caustic estimates of a pixel's first sample at each recursion depth (primitive, point,
+/// gather radius, flux per area), reused by its other samples.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct PixelCaustic {
-    entry: Option<(u32, Vec3, f32, Vec3)>,
+    entries: [Option<(u32, Vec3, f32, Vec3)>; CACHED_DEPTHS],
 }
+
+/// Depths whose estimates a pixel keeps: the camera ray's hit and the first mirror bounces.
+const CACHED_DEPTHS: usize = 4;
 
 /// Reuse only within this fraction of the gather radius: the estimate is a kernel average over
 /// that radius, so it barely changes across so small a step.
@@ -176,9 +180,10 @@ const REUSE_FRACTION: f32 = 0.25;
 
 /// Renders the Whitted image, adding the photon map's caustics where a map is given.
 ///
-/// With `settings.reuse_caustic_estimates` (see docs/radiometry.md), the samples of one pixel share the caustic estimate of
-/// its first camera-ray hit when they land on the same primitive of a receiver without a
-/// specular lobe, within a quarter of the gather radius; every other estimate is computed afresh.
+/// With `settings.reuse_caustic_estimates` (see docs/radiometry.md), the samples of one pixel
+/// share the caustic estimate its first sample made at the same recursion depth when they land
+/// on the same primitive of a receiver without a specular lobe, within a quarter of the gather
+/// radius; every other estimate is computed afresh.
 pub fn render(
     scene: &Scene,
     caustics: Option<(&crate::photon::PhotonMap, &crate::photon::EstimateSettings)>,
@@ -205,19 +210,20 @@ pub fn render(
                 if p.diffuse == Vec3::ZERO && p.specular == Vec3::ZERO {
                     return Vec3::ZERO;
                 }
-                if !reuse || depth > 0 || p.specular != Vec3::ZERO {
+                let slot = depth as usize;
+                if !reuse || slot >= CACHED_DEPTHS || p.specular != Vec3::ZERO {
                     return map.radiance(scene, hit, n, wo, estimate);
                 }
-                if let Some((prim, point, r, flux)) = cache.get().entry {
+                let mut entries = cache.get();
+                if let Some((prim, point, r, flux)) = entries.entries[slot] {
                     if prim == hit.prim && point.distance(hit.point) <= REUSE_FRACTION * r {
                         return p.diffuse * flux;
                     }
                 }
                 let (flux, r) = map.irradiance(scene, hit, n, estimate);
-                if cache.get().entry.is_none() {
-                    cache.set(PixelCaustic {
-                        entry: Some((hit.prim, hit.point, r, flux)),
-                    });
+                if entries.entries[slot].is_none() {
+                    entries.entries[slot] = Some((hit.prim, hit.point, r, flux));
+                    cache.set(entries);
                 }
                 p.diffuse * flux
             },
