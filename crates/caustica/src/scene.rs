@@ -199,28 +199,11 @@ impl Scene {
     /// The closest hit in `(0, t_max)`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Intersection> {
-        let n_shapes = self.shapes.len() as u32;
         let mut best: Option<Intersection> = None;
         self.bvh.closest_hit(ray, t_max, |prim, t_max| {
-            if prim < n_shapes {
-                let hit = self.shapes[prim as usize].intersect(ray, t_max)?;
-                best = Some(Intersection {
-                    t: hit.t,
-                    prim,
-                    normal_or_bary: hit.normal,
-                    uv: hit.uv,
-                });
-                Some(hit.t)
-            } else {
-                let hit = self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max)?;
-                best = Some(Intersection {
-                    t: hit.t,
-                    prim,
-                    normal_or_bary: Vec3::new(hit.u, hit.v, 0.0),
-                    uv: Vec2::ZERO,
-                });
-                Some(hit.t)
-            }
+            let hit = self.intersect_prim(prim, ray, t_max)?;
+            best = Some(hit);
+            Some(hit.t)
         })?;
         best
     }
@@ -228,27 +211,32 @@ impl Scene {
     /// Calls `visit(hit)` for each primitive the segment `(0, t_max)` meets (its nearest hit
     /// within the segment), until `visit` returns true; returns whether it did.
     pub fn any_hit(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&Intersection) -> bool) -> bool {
-        let n_shapes = self.shapes.len() as u32;
         self.bvh.any_hit(ray, t_max, |prim, t_max| {
-            let hit = if prim < n_shapes {
-                self.shapes[prim as usize].intersect(ray, t_max).map(|h| Intersection {
-                    t: h.t,
-                    prim,
-                    normal_or_bary: h.normal,
-                    uv: h.uv,
-                })
-            } else {
-                self.triangles[(prim - n_shapes) as usize]
-                    .intersect(ray, t_max)
-                    .map(|h| Intersection {
-                        t: h.t,
-                        prim,
-                        normal_or_bary: Vec3::new(h.u, h.v, 0.0),
-                        uv: Vec2::ZERO,
-                    })
-            };
-            hit.is_some_and(|h| visit(&h))
+            self.intersect_prim(prim, ray, t_max).is_some_and(|h| visit(&h))
         })
+    }
+
+    /// The nearest hit of one primitive (shapes first, then triangles) in `(0, t_max)`.
+    #[inline]
+    fn intersect_prim(&self, prim: u32, ray: &Ray, t_max: f32) -> Option<Intersection> {
+        let n_shapes = self.shapes.len() as u32;
+        if prim < n_shapes {
+            let hit = self.shapes[prim as usize].intersect(ray, t_max)?;
+            Some(Intersection {
+                t: hit.t,
+                prim,
+                normal_or_bary: hit.normal,
+                uv: hit.uv,
+            })
+        } else {
+            let hit = self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max)?;
+            Some(Intersection {
+                t: hit.t,
+                prim,
+                normal_or_bary: Vec3::new(hit.u, hit.v, 0.0),
+                uv: Vec2::ZERO,
+            })
+        }
     }
 
     /// The next crossing of the same primitive beyond `hit` (a closed shape is crossed twice),
@@ -353,41 +341,23 @@ impl Scene {
     /// (every primitive of the scene when the list overflowed); ends are offset as in
     /// [`Scene::segment_clear`].
     pub fn segment_clear_of(&self, occluders: &Occluders, a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> bool {
-        if occluders.overflowed {
-            return self.segment_clear(a, a_normal, b, b_normal);
-        }
-        let from = crate::math::offset_along(a, a_normal);
-        let to = crate::math::offset_along(b, b_normal);
-        let d = to - from;
-        let len = d.length();
-        if len <= 0.0 {
+        let Some((ray, len)) = segment_ray(a, a_normal, b, b_normal) else {
             return true;
+        };
+        if occluders.overflowed {
+            return !self.any_hit(&ray, len, |_| true);
         }
-        let ray = Ray::new(from, d / len);
-        let n_shapes = self.shapes.len() as u32;
-        !occluders.prims().iter().any(|&prim| {
-            if prim < n_shapes {
-                self.shapes[prim as usize].intersect(&ray, len).is_some()
-            } else {
-                self.triangles[(prim - n_shapes) as usize]
-                    .intersect(&ray, len)
-                    .is_some()
-            }
-        })
+        !occluders
+            .prims()
+            .iter()
+            .any(|&prim| self.intersect_prim(prim, &ray, len).is_some())
     }
 
     /// Whether the straight segment between two surface points is free of geometry; each end is
     /// moved off its surface to the side its normal points to (the side it is seen or lit from),
     /// whatever the segment's direction, so a segment along a floor stays above it.
     pub fn segment_clear(&self, a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> bool {
-        let from = crate::math::offset_along(a, a_normal);
-        let to = crate::math::offset_along(b, b_normal);
-        let d = to - from;
-        let len = d.length();
-        if len <= 0.0 {
-            return true;
-        }
-        !self.any_hit(&Ray::new(from, d / len), len, |_| true)
+        segment_ray(a, a_normal, b, b_normal).is_none_or(|(ray, len)| !self.any_hit(&ray, len, |_| true))
     }
 
     /// The material id of an object (a mesh's base material).
@@ -426,4 +396,14 @@ impl Scene {
             ObjectRef::Shape(_) => self.materials[self.object_material(object) as usize].is_specular(),
         }
     }
+}
+
+/// The unit ray from `a` to `b` and its length, each end moved off its surface along its normal;
+/// `None` when the ends coincide.
+fn segment_ray(a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> Option<(Ray, f32)> {
+    let from = crate::math::offset_along(a, a_normal);
+    let to = crate::math::offset_along(b, b_normal);
+    let d = to - from;
+    let len = d.length();
+    (len > 0.0).then(|| (Ray::new(from, d / len), len))
 }
