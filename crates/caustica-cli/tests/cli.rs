@@ -173,3 +173,29 @@ fn the_image_does_not_depend_on_the_thread_count() {
     let two = std::fs::read(dir.join("t2.png")).unwrap();
     assert!(one == two, "1 and 2 threads differ");
 }
+
+#[test]
+fn ctrl_c_saves_the_partial_image_and_exits_130() {
+    let dir = temp_dir("interrupt");
+    let out = dir.join("partial.png");
+    let exe = assert_cmd::cargo::cargo_bin("caustica");
+    // A render long enough to be interrupted: large, many samples.
+    let mut child = std::process::Command::new(exe)
+        .arg("render")
+        .arg(scenes().join("ring.ray"))
+        .arg("-o")
+        .arg(&out)
+        .args(["--width", "1500", "--aa", "6", "--photons", "20000", "--quiet"])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let status = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let code = child.wait().unwrap().code();
+    assert_eq!(code, Some(130), "exit code after Ctrl-C");
+    assert_eq!(png_size(&out), (1500, 1500), "the partial image is complete as a file");
+}
