@@ -10,6 +10,7 @@ mod common;
 
 use caustica::integrator::whitted::{render, WhittedSettings};
 use caustica::integrator::ImageSettings;
+use caustica::photon::{PhotonMap, PhotonSettings};
 use caustica::scene::build::{from_text, BuildSettings};
 use caustica::scene::ray_file::{self, ast::Dialect, ParseOptions};
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -30,10 +31,12 @@ const TOO_SLOW: Duration = Duration::from_secs(5);
 /// A case still running after this is a hang: the watchdog names it and aborts.
 const HANG: Duration = Duration::from_secs(60);
 
+/// Extreme numbers the reader accepts, then ones it must refuse.
 const NUMBERS: &[&str] = &[
-    "1e38", "-1e38", "1e999", "0", "-0", "3.4e38", "-3.4e38", "1e-45", "1e-38", "1e30", "-1e30", "4294967296",
-    "99999999999999999999", "-1", "0.0000001", "nan", "inf", ".", "-", "1e", "1e-999",
+    "1e38", "-1e38", "0", "-0", "3.4e38", "-3.4e38", "1e-45", "1e-38", "1e30", "-1e30", "4294967296",
+    "99999999999999999999", "-1", "0.0000001", "1e-999",
 ];
+const BAD_NUMBERS: &[&str] = &["1e999", "nan", "inf", ".", "-", "1e", "1e+5", "1E5"];
 const GARBAGE: &[&str] = &[
     "(", ")", "{", "}", ",", "=", ";", "\"", "/", "/*", "*/", "//", "+", "-", ".", "e", "E", "\0", "\u{feff}", "é",
     "\u{1F600}", "\r", "\t", "\n", "#", "map(", "material", "name", "SBT-raytracer", "polymesh", "gennormals",
@@ -198,7 +201,11 @@ fn mutate(source: &str, rng: &mut Rng) -> (String, String) {
                     break;
                 }
                 let i = *rng.pick(&numeric);
-                let value = *rng.pick(NUMBERS);
+                let value = if rng.below(6) == 0 {
+                    *rng.pick(BAD_NUMBERS)
+                } else {
+                    *rng.pick(NUMBERS)
+                };
                 p[i] = value;
                 done.push(format!("#{i}={value}"));
             }
@@ -340,7 +347,7 @@ fn fixed_cases() -> Vec<(String, String)> {
         (format!("SBT-raytracer 1.0 {}", "\"".repeat(100_001)), "100,001 quotes".to_string()),
         (format!("SBT-raytracer 1.0 {}", "-".repeat(100_000)), "100,000 minus signs".to_string()),
     ];
-    for n in NUMBERS {
+    for n in NUMBERS.iter().chain(BAD_NUMBERS) {
         cases.push((
             format!("{stage}translate({n}, {n}, {n}, scale({n}, rotate({n}, 1, 0, {n}, sphere {{ material = {{ index = {n}; shininess = {n}; }} }})))"),
             format!("every number {n}"),
@@ -376,9 +383,10 @@ fn sources() -> Vec<(String, String)> {
     out
 }
 
-/// Parses (auto and both forced dialects), builds, and renders a built scene 8×8.
-fn exercise(text: &str, dir: &Path) {
-    let _ = ray_file::parse(text, dir, &ParseOptions::default());
+/// Parses (auto and both forced dialects), builds, and renders a built scene 8×8; returns
+/// whether it parsed and whether it was rendered.
+fn exercise(text: &str, dir: &Path) -> (bool, bool) {
+    let parsed = ray_file::parse(text, dir, &ParseOptions::default()).is_ok();
     for dialect in [Dialect::Tokenizer, Dialect::Dictionary] {
         let _ = ray_file::parse(text, dir, &ParseOptions { dialect: Some(dialect) });
     }
@@ -390,7 +398,16 @@ fn exercise(text: &str, dir: &Path) {
             seed: 0,
         };
         let _ = render(&scene, None, &WhittedSettings::default(), &image, common::control());
+        // A few photons too: emission and aiming meet the same odd geometry.
+        let photons = PhotonSettings {
+            target_stored: 50,
+            max_emitted: 5_000,
+            ..PhotonSettings::default()
+        };
+        let _ = PhotonMap::trace(&scene, &photons, 10, common::control());
+        return (parsed, true);
     }
+    (parsed, false)
 }
 
 fn env_u64(name: &str) -> Option<u64> {
@@ -443,6 +460,7 @@ fn mutated_scenes_never_panic_or_hang() {
     let run_start = Instant::now();
     let mut run = 0u64;
     let mut longest = (Duration::ZERO, String::new());
+    let (mut parsed, mut rendered) = (0u64, 0u64);
     for case in 0..cases + fixed.len() as u64 {
         if budget.is_some_and(|b| run_start.elapsed() > b) {
             break;
@@ -464,6 +482,10 @@ fn mutated_scenes_never_panic_or_hang() {
         let t = Instant::now();
         let result = catch_unwind(AssertUnwindSafe(|| exercise(&text, &dir)));
         let elapsed = t.elapsed();
+        if let Ok((p, r)) = result {
+            parsed += u64::from(p);
+            rendered += u64::from(r);
+        }
         started_ms.store(u64::MAX, Ordering::Relaxed);
         run += 1;
         let used = PEAK.load(Ordering::Relaxed).saturating_sub(base);
@@ -487,7 +509,7 @@ fn mutated_scenes_never_panic_or_hang() {
     }
     std::panic::set_hook(default_hook);
     println!(
-        "fuzz: {run} cases ({} fixed) in {:.1} s from {} scenes, seed {seed:#x}; slowest {:?}: {}",
+        "fuzz: {run} cases ({} fixed; {parsed} parsed, {rendered} built and rendered) in {:.1} s from {} scenes, seed {seed:#x}; slowest {:?}: {}",
         fixed.len(),
         run_start.elapsed().as_secs_f64(),
         sources.len(),
