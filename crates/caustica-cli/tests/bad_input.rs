@@ -165,6 +165,12 @@ fn catalogue() -> Vec<Case> {
             &["cannot read the texture", "garbage.png"],
         )
         .at("4:33"),
+        case(
+            "huge_texture",
+            staged("sphere { material = { diffuse = map(\"huge.png\"); } }\n"),
+            &["cannot read the texture", "is 10000×10000, too large"],
+        )
+        .at("4:33"),
         // Numbers and transforms.
         case("huge_number", staged("translate(1e999, 0, 0, sphere {})\n"), &["out of range"]).at("4:11"),
         case("not_a_number", staged("translate(nan, 0, 0, sphere {})\n"), &["expected a number"]).at("4:11"),
@@ -233,6 +239,33 @@ fn catalogue() -> Vec<Case> {
         )
         .extra(&["--width", "30000"]),
     ]
+}
+
+/// A PNG whose header declares a `w`×`h` 8-bit RGB image and which holds no pixel data.
+fn png_header(w: u32, h: u32) -> Vec<u8> {
+    let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+    let mut ihdr = w.to_be_bytes().to_vec();
+    ihdr.extend(h.to_be_bytes());
+    ihdr.extend([8, 2, 0, 0, 0]);
+    for (kind, data) in [(&b"IHDR"[..], &ihdr[..]), (b"IDAT", &[]), (b"IEND", &[])] {
+        let chunk = [kind, data].concat();
+        png.extend((data.len() as u32).to_be_bytes());
+        png.extend(&chunk);
+        png.extend(crc32(&chunk).to_be_bytes());
+    }
+    png
+}
+
+/// The CRC-32 of PNG chunks (reflected, polynomial 0xEDB88320).
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = (crc >> 1) ^ (0xedb8_8320 & (crc & 1).wrapping_neg());
+        }
+    }
+    !crc
 }
 
 /// The report with miette's wrapping undone: box-drawing margins dropped, whitespace collapsed.
@@ -314,6 +347,7 @@ fn check(dir: &Path, case: &Case) -> Result<(), String> {
 fn every_bad_input_is_refused_with_a_located_message() {
     let dir = temp_dir("catalogue");
     std::fs::write(dir.join("garbage.png"), b"\x89PNG but not really \x00\x01\x02 garbage bytes").unwrap();
+    std::fs::write(dir.join("huge.png"), png_header(10_000, 10_000)).unwrap();
     let failures: Vec<String> = catalogue().iter().filter_map(|c| check(&dir, c).err()).collect();
     assert!(failures.is_empty(), "{} case(s) failed:\n\n{}", failures.len(), failures.join("\n\n"));
 }
