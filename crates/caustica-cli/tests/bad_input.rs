@@ -346,10 +346,19 @@ fn check(dir: &Path, case: &Case) -> Result<(), String> {
 #[test]
 fn every_bad_input_is_refused_with_a_located_message() {
     let dir = temp_dir("catalogue");
-    std::fs::write(dir.join("garbage.png"), b"\x89PNG but not really \x00\x01\x02 garbage bytes").unwrap();
+    std::fs::write(
+        dir.join("garbage.png"),
+        b"\x89PNG but not really \x00\x01\x02 garbage bytes",
+    )
+    .unwrap();
     std::fs::write(dir.join("huge.png"), png_header(10_000, 10_000)).unwrap();
     let failures: Vec<String> = catalogue().iter().filter_map(|c| check(&dir, c).err()).collect();
-    assert!(failures.is_empty(), "{} case(s) failed:\n\n{}", failures.len(), failures.join("\n\n"));
+    assert!(
+        failures.is_empty(),
+        "{} case(s) failed:\n\n{}",
+        failures.len(),
+        failures.join("\n\n")
+    );
 }
 
 #[test]

@@ -33,13 +33,55 @@ const HANG: Duration = Duration::from_secs(60);
 
 /// Extreme numbers the reader accepts, then ones it must refuse.
 const NUMBERS: &[&str] = &[
-    "1e38", "-1e38", "0", "-0", "3.4e38", "-3.4e38", "1e-45", "1e-38", "1e30", "-1e30", "4294967296",
-    "99999999999999999999", "-1", "0.0000001", "1e-999",
+    "1e38",
+    "-1e38",
+    "0",
+    "-0",
+    "3.4e38",
+    "-3.4e38",
+    "1e-45",
+    "1e-38",
+    "1e30",
+    "-1e30",
+    "4294967296",
+    "99999999999999999999",
+    "-1",
+    "0.0000001",
+    "1e-999",
 ];
 const BAD_NUMBERS: &[&str] = &["1e999", "nan", "inf", ".", "-", "1e", "1e+5", "1E5"];
 const GARBAGE: &[&str] = &[
-    "(", ")", "{", "}", ",", "=", ";", "\"", "/", "/*", "*/", "//", "+", "-", ".", "e", "E", "\0", "\u{feff}", "é",
-    "\u{1F600}", "\r", "\t", "\n", "#", "map(", "material", "name", "SBT-raytracer", "polymesh", "gennormals",
+    "(",
+    ")",
+    "{",
+    "}",
+    ",",
+    "=",
+    ";",
+    "\"",
+    "/",
+    "/*",
+    "*/",
+    "//",
+    "+",
+    "-",
+    ".",
+    "e",
+    "E",
+    "\0",
+    "\u{feff}",
+    "é",
+    "\u{1F600}",
+    "\r",
+    "\t",
+    "\n",
+    "#",
+    "map(",
+    "material",
+    "name",
+    "SBT-raytracer",
+    "polymesh",
+    "gennormals",
 ];
 
 /// Live heap bytes and their peak, so a case that allocates from a count in the file is caught.
@@ -363,7 +405,10 @@ fn sources() -> Vec<(String, String)> {
     if corpus.is_dir() {
         dirs.push(corpus);
     } else {
-        println!("note: the corpus at {} is absent; fuzzing the project's scenes only", corpus.display());
+        println!(
+            "note: the corpus at {} is absent; fuzzing the project's scenes only",
+            corpus.display()
+        );
     }
     let mut out = Vec::new();
     for dir in dirs {
@@ -374,7 +419,9 @@ fn sources() -> Vec<(String, String)> {
             .collect();
         files.sort();
         for file in files {
-            let Ok(text) = std::fs::read_to_string(&file) else { continue };
+            let Ok(text) = std::fs::read_to_string(&file) else {
+                continue;
+            };
             if text.len() <= MAX_SOURCE_BYTES {
                 out.push((file.file_name().unwrap().to_string_lossy().into_owned(), text));
             }
@@ -411,7 +458,9 @@ fn exercise(text: &str, dir: &Path) -> (bool, bool) {
 }
 
 fn env_u64(name: &str) -> Option<u64> {
-    std::env::var(name).ok().map(|v| v.parse().unwrap_or_else(|_| panic!("{name} must be a number")))
+    std::env::var(name)
+        .ok()
+        .map(|v| v.parse().unwrap_or_else(|_| panic!("{name} must be a number")))
 }
 
 #[test]
