@@ -6,12 +6,31 @@ use crate::math::Vec3;
 use crate::texture::Texture;
 use std::path::{Path, PathBuf};
 
+/// Largest texture accepted, in pixels (8192 × 4096): a small compressed file can declare a huge
+/// image, and each pixel costs 24 bytes once converted.
+const MAX_TEXTURE_PIXELS: u64 = 1 << 25;
+
 /// Loads a PNG or BMP texture (8 or 16 bits per channel; alpha ignored).
 pub fn load_texture(path: &Path) -> Result<Texture> {
-    let img = image::open(path).map_err(|e| Error::Image {
+    let image_error = |e: image::ImageError| Error::Image {
         path: path.to_path_buf(),
         message: e.to_string(),
-    })?;
+    };
+    // The header's size is checked before anything is decoded.
+    let (w, h) = image::ImageReader::open(path)
+        .map_err(|e| Error::Image {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?
+        .into_dimensions()
+        .map_err(image_error)?;
+    if u64::from(w) * u64::from(h) > MAX_TEXTURE_PIXELS {
+        return Err(Error::Image {
+            path: path.to_path_buf(),
+            message: format!("the image is {w}×{h}, too large: at most {MAX_TEXTURE_PIXELS} pixels are accepted"),
+        });
+    }
+    let img = image::open(path).map_err(image_error)?;
     let rgb = img.to_rgb32f();
     let (w, h) = (rgb.width() as usize, rgb.height() as usize);
     let texels = rgb.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
