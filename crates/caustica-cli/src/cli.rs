@@ -89,6 +89,10 @@ pub struct PhotonOptions {
     /// Emit photons in all directions instead of aiming at mirrors and glass.
     #[arg(long)]
     pub no_aim: bool,
+    /// Largest photon map in MB (photons are 24 bytes, the kd-tree under 1 byte each); larger
+    /// photon counts are refused before any work.
+    #[arg(long, default_value_t = 4096)]
+    pub max_memory: u64,
 }
 
 #[derive(Args, Debug)]

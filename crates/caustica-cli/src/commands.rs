@@ -81,6 +81,14 @@ pub fn photon_settings(options: &PhotonOptions, seed: u64) -> Result<PhotonSetti
         Some(counts) => counts.iter().fold(0usize, |a, b| a.saturating_add(*b)),
         None => options.photons,
     };
+    // 24 bytes a photon plus the tree's node per 8–16 photons; stored counts overshoot by a few.
+    let needed_mb = (total as u64).saturating_mul(25) / 1_000_000;
+    if needed_mb > options.max_memory {
+        return Err(Error::InvalidSettings(format!(
+            "{total} photons need about {needed_mb} MB, more than --max-memory {} MB: store fewer photons or raise the cap",
+            options.max_memory
+        )));
+    }
     if total > MAX_PHOTONS {
         return Err(Error::InvalidSettings(format!(
             "{total} photons would need {} MB; at most {MAX_PHOTONS} photons are accepted",

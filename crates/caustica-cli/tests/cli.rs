@@ -199,3 +199,29 @@ fn ctrl_c_saves_the_partial_image_and_exits_130() {
     assert_eq!(code, Some(130), "exit code after Ctrl-C");
     assert_eq!(png_size(&out), (1500, 1500), "the partial image is complete as a file");
 }
+
+#[test]
+fn max_memory_caps_the_photon_map() {
+    let dir = temp_dir("max-memory");
+    let assert = caustica()
+        .current_dir(&dir)
+        .args(["render", "--photons", "50000000", "--max-memory", "100"])
+        .assert()
+        .code(2);
+    let stderr = String::from_utf8(assert.get_output().stderr.clone()).unwrap();
+    assert!(stderr.contains("--max-memory 100 MB"), "{stderr}");
+    caustica()
+        .current_dir(&dir)
+        .args([
+            "render",
+            "--photons",
+            "2000",
+            "--max-memory",
+            "1",
+            "--width",
+            "16",
+            "--quiet",
+        ])
+        .assert()
+        .success();
+}

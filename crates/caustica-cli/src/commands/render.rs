@@ -42,7 +42,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     };
 
     let t_parse = Instant::now();
-    let scene = load_scene(args.scene.as_deref(), &args.scene_args)?;
+    caustica::integrator::Progress::start(&bars, "load", 1);
+    let scene = load_scene(args.scene.as_deref(), &args.scene_args);
+    caustica::integrator::Progress::finish(&bars);
+    let scene = scene?;
     let parse_seconds = t_parse.elapsed().as_secs_f64();
     if !args.quiet {
         for warning in &scene.warnings {
