@@ -231,7 +231,7 @@ fn catalogue() -> Vec<Case> {
             .at("4:10"),
         // Absurd settings: refused before any memory is committed.
         case("absurd_size", STAGE, &["too large"]).extra(&["--width", "1000000", "--height", "1000000"]),
-        case("absurd_photons", STAGE, &["10000000000 photons would need"]).extra(&["--photons", "10000000000"]),
+        case("absurd_photons", STAGE, &["10000000000 photons need about"]).extra(&["--photons", "10000000000"]),
         case(
             "absurd_aspect",
             "SBT-raytracer 1.0\ncamera { aspectratio = 0.000001; }\n",
