@@ -8,7 +8,7 @@ use super::ast::{
     CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
 };
 use super::cursor::Cursor;
-use super::keywords::{extension_error, COLOUR_FIELDS};
+use super::keywords::{extension_error, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok};
 use super::named_materials::NamedMaterials;
 use super::suggest;
@@ -21,25 +21,6 @@ use std::path::Path;
 
 /// Prefix of the warning for an ignored dictionary key (detection looks for it).
 pub(crate) const IGNORED_KEY: &str = "ignored unknown key";
-
-const TOP_LEVEL: &[&str] = &[
-    "camera",
-    "point_light",
-    "directional_light",
-    "ambient_light",
-    "material",
-    "sphere",
-    "box",
-    "square",
-    "cylinder",
-    "cone",
-    "trimesh",
-    "polymesh",
-    "translate",
-    "scale",
-    "rotate",
-    "transform",
-];
 
 /// Parses a whole dialect-O file.
 pub(crate) fn parse(text: &str, scene_dir: &Path) -> Result<SceneDescription, ParseError> {

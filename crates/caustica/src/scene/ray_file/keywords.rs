@@ -121,3 +121,23 @@ pub(crate) const COLOUR_FIELDS: &[&str] = &[
     "diffuse",
     "transmissive",
 ];
+
+/// Statements that may start an item at the top level of a file (both dialects).
+pub(crate) const TOP_LEVEL: &[&str] = &[
+    "camera",
+    "point_light",
+    "directional_light",
+    "ambient_light",
+    "material",
+    "sphere",
+    "box",
+    "square",
+    "cylinder",
+    "cone",
+    "trimesh",
+    "polymesh",
+    "translate",
+    "scale",
+    "rotate",
+    "transform",
+];

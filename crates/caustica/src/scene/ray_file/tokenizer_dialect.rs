@@ -7,7 +7,7 @@ use super::ast::{
     CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
 };
 use super::cursor::Cursor;
-use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS};
+use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok, Token};
 use super::named_materials::NamedMaterials;
 use super::suggest;
@@ -17,24 +17,6 @@ use crate::ParseError;
 use glam::{Vec2, Vec3, Vec4};
 use std::path::Path;
 
-const TOP_LEVEL: &[&str] = &[
-    "camera",
-    "point_light",
-    "directional_light",
-    "ambient_light",
-    "material",
-    "sphere",
-    "box",
-    "square",
-    "cylinder",
-    "cone",
-    "trimesh",
-    "polymesh",
-    "translate",
-    "scale",
-    "rotate",
-    "transform",
-];
 const ELEMENTS: &[&str] = &[
     "sphere",
     "box",
