@@ -18,7 +18,9 @@ pub enum Command {
   caustica render                                   # the built-in ring scene to caustica.png
   caustica render scenes/lens.ray -o lens.png --aa 3
   caustica render scenes/ring.ray --photons 500000 --k 200 -o ring.exr
-  caustica render scene.ray --photons 0             # plain Whitted, no caustics")]
+  caustica render scene.ray --photons 0             # plain Whitted, no caustics
+  caustica render scene.ray --model physical --passes 256 -o out.exr     # progressive photon mapping
+  caustica render scene.ray --integrator path --time 60 -o reference.exr # path-traced reference")]
     Render(RenderArgs),
     /// Show what was parsed: camera, lights, objects, bounds, materials.
     #[command(after_help = "Examples:
@@ -42,6 +44,40 @@ Examples:
   caustica bench --corpus ../shared/scenes/sbt-corpus   # adds the original project's ring scene"
     )]
     Bench(BenchArgs),
+    /// Merge the partial files of a split progressive run into one image.
+    #[command(after_help = "Passes are independent: parts rendered on several machines with
+`render --passes A..B --partial part.part` merge into exactly the image of one run over all
+passes. Parts of different runs (scene or settings) or sharing a pass are refused.
+
+Examples:
+  caustica render scene.ray --model physical --passes 0..32 --partial a.part
+  caustica render scene.ray --model physical --passes 32..64 --partial b.part
+  caustica merge a.part b.part -o image.exr")]
+    Merge(MergeArgs),
+    /// Compare an EXR image with a reference EXR: region means and relative errors.
+    #[command(
+        after_help = "Regions are inclusive row and column ranges counted from the top-left pixel,
+ROWS,COLS as R0..R1,C0..C1, optionally named NAME=R0..R1,C0..C1. With no region the whole image is compared.
+
+Examples:
+  caustica compare ppm.exr reference.exr
+  caustica compare ppm.exr reference.exr --region caustic=135..139,41..45 --region floor=150..158,60..90"
+    )]
+    Compare(CompareArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct CompareArgs {
+    /// The image to check (.exr).
+    pub image: PathBuf,
+    /// The reference (.exr), of the same size.
+    pub reference: PathBuf,
+    /// A region: [NAME=]R0..R1,C0..C1 (inclusive, from the top-left).
+    #[arg(long)]
+    pub region: Vec<String>,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Args, Debug)]
@@ -99,9 +135,10 @@ pub struct PhotonOptions {
 pub struct RenderArgs {
     /// The .ray scene (default: the built-in ring scene).
     pub scene: Option<PathBuf>,
-    /// Output image; .png (8-bit) or .exr (linear float).
-    #[arg(short, long, default_value = "caustica.png")]
-    pub output: PathBuf,
+    /// Output image; .png (8-bit) or .exr (linear float) [default: caustica.png, or none when
+    /// only a --partial file is asked for].
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
     /// Image width in pixels.
     #[arg(long, default_value_t = 512)]
     pub width: usize,
@@ -111,9 +148,9 @@ pub struct RenderArgs {
     /// N×N stratified, jittered samples per pixel.
     #[arg(long, default_value_t = 1)]
     pub aa: u32,
-    /// Maximum reflection/refraction depth.
-    #[arg(long, default_value_t = 5)]
-    pub depth: u32,
+    /// Maximum reflection/refraction depth [default: 5 for whitted, 64 bounces for path, ppm, gi].
+    #[arg(long)]
+    pub depth: Option<u32>,
     /// Worker threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -141,7 +178,66 @@ pub struct RenderArgs {
     #[arg(long)]
     pub no_estimate_reuse: bool,
     #[command(flatten)]
+    pub progressive: ProgressiveOptions,
+    #[command(flatten)]
     pub scene_args: SceneArgs,
+}
+
+/// The physical model and its integrators.
+#[derive(Args, Debug, Clone)]
+pub struct ProgressiveOptions {
+    /// Shading model: `course` (the .ray look, Whitted) or `physical` (radiometric units,
+    /// inverse-square lights, Fresnel glass, emissive objects as area lights).
+    #[arg(long, value_parser = ["course", "physical"])]
+    pub model: Option<String>,
+    /// Integrator: whitted (course model), or path, ppm, gi (physical model; ppm by default there).
+    #[arg(long, value_parser = ["whitted", "path", "ppm", "gi"])]
+    pub integrator: Option<String>,
+    /// Passes to render: N (passes 0..N) or A..B (passes A to B−1 of a run split across
+    /// machines) [default: 64 unless --time is given].
+    #[arg(long)]
+    pub passes: Option<String>,
+    /// Render passes until this many seconds have passed (at least one pass).
+    #[arg(long)]
+    pub time: Option<f64>,
+    /// Also write the sums of the passes to this file, for `caustica merge`.
+    #[arg(long)]
+    pub partial: Option<PathBuf>,
+    /// Seconds between rewrites of the image while passes run.
+    #[arg(long, default_value_t = 10.0)]
+    pub save_every: f64,
+    /// Exposure in stops for PNG output of the physical model (x·2^E, then x/(1+x), then sRGB).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// ppm: first gather radius in pixels at the gather point (the footprint the blur starts from).
+    #[arg(long, default_value_t = 2.0)]
+    pub footprint: f32,
+    /// Black wherever the camera looks into a mirror or through glass, as in a particle tracer's
+    /// image (for comparing with one).
+    #[arg(long)]
+    pub no_camera_specular: bool,
+    /// ppm: Knaus–Zwicker α in (0, 1); the radius² shrinks by (i + α)/(i + 1) each pass.
+    #[arg(long, default_value_t = 2.0 / 3.0)]
+    pub alpha: f32,
+}
+
+#[derive(Args, Debug)]
+pub struct MergeArgs {
+    /// Partial files written by `render --partial`.
+    #[arg(required = true)]
+    pub parts: Vec<PathBuf>,
+    /// The merged image; .png (tone-mapped) or .exr (linear float).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// Also write the merged sums as a partial file (to merge further later).
+    #[arg(long)]
+    pub partial: Option<PathBuf>,
+    /// Exposure in stops for PNG output.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    pub quiet: bool,
 }
 
 #[derive(Args, Debug)]

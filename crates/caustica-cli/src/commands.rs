@@ -1,8 +1,11 @@
 //! One module per subcommand, plus what they share.
 
 pub mod bench;
+pub mod compare;
 pub mod info;
+pub mod merge;
 pub mod photons;
+pub mod progressive;
 pub mod render;
 
 use crate::cli::{PhotonOptions, SceneArgs};

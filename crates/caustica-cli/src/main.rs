@@ -26,6 +26,8 @@ fn main() -> ExitCode {
         cli::Command::Info(args) => commands::info::run(args),
         cli::Command::Photons(args) => commands::photons::run(args, cancel),
         cli::Command::Bench(args) => commands::bench::run(args),
+        cli::Command::Merge(args) => commands::merge::run(args),
+        cli::Command::Compare(args) => commands::compare::run(args),
     };
     match result {
         Ok(code) => ExitCode::from(code),

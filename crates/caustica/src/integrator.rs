@@ -2,6 +2,11 @@
 //! parallel; each pixel draws from its own random stream (seed, pixel index), so the picture does
 //! not depend on the thread count.
 
+pub mod gi;
+pub mod path;
+pub mod physical;
+pub mod ppm;
+pub mod progressive;
 pub mod whitted;
 
 use crate::camera::Camera;

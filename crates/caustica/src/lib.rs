@@ -8,6 +8,8 @@
 #![warn(missing_docs)]
 
 pub mod accel;
+pub mod area_light;
+pub mod bsdf;
 pub mod camera;
 pub mod error;
 pub mod film;

@@ -6,8 +6,10 @@
 //! form, the receiver's normal in 16-bit octahedral form, and path flags.
 
 pub mod emit;
+pub mod estimate;
 pub mod kd_tree;
 pub mod map;
+pub mod physical;
 pub mod picture;
 pub mod trace;
 

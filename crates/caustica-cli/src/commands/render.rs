@@ -14,12 +14,22 @@ use std::time::Instant;
 
 /// Runs the command; returns the exit code.
 pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
+    if let Some(integrator) = super::progressive::integrator_for(&args.progressive)? {
+        return super::progressive::run(args, integrator, cancel);
+    }
     let start = Instant::now();
-    ImageFormat::from_path(&args.output)?;
+    if args.progressive.partial.is_some() || args.progressive.passes.is_some() || args.progressive.time.is_some() {
+        return Err(Error::InvalidSettings(
+            "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
+        ));
+    }
+    let output = args.output.clone().unwrap_or_else(|| "caustica.png".into());
+    let depth = args.depth.unwrap_or(5);
+    ImageFormat::from_path(&output)?;
     if args.aa == 0 || args.aa > 64 {
         return Err(Error::InvalidSettings("--aa must be between 1 and 64".into()));
     }
-    if args.depth > 64 {
+    if depth > 64 {
         return Err(Error::InvalidSettings("--depth must be at most 64".into()));
     }
     if args.radius.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
@@ -95,7 +105,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         seed: args.seed,
     };
     let settings = WhittedSettings {
-        max_depth: args.depth,
+        max_depth: depth,
         reuse_caustic_estimates: !args.no_estimate_reuse,
         ..WhittedSettings::default()
     };
@@ -103,14 +113,14 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let caustics = map.as_ref().filter(|m| !m.is_empty()).map(|m| (m, &estimate));
     let (film, complete) = pool.install(|| whitted::render(&scene, caustics, &settings, &image, control));
     let render_seconds = t_render.elapsed().as_secs_f64();
-    film.save(&args.output, ToneMap::Clamp)?;
+    film.save(&output, ToneMap::Clamp)?;
 
     let total = start.elapsed().as_secs_f64();
     let stored = map.as_ref().map_or(0, |m| m.stats.stored);
     if args.json {
         println!(
             "{{\"output\":{:?},\"width\":{width},\"height\":{height},\"samples_per_pixel\":{},\"photons_stored\":{stored},\"photons_emitted\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"photons\":{photon_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
-            args.output.display().to_string(),
+            output.display().to_string(),
             args.aa * args.aa,
             map.as_ref().map_or(0, |m| m.stats.emitted),
             super::peak_memory_bytes().map_or("null".to_string(), |b| b.to_string()),
@@ -118,7 +128,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     } else if !args.quiet {
         eprintln!(
             "{} {}×{} at {} spp, {stored} photons — parse {parse_seconds:.2} s, photons {photon_seconds:.2} s, render {render_seconds:.2} s, total {total:.2} s{}",
-            args.output.display(),
+            output.display(),
             width,
             height,
             args.aa * args.aa,

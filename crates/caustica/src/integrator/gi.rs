@@ -1,0 +1,228 @@
+//! Jensen's full photon-mapping method ("Global illumination using photon maps", EGWR 1996),
+//! split into independent passes so that it converges and merges like the other integrators.
+//!
+//! At the first smooth surface a camera path meets (after mirrors and glass): direct light by
+//! next-event estimation, caustics from the caustic map (photons that came by mirrors and glass
+//! only, L S+ D) within a radius that shrinks pass by pass as in progressive photon mapping (a
+//! fixed k-nearest radius would blur a sharp caustic by the same amount forever), and indirect
+//! diffuse light by final gathering: a BSDF-sampled gather ray
+//! follows mirrors and glass to the next smooth surface and reads the global map's radiance
+//! estimate there (photons of every path, direct ones included). The global map's radius starts
+//! where about k photons fall and shrinks like the caustic radius, so the method's bias vanishes
+//! as passes grow instead of staying at the k-nearest blur of one map. Each pass traces its own maps
+//! and one gather ray per pixel, so N passes gather N rays per pixel.
+//!
+//! A gather ray that reaches a light, directly or by a specular chain, adds nothing: next-event
+//! estimation and the caustic map already count those paths.
+
+use super::physical::{direct_light, emitted, Lights};
+use super::ppm::{pixel_angle, InitialRadius, PHOTON_SEED};
+use super::progressive::{radius_factor, sample_pass, Progressive};
+use super::Control;
+use crate::bsdf::{Bsdf, Transport};
+use crate::math::{offset_origin, Ray, Vec3};
+use crate::photon::estimate::DensityMap;
+use crate::photon::physical::{is_caustic, trace};
+use crate::sampling::Rng;
+use crate::scene::Scene;
+
+/// Settings of the photon-map global illumination integrator.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GiSettings {
+    /// Photons emitted per pass (they fill both maps).
+    pub photons_per_pass: u64,
+    /// Photons a global-map estimate holds on average in the first pass (its radius then
+    /// shrinks pass by pass like the caustic radius).
+    pub k_global: usize,
+    /// Caustic-map gather radius of the first pass; it shrinks like progressive photon mapping's.
+    pub caustic_radius: InitialRadius,
+    /// Knaus & Zwicker's α for the caustic radius.
+    pub alpha: f32,
+    /// Longest specular chain, and longest photon path.
+    pub max_depth: u32,
+    /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
+    /// through glass is black, as in a particle tracer's image — for comparing with one).
+    pub specular_camera_paths: bool,
+}
+
+impl Default for GiSettings {
+    fn default() -> Self {
+        GiSettings {
+            photons_per_pass: 200_000,
+            k_global: 50,
+            caustic_radius: InitialRadius::Pixels(2.0),
+            alpha: 2.0 / 3.0,
+            max_depth: 64,
+            specular_camera_paths: true,
+        }
+    }
+}
+
+/// One pass's two maps and their largest gather radii.
+pub struct GiMaps {
+    /// Every stored photon.
+    pub global: DensityMap,
+    /// Photons that came by mirrors and glass only.
+    pub caustic: DensityMap,
+    /// Twice the typical distance to the k-th nearest global photon.
+    global_radius: f32,
+    /// This pass's shrink factor of the gather radii.
+    caustic_factor: f32,
+}
+
+/// The integrator over a whole image.
+pub struct Gi<'a> {
+    scene: &'a Scene,
+    lights: Lights,
+    settings: GiSettings,
+    width: usize,
+    height: usize,
+    seed: u64,
+    pixel_angle: f32,
+}
+
+impl<'a> Gi<'a> {
+    /// A renderer for `scene` at `width`×`height`.
+    pub fn new(scene: &'a Scene, settings: GiSettings, width: usize, height: usize, seed: u64) -> Gi<'a> {
+        Gi {
+            scene,
+            lights: Lights::new(scene),
+            settings,
+            width,
+            height,
+            seed,
+            pixel_angle: pixel_angle(&scene.camera, height),
+        }
+    }
+
+    /// The maps of pass `pass`.
+    pub fn maps(&self, pass: u64, control: Control) -> GiMaps {
+        let photons = trace(
+            self.scene,
+            &self.lights,
+            self.settings.photons_per_pass,
+            self.seed ^ PHOTON_SEED,
+            pass,
+            self.settings.max_depth,
+            control,
+        );
+        let caustic: Vec<_> = photons.iter().copied().filter(is_caustic).collect();
+        let global = DensityMap::new(photons);
+        let caustic = DensityMap::new(caustic);
+        // Largest radii: past these a k-NN estimate reaches across the scene for nothing.
+        let global_radius = global.typical_radius(self.settings.k_global) * 2.0;
+        GiMaps {
+            global,
+            caustic,
+            global_radius,
+            caustic_factor: radius_factor(pass, self.settings.alpha),
+        }
+    }
+
+    fn radiance(&self, maps: &GiMaps, ray: Ray, rng: &mut Rng) -> Vec3 {
+        let scene = self.scene;
+        let s = &self.settings;
+        let mut ray = ray;
+        let mut beta = Vec3::ONE;
+        let mut l = Vec3::ZERO;
+        let mut path_length = 0.0f32;
+        for depth in 0..=s.max_depth {
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            let hit = scene.surface(&ray, &isect);
+            path_length += isect.t;
+            let wo = -ray.dir;
+            l += beta * emitted(&hit);
+            let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+            if bsdf.is_black() {
+                break;
+            }
+            if bsdf.is_smooth() {
+                l += beta * direct_light(scene, &self.lights, &hit, &bsdf, wo, false, rng);
+                let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
+                l += beta * maps.caustic.radiance_within(hit.point, &bsdf, wo, r);
+            }
+            if depth == s.max_depth {
+                break;
+            }
+            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
+                break;
+            };
+            let origin = offset_origin(hit.point, hit.geometric_normal, sample.wi);
+            if sample.specular {
+                if depth == 0 && !s.specular_camera_paths {
+                    break;
+                }
+                beta *= sample.weight;
+                ray = Ray::new(origin, sample.wi);
+                continue;
+            }
+            l += beta * sample.weight * self.gather(maps, Ray::new(origin, sample.wi), path_length, rng, 0);
+            break;
+        }
+        l
+    }
+
+    /// Light arriving along a gather ray, emission excluded: the global map's estimate at the
+    /// smooth surface it reaches through mirrors and glass. Where that surface is closer than
+    /// the global map's gather radius (corners, contact shadows) the map's blur would show, so
+    /// up to [`EXACT_LEVELS`] times the light there is computed like at the first surface instead.
+    fn gather(&self, maps: &GiMaps, ray: Ray, path_length: f32, rng: &mut Rng, level: u32) -> Vec3 {
+        let scene = self.scene;
+        let s = &self.settings;
+        let mut ray = ray;
+        let mut beta = Vec3::ONE;
+        let mut path_length = path_length;
+        let mut segment = 0.0f32;
+        for _ in 0..=s.max_depth {
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            let hit = scene.surface(&ray, &isect);
+            path_length += isect.t;
+            segment += isect.t;
+            let wo = -ray.dir;
+            let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+            if bsdf.is_black() {
+                break;
+            }
+            if bsdf.is_smooth() {
+                if level >= EXACT_LEVELS || segment > maps.global_radius {
+                    let r = maps.global_radius * 0.5 * maps.caustic_factor;
+                    return beta * maps.global.radiance_within(hit.point, &bsdf, wo, r);
+                }
+                let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
+                let mut l = direct_light(scene, &self.lights, &hit, &bsdf, wo, false, rng);
+                l += maps.caustic.radiance_within(hit.point, &bsdf, wo, r);
+                if let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) {
+                    let next = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+                    l += sample.weight * self.gather(maps, next, path_length, rng, level + 1);
+                }
+                return beta * l;
+            }
+            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
+                break;
+            };
+            beta *= sample.weight;
+            ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+        }
+        Vec3::ZERO
+    }
+}
+
+/// Gather bounces computed exactly, rather than read from the global map, for close surfaces.
+const EXACT_LEVELS: u32 = 2;
+
+impl Progressive for Gi<'_> {
+    fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
+        let maps = self.maps(pass, control);
+        if control.cancelled() {
+            return None;
+        }
+        let camera = &self.scene.camera;
+        sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
+            self.radiance(&maps, camera.generate_ray(sx, sy), rng)
+        })
+    }
+}

@@ -1,0 +1,132 @@
+//! A unidirectional path tracer with next-event estimation and multiple importance sampling
+//! (power heuristic): the reference the photon-mapping integrators are checked against.
+//!
+//! It cannot see caustics of point or directional lights (a path can never hit a delta light
+//! after a mirror or through glass); that is what photon mapping is for.
+
+use super::physical::{direct_light, emitted, power_heuristic, Lights};
+use crate::bsdf::{Bsdf, Transport};
+use crate::math::{offset_origin, Ray, Vec3};
+use crate::sampling::Rng;
+use crate::scene::Scene;
+
+/// Settings of the path tracer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathSettings {
+    /// Longest path, in bounces.
+    pub max_depth: u32,
+    /// Bounces before Russian roulette may end a path.
+    pub roulette_depth: u32,
+    /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
+    /// through glass is black, as in a particle tracer's image — for comparing with one).
+    pub specular_camera_paths: bool,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings {
+            max_depth: 64,
+            roulette_depth: 3,
+            specular_camera_paths: true,
+        }
+    }
+}
+
+/// Radiance arriving along `ray` (unit direction).
+pub fn radiance(scene: &Scene, lights: &Lights, settings: &PathSettings, ray: Ray, rng: &mut Rng) -> Vec3 {
+    let mut ray = ray;
+    let mut l = Vec3::ZERO;
+    let mut beta = Vec3::ONE;
+    // The last bounce's pdf and point, for weighting emitters that BSDF sampling hits.
+    let mut specular = true;
+    let mut last_pdf = 0.0f32;
+    let mut last_point = ray.origin;
+    for depth in 0..=settings.max_depth {
+        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+            break;
+        };
+        let hit = scene.surface(&ray, &isect);
+        let wo = -ray.dir;
+        let le = emitted(&hit);
+        if le != Vec3::ZERO {
+            let weight = if specular {
+                1.0
+            } else {
+                power_heuristic(last_pdf, lights.pdf_direct(last_point, &hit))
+            };
+            l += beta * le * weight;
+        }
+        if depth == settings.max_depth {
+            break;
+        }
+        let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+        if bsdf.is_black() {
+            break;
+        }
+        if bsdf.is_smooth() {
+            l += beta * direct_light(scene, lights, &hit, &bsdf, wo, true, rng);
+        }
+        let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
+            break;
+        };
+        if depth == 0 && sample.specular && !settings.specular_camera_paths {
+            break;
+        }
+        beta *= sample.weight;
+        specular = sample.specular;
+        last_pdf = sample.pdf;
+        last_point = hit.point;
+        if depth + 1 >= settings.roulette_depth {
+            let q = beta.max_element().min(0.95);
+            if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                break;
+            }
+            beta /= q;
+        }
+        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+    }
+    if l.is_finite() {
+        l
+    } else {
+        Vec3::ZERO
+    }
+}
+
+/// The path tracer over a whole image, one sample per pixel per pass.
+pub struct PathTracer<'a> {
+    scene: &'a Scene,
+    lights: Lights,
+    settings: PathSettings,
+    width: usize,
+    height: usize,
+    seed: u64,
+}
+
+impl<'a> PathTracer<'a> {
+    /// A path tracer for `scene` at `width`×`height`.
+    pub fn new(scene: &'a Scene, settings: PathSettings, width: usize, height: usize, seed: u64) -> PathTracer<'a> {
+        PathTracer {
+            scene,
+            lights: Lights::new(scene),
+            settings,
+            width,
+            height,
+            seed,
+        }
+    }
+}
+
+impl super::progressive::Progressive for PathTracer<'_> {
+    fn render_pass(&self, pass: u64, control: super::Control) -> Option<Vec<Vec3>> {
+        let camera = &self.scene.camera;
+        super::progressive::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
+            radiance(
+                self.scene,
+                &self.lights,
+                &self.settings,
+                camera.generate_ray(sx, sy),
+                rng,
+            )
+        })
+    }
+}

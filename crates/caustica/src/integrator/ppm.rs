@@ -1,0 +1,178 @@
+//! Progressive photon mapping in Knaus & Zwicker's probabilistic form ("Progressive photon
+//! mapping: a probabilistic approach", TOG 2011): every pass is an independent photon-mapping
+//! render whose gather radius shrinks with the pass index, r²ᵢ₊₁ = r²ᵢ (i + α)/(i + 1), and the
+//! image is the mean of the passes. Bias and variance both vanish as passes grow, so the mean
+//! converges to the true image — caustics of point lights included.
+//!
+//! Per pass: photons from every light are traced and stored on smooth surfaces after at least
+//! one bounce; camera paths follow mirrors and glass to their first smooth surface, where direct
+//! light comes from next-event estimation and everything else (caustics, indirect diffuse light)
+//! from the photons within the pass's radius.
+
+use super::physical::{direct_light, emitted, Lights};
+use super::progressive::{radius_factor, sample_pass, Progressive};
+use super::Control;
+use crate::bsdf::{Bsdf, Transport};
+use crate::math::{offset_origin, Ray, Vec3};
+use crate::photon::estimate::DensityMap;
+use crate::photon::physical::{is_direct, trace};
+use crate::sampling::Rng;
+use crate::scene::Scene;
+
+/// How the first pass's gather radius is chosen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InitialRadius {
+    /// This many pixels wide where the camera path meets the surface (its footprint), so the
+    /// blur starts at a size the user sees and shrinks from there.
+    Pixels(f32),
+    /// A fixed radius in scene units.
+    World(f32),
+}
+
+impl InitialRadius {
+    /// The first pass's radius at a point `path_length` from the eye along the camera path,
+    /// for pixels `pixel_angle` wide at unit distance.
+    pub fn at(self, pixel_angle: f32, path_length: f32) -> f32 {
+        match self {
+            InitialRadius::Pixels(px) => px * pixel_angle * path_length,
+            InitialRadius::World(r) => r,
+        }
+    }
+}
+
+/// Width of a pixel at unit distance from the eye, `height` pixels high.
+pub fn pixel_angle(camera: &crate::camera::Camera, height: usize) -> f32 {
+    camera.v.length() / camera.look.length().max(1e-30) / height.max(1) as f32
+}
+
+/// Settings of progressive photon mapping.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PpmSettings {
+    /// Photons emitted per pass.
+    pub photons_per_pass: u64,
+    /// Knaus & Zwicker's α in (0, 1): the share of the radius reduction kept per pass.
+    pub alpha: f32,
+    /// Radius of the first pass.
+    pub initial_radius: InitialRadius,
+    /// Longest specular chain from the camera, and longest photon path.
+    pub max_depth: u32,
+    /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
+    /// through glass is black, as in a particle tracer's image — for comparing with one).
+    pub specular_camera_paths: bool,
+}
+
+impl Default for PpmSettings {
+    fn default() -> Self {
+        PpmSettings {
+            photons_per_pass: 200_000,
+            alpha: 2.0 / 3.0,
+            initial_radius: InitialRadius::Pixels(2.0),
+            max_depth: 64,
+            specular_camera_paths: true,
+        }
+    }
+}
+
+/// Seed offset that separates photon streams from camera streams.
+pub(crate) const PHOTON_SEED: u64 = 0x70_686f_746f_6e73;
+
+/// The progressive photon mapper over a whole image.
+pub struct Ppm<'a> {
+    scene: &'a Scene,
+    lights: Lights,
+    settings: PpmSettings,
+    width: usize,
+    height: usize,
+    seed: u64,
+    /// Width of a pixel at unit distance from the eye.
+    pixel_angle: f32,
+}
+
+impl<'a> Ppm<'a> {
+    /// A renderer for `scene` at `width`×`height`.
+    pub fn new(scene: &'a Scene, settings: PpmSettings, width: usize, height: usize, seed: u64) -> Ppm<'a> {
+        let pixel_angle = pixel_angle(&scene.camera, height);
+        Ppm {
+            scene,
+            lights: Lights::new(scene),
+            settings,
+            width,
+            height,
+            seed,
+            pixel_angle,
+        }
+    }
+
+    /// The photons of pass `pass` that the estimate uses (all but direct ones).
+    pub fn photon_map(&self, pass: u64, control: Control) -> DensityMap {
+        let mut photons = trace(
+            self.scene,
+            &self.lights,
+            self.settings.photons_per_pass,
+            self.seed ^ PHOTON_SEED,
+            pass,
+            self.settings.max_depth,
+            control,
+        );
+        photons.retain(|p| !is_direct(p));
+        DensityMap::new(photons)
+    }
+
+    /// Radiance along a camera ray with the photons of one pass.
+    fn radiance(&self, map: &DensityMap, ray: Ray, radius_factor: f32, rng: &mut Rng) -> Vec3 {
+        let scene = self.scene;
+        let mut ray = ray;
+        let mut beta = Vec3::ONE;
+        let mut l = Vec3::ZERO;
+        let mut path_length = 0.0f32;
+        for depth in 0..=self.settings.max_depth {
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            let hit = scene.surface(&ray, &isect);
+            path_length += isect.t;
+            let wo = -ray.dir;
+            // Only the camera and specular chains reach here: emission counts in full.
+            l += beta * emitted(&hit);
+            let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+            if bsdf.is_black() {
+                break;
+            }
+            if bsdf.is_smooth() {
+                l += beta * direct_light(scene, &self.lights, &hit, &bsdf, wo, false, rng);
+                let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
+                l += beta * map.radiance_within(hit.point, &bsdf, wo, r);
+            }
+            if depth == self.settings.max_depth {
+                break;
+            }
+            // Smooth lobes were fully counted above; only specular ones continue the path.
+            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
+                break;
+            };
+            if !sample.specular || (depth == 0 && !self.settings.specular_camera_paths) {
+                break;
+            }
+            beta *= sample.weight;
+            if beta.max_element() <= 0.0 {
+                break;
+            }
+            ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+        }
+        l
+    }
+}
+
+impl Progressive for Ppm<'_> {
+    fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
+        let map = self.photon_map(pass, control);
+        if control.cancelled() {
+            return None;
+        }
+        let factor = radius_factor(pass, self.settings.alpha);
+        let camera = &self.scene.camera;
+        sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
+            self.radiance(&map, camera.generate_ray(sx, sy), factor, rng)
+        })
+    }
+}
