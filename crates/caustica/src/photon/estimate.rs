@@ -1,7 +1,9 @@
 //! Radiance estimates from photons under the physical model, for a fixed radius (progressive
 //! photon mapping) or the k nearest photons (Jensen's global and caustic maps):
 //!
-//!     L(x, ωo) ≈ Σ_p f(x, ωo, ωp) Φp / (π r²)
+//! ```text
+//! L(x, ωo) ≈ Σ_p f(x, ωo, ωp) Φp / (π r²)
+//! ```
 //!
 //! with the same BSDF the camera paths use, evaluated for each photon's own incoming direction.
 //! The gather is a disc: photons whose surface faces away from the receiver (the other side of
