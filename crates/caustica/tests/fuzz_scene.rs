@@ -8,6 +8,9 @@
 
 mod common;
 
+use caustica::integrator::path::{PathSettings, PathTracer};
+use caustica::integrator::ppm::{Ppm, PpmSettings};
+use caustica::integrator::progressive::Progressive;
 use caustica::integrator::whitted::{render, WhittedSettings};
 use caustica::integrator::ImageSettings;
 use caustica::photon::{PhotonMap, PhotonSettings};
@@ -452,6 +455,30 @@ fn exercise(text: &str, dir: &Path) -> (bool, bool) {
             ..PhotonSettings::default()
         };
         let _ = PhotonMap::trace(&scene, &photons, 10, common::control());
+        // And one pass of the physical model: area lights, BSDF sampling, photon scattering.
+        let ppm = Ppm::new(
+            &scene,
+            PpmSettings {
+                photons_per_pass: 200,
+                max_depth: 16,
+                ..PpmSettings::default()
+            },
+            8,
+            8,
+            0,
+        );
+        let _ = ppm.render_pass(0, common::control());
+        let path = PathTracer::new(
+            &scene,
+            PathSettings {
+                max_depth: 16,
+                ..PathSettings::default()
+            },
+            4,
+            4,
+            0,
+        );
+        let _ = path.render_pass(0, common::control());
         return (parsed, true);
     }
     (parsed, false)

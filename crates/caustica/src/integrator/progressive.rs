@@ -279,8 +279,31 @@ fn parse_ranges(text: &str) -> Option<Vec<(u64, u64)>> {
 /// r²ᵢ₊₁ = r²ᵢ (i + α) / (i + 1) for 1-based i, so r_pass = r_0 · √(Π_{k=1}^{pass} (k + α)/(k + 1)).
 pub fn radius_factor(pass: u64, alpha: f32) -> f32 {
     let alpha = alpha as f64;
-    let log: f64 = (1..=pass).map(|k| ((k as f64 + alpha) / (k as f64 + 1.0)).ln()).sum();
+    let log = if pass <= DIRECT_PRODUCT_PASSES {
+        (1..=pass).map(|k| ((k as f64 + alpha) / (k as f64 + 1.0)).ln()).sum()
+    } else {
+        // The product is Γ(n + 1 + α) / (Γ(1 + α) Γ(n + 2)): constant time for any pass.
+        let n = pass as f64;
+        ln_gamma(n + 1.0 + alpha) - ln_gamma(1.0 + alpha) - ln_gamma(n + 2.0)
+    };
     (0.5 * log).exp() as f32
+}
+
+/// Passes up to which the radius product is summed term by term.
+const DIRECT_PRODUCT_PASSES: u64 = 4096;
+
+/// ln Γ(x) for x ≥ 1: shifted up to 8, then Stirling's series (error below 1e-10).
+fn ln_gamma(mut x: f64) -> f64 {
+    let mut shift = 0.0;
+    while x < 8.0 {
+        shift -= x.ln();
+        x += 1.0;
+    }
+    let inv = 1.0 / x;
+    let inv2 = inv * inv;
+    shift + (x - 0.5) * x.ln() - x
+        + 0.5 * (2.0 * std::f64::consts::PI).ln()
+        + inv * (1.0 / 12.0 - inv2 * (1.0 / 360.0 - inv2 / 1260.0))
 }
 
 #[cfg(test)]
@@ -297,6 +320,12 @@ mod tests {
         // r² falls like i^(α−1): a thousand passes shrink it by about 1000^0.3.
         let r1000 = radius_factor(1000, 0.7);
         assert!(r1000 * r1000 < 0.2 && r1000 * r1000 > 0.05, "{r1000}");
+        // The closed form used past 4096 passes continues the product.
+        let direct: f64 = (1..=5000u64).map(|k| ((k as f64 + 0.7) / (k as f64 + 1.0)).ln()).sum();
+        let direct = (0.5 * direct).exp() as f32;
+        assert!((radius_factor(5000, 0.7) / direct - 1.0).abs() < 1e-5);
+        let far = radius_factor(u32::MAX as u64, 0.7);
+        assert!(far > 0.0 && far < radius_factor(5000, 0.7));
     }
 
     #[test]
