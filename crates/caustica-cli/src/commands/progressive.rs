@@ -164,6 +164,13 @@ pub fn run(args: RenderArgs, integrator: Integrator, cancel: &'static AtomicBool
         for note in physical_notes(&scene) {
             eprintln!("note: {note}");
         }
+        let ignored = ignored_options(&args);
+        if !ignored.is_empty() {
+            eprintln!(
+                "note: {} only apply to the course model's Whitted renderer; ignored here",
+                ignored.join(", ")
+            );
+        }
     }
     let (width, height) = image_size(&scene.camera, args.width, args.height);
     check_image_size(width, height)?;
@@ -335,6 +342,27 @@ pub fn run(args: RenderArgs, integrator: Integrator, cancel: &'static AtomicBool
         );
     }
     Ok(if complete { 0 } else { crate::EXIT_INTERRUPTED })
+}
+
+/// Options of the Whitted renderer that a physical render was given but does not use.
+fn ignored_options(args: &RenderArgs) -> Vec<&'static str> {
+    let mut ignored = Vec::new();
+    if args.aa != 1 {
+        ignored.push("--aa (each pass takes one jittered sample per pixel)");
+    }
+    if args.photon.photons_per_light.is_some() {
+        ignored.push("--photons-per-light");
+    }
+    if args.photon.no_aim {
+        ignored.push("--no-aim");
+    }
+    if args.photon.max_emitted.is_some() {
+        ignored.push("--max-emitted");
+    }
+    if args.no_estimate_reuse {
+        ignored.push("--no-estimate-reuse");
+    }
+    ignored
 }
 
 /// What the physical model reads differently from the course's shading.
