@@ -209,3 +209,32 @@ fn info_json_of_an_empty_scene_is_still_json() {
     assert_eq!(info["bounds"]["min"][0], Value::Null);
     assert_eq!(info["warnings"].as_array().map(Vec::len), Some(2), "{info}");
 }
+
+#[test]
+fn photons_ctrl_c_draws_the_partial_map_and_exits_130() {
+    let dir = temp_dir("photons-interrupt");
+    let out = dir.join("partial.png");
+    // Far more photons than can be traced before the signal.
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("caustica"))
+        .arg("photons")
+        .arg(scene("ring.ray"))
+        .arg("-o")
+        .arg(&out)
+        .args(["--width", "32", "--photons", "5000000", "--json"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1000));
+    let status = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let output = child.wait_with_output().unwrap();
+    assert_eq!(output.status.code(), Some(130), "exit code after Ctrl-C");
+    let summary = json(&String::from_utf8(output.stdout).unwrap());
+    assert_eq!(summary["complete"], false);
+    assert!(summary["photons_stored"].as_u64().unwrap() < 5_000_000);
+    assert!(out.exists(), "the photons stored so far are drawn");
+}
