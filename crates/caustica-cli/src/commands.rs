@@ -7,7 +7,6 @@ pub mod render;
 
 use crate::cli::{PhotonOptions, SceneArgs};
 use crate::progress::Bars;
-use caustica::integrator::Progress;
 use caustica::photon::PhotonSettings;
 use caustica::scene::ray_file::ast::Dialect;
 use caustica::scene::ray_file::ParseOptions;
@@ -52,18 +51,16 @@ pub struct Loaded {
 pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<Loaded> {
     let settings = build_settings(args);
     let start = Instant::now();
-    // The parser does not report progress: its length is unknown, hence a spinner.
-    bars.start_spinner("parse");
     let parsed = match path {
-        Some(path) => scene::parse_file(path, &settings),
+        Some(path) => scene::parse_file(path, &settings, bars),
         None => scene::parse_text(
             Path::new("<built-in ring scene>"),
             presets::RING.to_string(),
             Path::new("."),
             &settings,
+            bars,
         ),
     };
-    bars.finish();
     let parse_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
     let scene = parsed?.build(&settings, bars)?;

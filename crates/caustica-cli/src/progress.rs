@@ -30,19 +30,6 @@ impl Bars {
         }
     }
 
-    /// A phase whose amount of work is not known ahead: a spinner with the elapsed time.
-    pub fn start_spinner(&self, phase: &str) {
-        if self.quiet {
-            return;
-        }
-        let bar = ProgressBar::hidden();
-        bar.set_style(
-            ProgressStyle::with_template("{prefix:>8} {spinner} {elapsed_precise}")
-                .unwrap_or_else(|_| ProgressStyle::default_spinner()),
-        );
-        self.begin(phase, bar);
-    }
-
     /// Starts `bar` hidden; a timer thread draws it if the phase is still running later.
     fn begin(&self, phase: &str, bar: ProgressBar) {
         bar.set_prefix(phase.to_string());

@@ -29,7 +29,7 @@ pub struct BuildSettings {
 
 /// Reads, parses and builds the scene file at `path`.
 pub fn load(path: &Path, settings: &BuildSettings) -> Result<Scene> {
-    parse_file(path, settings)?.build(settings, &NoProgress)
+    parse_file(path, settings, &NoProgress)?.build(settings, &NoProgress)
 }
 
 /// A scene file read and parsed but not yet built; it keeps the text so that errors found while
@@ -43,8 +43,9 @@ pub struct ParsedScene {
     pub description: SceneDescription,
 }
 
-/// Reads and parses the scene file at `path` (the first half of [`load`]).
-pub fn parse_file(path: &Path, settings: &BuildSettings) -> Result<ParsedScene> {
+/// Reads and parses the scene file at `path` (the first half of [`load`]), reporting a "parse"
+/// phase to `progress`.
+pub fn parse_file(path: &Path, settings: &BuildSettings, progress: &dyn Progress) -> Result<ParsedScene> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
@@ -62,12 +63,19 @@ pub fn parse_file(path: &Path, settings: &BuildSettings) -> Result<ParsedScene> 
         }
     };
     let dir = path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-    parse_text(path, text, &dir, settings)
+    parse_text(path, text, &dir, settings, progress)
 }
 
-/// Parses scene text; `path` names it in errors and textures resolve against `scene_dir`.
-pub fn parse_text(path: &Path, text: String, scene_dir: &Path, settings: &BuildSettings) -> Result<ParsedScene> {
-    match ray_file::parse(&text, scene_dir, &settings.parse) {
+/// Parses scene text, reporting a "parse" phase; `path` names it in errors and textures resolve
+/// against `scene_dir`.
+pub fn parse_text(
+    path: &Path,
+    text: String,
+    scene_dir: &Path,
+    settings: &BuildSettings,
+    progress: &dyn Progress,
+) -> Result<ParsedScene> {
+    match ray_file::parse_reporting(&text, scene_dir, &settings.parse, progress) {
         Ok(description) => Ok(ParsedScene {
             path: path.to_path_buf(),
             text,
@@ -388,6 +396,7 @@ fn singular(span: &Span) -> ParseError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::ray_file::ast::Dialect;
     use std::sync::Mutex;
 
     /// Records the phases and the units reported.
@@ -416,13 +425,42 @@ polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1
     #[test]
     fn parse_then_build_reports_one_build_phase_that_ends_at_its_total() {
         let settings = BuildSettings::default();
-        let parsed = parse_text(Path::new("t.ray"), SCENE.into(), Path::new("."), &settings).unwrap();
         let record = Record::default();
+        let parsed = parse_text(Path::new("t.ray"), SCENE.into(), Path::new("."), &settings, &record).unwrap();
         let scene = parsed.build(&settings, &record).unwrap();
         // The collinear face is dropped by the parser; placing and the BVH count 2 units each.
         assert_eq!(scene.triangles.len(), 1);
         let phases = record.0.into_inner().unwrap();
-        assert_eq!(phases, [("build".to_string(), 4, 4, true)]);
+        let bytes = SCENE.len() as u64;
+        assert_eq!(
+            phases,
+            [
+                ("parse".to_string(), bytes, bytes, true),
+                ("build".to_string(), 4, 4, true)
+            ]
+        );
+    }
+
+    #[test]
+    fn a_large_file_reports_each_byte_once() {
+        let points: Vec<String> = (0..20_000).map(|i| format!("({i}, 0, 1)")).collect();
+        let text = format!(
+            "SBT-raytracer 1.0\npolymesh {{ points = ({}); faces = ((0, 1, 2)); }}\n",
+            points.join(", ")
+        );
+        let settings = BuildSettings::default();
+        for dialect in [None, Some(Dialect::Tokenizer), Some(Dialect::Dictionary)] {
+            let settings = BuildSettings {
+                parse: ParseOptions { dialect },
+                ..settings.clone()
+            };
+            let record = Record::default();
+            let parsed = parse_text(Path::new("big.ray"), text.clone(), Path::new("."), &settings, &record);
+            assert!(parsed.is_ok(), "{dialect:?}");
+            let phases = record.0.into_inner().unwrap();
+            let total = text.len() as u64;
+            assert_eq!(phases, [("parse".to_string(), total, total, true)], "{dialect:?}");
+        }
     }
 
     #[test]
@@ -433,11 +471,19 @@ polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1
             "SBT-raytracer 1.0\nsphere {".into(),
             Path::new("."),
             &settings,
+            &NoProgress,
         );
         assert!(matches!(bad_syntax, Err(Error::Scene { path, .. }) if path == Path::new("a.ray")));
         // Textures are read while building.
         let no_texture = "SBT-raytracer 1.0\nsphere { material = { diffuse = map(\"missing.png\"); } }\n";
-        let parsed = parse_text(Path::new("b.ray"), no_texture.into(), Path::new("."), &settings).unwrap();
+        let parsed = parse_text(
+            Path::new("b.ray"),
+            no_texture.into(),
+            Path::new("."),
+            &settings,
+            &NoProgress,
+        )
+        .unwrap();
         let built = parsed.build(&settings, &NoProgress);
         assert!(
             matches!(built, Err(Error::Scene { path, text, .. }) if path == Path::new("b.ray") && text == no_texture)
