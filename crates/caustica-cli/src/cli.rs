@@ -32,7 +32,8 @@ pub enum Command {
 
 Examples:
   caustica photons scenes/ring.ray -o ring-photons.png
-  caustica photons scenes/lens.ray -o lens-map.png --ply lens.ply --photons 50000")]
+  caustica photons scenes/lens.ray -o lens-map.png --ply lens.ply --photons 50000
+  caustica photons scenes/ring.ray --json            # a one-line summary on stdout")]
     Photons(PhotonArgs),
     /// Time whole renders of the project's scenes and print a table (for BENCHMARKS.md).
     #[command(
@@ -276,6 +277,9 @@ pub struct PhotonArgs {
     /// Print nothing but errors.
     #[arg(short, long)]
     pub quiet: bool,
+    /// Print a machine-readable summary on stdout.
+    #[arg(long)]
+    pub json: bool,
     #[command(flatten)]
     pub photon: PhotonOptions,
     #[command(flatten)]

@@ -9,12 +9,14 @@ pub mod progressive;
 pub mod render;
 
 use crate::cli::{PhotonOptions, SceneArgs};
+use crate::progress::Bars;
 use caustica::photon::PhotonSettings;
 use caustica::scene::ray_file::ast::Dialect;
 use caustica::scene::ray_file::ParseOptions;
-use caustica::scene::{presets, BuildSettings, Scene};
+use caustica::scene::{self, presets, BuildSettings, Scene};
 use caustica::{Error, Result};
 use std::path::Path;
+use std::time::Instant;
 
 /// Largest image side accepted: beyond it the film alone would not fit in memory.
 const MAX_SIDE: usize = 32_768;
@@ -37,19 +39,39 @@ pub fn build_settings(args: &SceneArgs) -> BuildSettings {
     settings
 }
 
-/// Loads the scene file, or the built-in ring scene when no path is given.
-pub fn load_scene(path: Option<&Path>, args: &SceneArgs) -> Result<Scene> {
+/// A built scene and the seconds its two phases took.
+pub struct Loaded {
+    /// The scene.
+    pub scene: Scene,
+    /// Reading and parsing the file.
+    pub parse_seconds: f64,
+    /// Building shapes, meshes, textures and the BVH.
+    pub build_seconds: f64,
+}
+
+/// Reads and parses the scene file, or the built-in ring scene when no path is given, then
+/// builds it: two phases, each with its bar.
+pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<Loaded> {
     let settings = build_settings(args);
-    match path {
-        Some(path) => caustica::scene::load(path, &settings),
-        None => {
-            caustica::scene::build::from_text(presets::RING, Path::new("."), &settings).map_err(|error| Error::Scene {
-                path: "<built-in ring scene>".into(),
-                text: presets::RING.to_string(),
-                error,
-            })
-        }
-    }
+    let start = Instant::now();
+    let parsed = match path {
+        Some(path) => scene::parse_file(path, &settings, bars),
+        None => scene::parse_text(
+            Path::new("<built-in ring scene>"),
+            presets::RING.to_string(),
+            Path::new("."),
+            &settings,
+            bars,
+        ),
+    };
+    let parse_seconds = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let scene = parsed?.build(&settings, bars)?;
+    Ok(Loaded {
+        scene,
+        parse_seconds,
+        build_seconds: start.elapsed().as_secs_f64(),
+    })
 }
 
 /// Makes a thread pool of `threads` workers (all cores by default).

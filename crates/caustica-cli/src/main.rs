@@ -6,6 +6,7 @@ mod cli;
 mod commands;
 mod diagnostics;
 mod interrupt;
+mod json;
 mod progress;
 
 use clap::Parser;

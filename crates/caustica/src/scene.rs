@@ -5,12 +5,13 @@ pub mod build;
 pub mod presets;
 pub mod ray_file;
 
-pub use build::{build, load, BuildSettings};
+pub use build::{build, load, parse_file, parse_text, BuildSettings, ParsedScene};
 
 use crate::accel::bvh::Bvh;
 use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::Shape;
+use crate::integrator::Progress;
 use crate::light::Light;
 use crate::material::{Material, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
@@ -158,13 +159,14 @@ impl Scene {
         triangles: Vec<Triangle>,
         triangle_refs: Vec<TriangleRef>,
         warnings: Vec<String>,
+        progress: &dyn Progress,
     ) -> Scene {
         let prim_bounds: Vec<Aabb> = shapes
             .iter()
             .map(|s| s.bounds)
             .chain(triangles.iter().map(|t| t.bounds()))
             .collect();
-        let bvh = Bvh::build(&prim_bounds);
+        let bvh = Bvh::build_reporting(&prim_bounds, progress);
         Scene {
             camera,
             lights,

@@ -74,8 +74,15 @@ pub fn run(args: CompareArgs) -> Result<u8> {
             .iter()
             .map(|(r, g, w, e)| {
                 format!(
-                    "{{\"name\":{:?},\"mean\":[{},{},{}],\"reference\":[{},{},{}],\"relative_error\":{}}}",
-                    r.name, g.x, g.y, g.z, w.x, w.y, w.z, e
+                    "{{\"name\":{},\"mean\":[{},{},{}],\"reference\":[{},{},{}],\"relative_error\":{}}}",
+                    crate::json::string(&r.name),
+                    crate::json::number(g.x as f64),
+                    crate::json::number(g.y as f64),
+                    crate::json::number(g.z as f64),
+                    crate::json::number(w.x as f64),
+                    crate::json::number(w.y as f64),
+                    crate::json::number(w.z as f64),
+                    crate::json::number(*e as f64)
                 )
             })
             .collect();

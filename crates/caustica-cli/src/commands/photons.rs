@@ -2,44 +2,76 @@
 
 use super::{check_image_size, load_scene, photon_settings, thread_pool};
 use crate::cli::PhotonArgs;
+use crate::json;
 use crate::progress::Bars;
 use caustica::film::ToneMap;
 use caustica::integrator::{image_size, Control};
 use caustica::photon::picture::{draw_photons, write_ply};
 use caustica::photon::PhotonMap;
 use caustica::Result;
-use std::sync::atomic::AtomicBool;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
 
 /// Runs the command; returns the exit code.
 pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
+    let start = Instant::now();
     caustica::image_io::ImageFormat::from_path(&args.output)?;
     let settings = photon_settings(&args.photon, args.seed)?;
     let pool = thread_pool(args.threads)?;
-    let scene = load_scene(Some(&args.scene), &args.scene_args)?;
+    let bars = Bars::new(args.quiet || args.json);
+    let loaded = load_scene(Some(&args.scene), &args.scene_args, &bars)?;
+    let scene = loaded.scene;
+    if !args.quiet {
+        for warning in &scene.warnings {
+            eprintln!("warning: {warning}");
+        }
+    }
     let (width, height) = image_size(&scene.camera, args.width, args.height);
     check_image_size(width, height)?;
-    let bars = Bars::new(args.quiet);
     let control = Control {
         progress: &bars,
         cancel,
     };
+    let t_photons = Instant::now();
     let map = pool.install(|| PhotonMap::trace(&scene, &settings, 1, control));
+    let photon_seconds = t_photons.elapsed().as_secs_f64();
+    // Checked right after tracing: a Ctrl-C while writing does not make the map partial.
+    let complete = !cancel.load(Ordering::Relaxed);
     let film = draw_photons(&scene, map.photons(), width, height);
     film.save(&args.output, ToneMap::Clamp)?;
     if let Some(ply) = &args.ply {
         write_ply(ply, map.photons())?;
     }
-    if !args.quiet {
-        let s = &map.stats;
+    let total = start.elapsed().as_secs_f64();
+    let s = &map.stats;
+    if args.json {
+        println!(
+            "{{\"output\":{},\"ply\":{},\"width\":{width},\"height\":{height},\"photons_stored\":{},\"photons_emitted\":{},\"useful_fraction\":{:.4},\"cap_reached\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{:.4},\"build\":{:.4},\"photons\":{photon_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
+            json::string(&args.output.display().to_string()),
+            args.ply
+                .as_ref()
+                .map_or("null".to_string(), |p| json::string(&p.display().to_string())),
+            s.stored,
+            s.emitted,
+            s.useful_fraction(),
+            s.cap_reached,
+            loaded.parse_seconds,
+            loaded.build_seconds,
+            super::peak_memory_bytes().map_or("null".to_string(), |b| b.to_string()),
+        );
+    } else if !args.quiet {
         eprintln!(
-            "{}: {} photons stored of {} emitted ({:.1}% useful) in {:.2} s{}",
+            "{}{}: {} photons stored of {} emitted ({:.1}% useful){} — parse {:.2} s, build {:.2} s, photons {photon_seconds:.2} s, total {total:.2} s{}",
             args.output.display(),
+            args.ply.as_ref().map_or(String::new(), |p| format!(" and {}", p.display())),
             s.stored,
             s.emitted,
             100.0 * s.useful_fraction(),
-            s.seconds,
-            if s.cap_reached { " — emission cap reached" } else { "" }
+            if s.cap_reached { ", emission cap reached" } else { "" },
+            loaded.parse_seconds,
+            loaded.build_seconds,
+            if complete { "" } else { " (interrupted: partial map)" }
         );
     }
-    Ok(0)
+    Ok(if complete { 0 } else { crate::EXIT_INTERRUPTED })
 }

@@ -154,9 +154,8 @@ pub fn run(args: RenderArgs, integrator: Integrator, cancel: &'static AtomicBool
         cancel,
     };
 
-    let t_parse = Instant::now();
-    let scene = load_scene(args.scene.as_deref(), &args.scene_args)?;
-    let parse_seconds = t_parse.elapsed().as_secs_f64();
+    let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
+    let (scene, parse_seconds, build_seconds) = (loaded.scene, loaded.parse_seconds, loaded.build_seconds);
     if !quiet {
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
@@ -309,11 +308,11 @@ pub fn run(args: RenderArgs, integrator: Integrator, cancel: &'static AtomicBool
     let passes: Vec<String> = acc.passes.iter().map(|(a, b)| format!("{a}..{b}")).collect();
     let shown = |p: &Option<PathBuf>| {
         p.as_ref()
-            .map_or("null".to_string(), |p| format!("{:?}", p.display().to_string()))
+            .map_or("null".to_string(), |p| crate::json::string(&p.display().to_string()))
     };
     if args.json {
         println!(
-            "{{\"output\":{},\"partial\":{},\"integrator\":\"{}\",\"model\":\"physical\",\"width\":{width},\"height\":{height},\"passes\":{},\"pass_ranges\":\"{}\",\"photons_per_pass\":{photons_per_pass},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
+            "{{\"output\":{},\"partial\":{},\"integrator\":\"{}\",\"model\":\"physical\",\"width\":{width},\"height\":{height},\"passes\":{},\"pass_ranges\":\"{}\",\"photons_per_pass\":{photons_per_pass},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"build\":{build_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
             shown(&output),
             shown(&options.partial),
             integrator.name(),
@@ -328,7 +327,7 @@ pub fn run(args: RenderArgs, integrator: Integrator, cancel: &'static AtomicBool
             .map(|p| p.display().to_string())
             .collect();
         eprintln!(
-            "{} {width}×{height}, {} {} passes ({}){} — parse {parse_seconds:.2} s, render {render_seconds:.2} s, total {total:.2} s{}",
+            "{} {width}×{height}, {} {} passes ({}){} — parse {parse_seconds:.2} s, build {build_seconds:.2} s, render {render_seconds:.2} s, total {total:.2} s{}",
             written.join(" and "),
             acc.pass_count(),
             integrator.name(),

@@ -51,12 +51,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         cancel,
     };
 
-    let t_parse = Instant::now();
-    caustica::integrator::Progress::start(&bars, "load", 1);
-    let scene = load_scene(args.scene.as_deref(), &args.scene_args);
-    caustica::integrator::Progress::finish(&bars);
-    let scene = scene?;
-    let parse_seconds = t_parse.elapsed().as_secs_f64();
+    let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
+    let (scene, parse_seconds, build_seconds) = (loaded.scene, loaded.parse_seconds, loaded.build_seconds);
     if !args.quiet {
         for warning in &scene.warnings {
             eprintln!("warning: {warning}");
@@ -119,15 +115,15 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let stored = map.as_ref().map_or(0, |m| m.stats.stored);
     if args.json {
         println!(
-            "{{\"output\":{:?},\"width\":{width},\"height\":{height},\"samples_per_pixel\":{},\"photons_stored\":{stored},\"photons_emitted\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"photons\":{photon_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
-            output.display().to_string(),
+            "{{\"output\":{},\"width\":{width},\"height\":{height},\"samples_per_pixel\":{},\"photons_stored\":{stored},\"photons_emitted\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"build\":{build_seconds:.4},\"photons\":{photon_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
+            crate::json::string(&output.display().to_string()),
             args.aa * args.aa,
             map.as_ref().map_or(0, |m| m.stats.emitted),
             super::peak_memory_bytes().map_or("null".to_string(), |b| b.to_string()),
         );
     } else if !args.quiet {
         eprintln!(
-            "{} {}×{} at {} spp, {stored} photons — parse {parse_seconds:.2} s, photons {photon_seconds:.2} s, render {render_seconds:.2} s, total {total:.2} s{}",
+            "{} {}×{} at {} spp, {stored} photons stored — parse {parse_seconds:.2} s, build {build_seconds:.2} s, photons {photon_seconds:.2} s, render {render_seconds:.2} s, total {total:.2} s{}",
             output.display(),
             width,
             height,

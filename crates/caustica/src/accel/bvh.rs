@@ -12,6 +12,7 @@ mod triangles;
 
 use glam::Vec4;
 
+use crate::integrator::{NoProgress, Progress};
 use crate::math::{Aabb, Ray, Vec3};
 
 pub use triangles::{TriangleBvh, TriangleBvhHit};
@@ -146,7 +147,13 @@ impl Bvh {
     /// # Panics
     /// If there are 2^31 or more primitives.
     pub fn build(prim_bounds: &[Aabb]) -> Bvh {
-        let c = build::collapse(build::build_bvh2(prim_bounds));
+        Bvh::build_reporting(prim_bounds, &NoProgress)
+    }
+
+    /// [`Bvh::build`], advancing `progress` by one unit per primitive placed in the tree (the
+    /// caller starts and finishes the phase).
+    pub fn build_reporting(prim_bounds: &[Aabb], progress: &dyn Progress) -> Bvh {
+        let c = build::collapse(build::build_bvh2(prim_bounds, progress));
         Bvh {
             nodes: c.nodes,
             order: c.order,

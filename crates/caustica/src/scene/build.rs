@@ -10,6 +10,7 @@ use crate::geometry::cone::Cone;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Shape, ShapeKind, ShapeSettings};
 use crate::image_io;
+use crate::integrator::{NoProgress, Progress};
 use crate::light::Light;
 use crate::material::{Channel, Material};
 use crate::math::{Aabb, Mat3, Vec3};
@@ -28,6 +29,23 @@ pub struct BuildSettings {
 
 /// Reads, parses and builds the scene file at `path`.
 pub fn load(path: &Path, settings: &BuildSettings) -> Result<Scene> {
+    parse_file(path, settings, &NoProgress)?.build(settings, &NoProgress)
+}
+
+/// A scene file read and parsed but not yet built; it keeps the text so that errors found while
+/// building can still point into it.
+pub struct ParsedScene {
+    /// The file, as errors name it.
+    pub path: PathBuf,
+    /// The file's text.
+    pub text: String,
+    /// What the file describes.
+    pub description: SceneDescription,
+}
+
+/// Reads and parses the scene file at `path` (the first half of [`load`]), reporting a "parse"
+/// phase to `progress`.
+pub fn parse_file(path: &Path, settings: &BuildSettings, progress: &dyn Progress) -> Result<ParsedScene> {
     let bytes = std::fs::read(path).map_err(|source| Error::Io {
         path: path.to_path_buf(),
         source,
@@ -45,11 +63,41 @@ pub fn load(path: &Path, settings: &BuildSettings) -> Result<Scene> {
         }
     };
     let dir = path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-    from_text(&text, &dir, settings).map_err(|error| Error::Scene {
-        path: path.to_path_buf(),
-        text,
-        error,
-    })
+    parse_text(path, text, &dir, settings, progress)
+}
+
+/// Parses scene text, reporting a "parse" phase; `path` names it in errors and textures resolve
+/// against `scene_dir`.
+pub fn parse_text(
+    path: &Path,
+    text: String,
+    scene_dir: &Path,
+    settings: &BuildSettings,
+    progress: &dyn Progress,
+) -> Result<ParsedScene> {
+    match ray_file::parse_reporting(&text, scene_dir, &settings.parse, progress) {
+        Ok(description) => Ok(ParsedScene {
+            path: path.to_path_buf(),
+            text,
+            description,
+        }),
+        Err(error) => Err(Error::Scene {
+            path: path.to_path_buf(),
+            text,
+            error,
+        }),
+    }
+}
+
+impl ParsedScene {
+    /// Builds the scene (the second half of [`load`]), reporting a "build" phase to `progress`.
+    pub fn build(self, settings: &BuildSettings, progress: &dyn Progress) -> Result<Scene> {
+        build_reporting(&self.description, settings, progress).map_err(|error| Error::Scene {
+            path: self.path,
+            text: self.text,
+            error,
+        })
+    }
 }
 
 /// Parses and builds scene text; textures resolve against `scene_dir`.
@@ -60,6 +108,28 @@ pub fn from_text(text: &str, scene_dir: &Path, settings: &BuildSettings) -> Resu
 
 /// Builds a scene from its description.
 pub fn build(desc: &SceneDescription, settings: &BuildSettings) -> Result<Scene, ParseError> {
+    build_reporting(desc, settings, &NoProgress)
+}
+
+/// [`build`], reporting a "build" phase: each object placed (a mesh counts its triangles), then
+/// each primitive put in the BVH — the slow part for large meshes.
+pub fn build_reporting(
+    desc: &SceneDescription,
+    settings: &BuildSettings,
+    progress: &dyn Progress,
+) -> Result<Scene, ParseError> {
+    let work: u64 = desc.objects.iter().map(weight).sum();
+    progress.start("build", 2 * work);
+    let scene = build_objects(desc, settings, progress);
+    progress.finish();
+    scene
+}
+
+fn build_objects(
+    desc: &SceneDescription,
+    settings: &BuildSettings,
+    progress: &dyn Progress,
+) -> Result<Scene, ParseError> {
     let mut builder = Builder::default();
     let camera = desc.camera.as_ref().map(Camera::from_desc).unwrap_or_default();
     let lights = desc.lights.iter().filter_map(convert_light).collect();
@@ -73,9 +143,14 @@ pub fn build(desc: &SceneDescription, settings: &BuildSettings) -> Result<Scene,
     {
         warnings.push("the scene has no lights: the image will be black".into());
     }
+    let mut placed = 0;
     for object in &desc.objects {
         builder.add_object(object, &settings.shapes, &mut warnings)?;
+        placed += weight(object);
+        progress.advance(weight(object));
     }
+    // Dropped triangles never reach the BVH: count them now so the phase ends at its total.
+    progress.advance(placed.saturating_sub((builder.shapes.len() + builder.triangles.len()) as u64));
     Ok(Scene::assemble(
         camera,
         lights,
@@ -88,7 +163,16 @@ pub fn build(desc: &SceneDescription, settings: &BuildSettings) -> Result<Scene,
         builder.triangles,
         builder.triangle_refs,
         warnings,
+        progress,
     ))
+}
+
+/// Units of build work for an object: its triangles, or 1 for a shape.
+fn weight(object: &ObjectDesc) -> u64 {
+    match &object.shape {
+        ShapeDesc::Trimesh(mesh) => mesh.triangles.len() as u64,
+        _ => 1,
+    }
 }
 
 fn material_is_emissive(m: &MaterialDesc) -> bool {
@@ -307,4 +391,102 @@ fn singular(span: &Span) -> ParseError {
         "this object's transform is singular (a zero scale or a degenerate matrix)",
         span.clone(),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::ray_file::ast::Dialect;
+    use std::sync::Mutex;
+
+    /// Records the phases and the units reported.
+    #[derive(Default)]
+    struct Record(Mutex<Vec<(String, u64, u64, bool)>>);
+
+    impl Progress for Record {
+        fn start(&self, phase: &str, total: u64) {
+            self.0.lock().unwrap().push((phase.into(), total, 0, false));
+        }
+        fn advance(&self, n: u64) {
+            self.0.lock().unwrap().last_mut().unwrap().2 += n;
+        }
+        fn finish(&self) {
+            self.0.lock().unwrap().last_mut().unwrap().3 = true;
+        }
+    }
+
+    const SCENE: &str = "SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); }
+point_light { position = (0, 5, 5); color = (1, 1, 1); }
+sphere { material = { diffuse = (1, 0, 0); } }
+polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1,3)); }
+";
+
+    #[test]
+    fn parse_then_build_reports_one_build_phase_that_ends_at_its_total() {
+        let settings = BuildSettings::default();
+        let record = Record::default();
+        let parsed = parse_text(Path::new("t.ray"), SCENE.into(), Path::new("."), &settings, &record).unwrap();
+        let scene = parsed.build(&settings, &record).unwrap();
+        // The collinear face is dropped by the parser; placing and the BVH count 2 units each.
+        assert_eq!(scene.triangles.len(), 1);
+        let phases = record.0.into_inner().unwrap();
+        let bytes = SCENE.len() as u64;
+        assert_eq!(
+            phases,
+            [
+                ("parse".to_string(), bytes, bytes, true),
+                ("build".to_string(), 4, 4, true)
+            ]
+        );
+    }
+
+    #[test]
+    fn a_large_file_reports_each_byte_once() {
+        let points: Vec<String> = (0..20_000).map(|i| format!("({i}, 0, 1)")).collect();
+        let text = format!(
+            "SBT-raytracer 1.0\npolymesh {{ points = ({}); faces = ((0, 1, 2)); }}\n",
+            points.join(", ")
+        );
+        let settings = BuildSettings::default();
+        for dialect in [None, Some(Dialect::Tokenizer), Some(Dialect::Dictionary)] {
+            let settings = BuildSettings {
+                parse: ParseOptions { dialect },
+                ..settings.clone()
+            };
+            let record = Record::default();
+            let parsed = parse_text(Path::new("big.ray"), text.clone(), Path::new("."), &settings, &record);
+            assert!(parsed.is_ok(), "{dialect:?}");
+            let phases = record.0.into_inner().unwrap();
+            let total = text.len() as u64;
+            assert_eq!(phases, [("parse".to_string(), total, total, true)], "{dialect:?}");
+        }
+    }
+
+    #[test]
+    fn errors_of_either_half_name_the_file() {
+        let settings = BuildSettings::default();
+        let bad_syntax = parse_text(
+            Path::new("a.ray"),
+            "SBT-raytracer 1.0\nsphere {".into(),
+            Path::new("."),
+            &settings,
+            &NoProgress,
+        );
+        assert!(matches!(bad_syntax, Err(Error::Scene { path, .. }) if path == Path::new("a.ray")));
+        // Textures are read while building.
+        let no_texture = "SBT-raytracer 1.0\nsphere { material = { diffuse = map(\"missing.png\"); } }\n";
+        let parsed = parse_text(
+            Path::new("b.ray"),
+            no_texture.into(),
+            Path::new("."),
+            &settings,
+            &NoProgress,
+        )
+        .unwrap();
+        let built = parsed.build(&settings, &NoProgress);
+        assert!(
+            matches!(built, Err(Error::Scene { path, text, .. }) if path == Path::new("b.ray") && text == no_texture)
+        );
+    }
 }

@@ -18,6 +18,7 @@ mod trimesh;
 #[cfg(test)]
 mod tests;
 
+use crate::integrator::{NoProgress, Progress};
 use crate::ParseError;
 use std::path::Path;
 
@@ -30,9 +31,27 @@ pub struct ParseOptions {
 
 /// Parses a whole `.ray` file; `scene_dir` resolves `map("file")` paths (images are not loaded).
 pub fn parse(text: &str, scene_dir: &Path, options: &ParseOptions) -> Result<ast::SceneDescription, ParseError> {
-    match options.dialect {
-        Some(ast::Dialect::Tokenizer) => tokenizer_dialect::parse(text, scene_dir),
-        Some(ast::Dialect::Dictionary) => dictionary_dialect::parse(text, scene_dir),
-        None => detect::parse_auto(text, scene_dir),
+    parse_reporting(text, scene_dir, options, &NoProgress)
+}
+
+/// [`parse`], reporting a "parse" phase in bytes of `text` read by the parser (lexing comes
+/// first and is not counted), every 64 kB and at the end.
+pub fn parse_reporting(
+    text: &str,
+    scene_dir: &Path,
+    options: &ParseOptions,
+    progress: &dyn Progress,
+) -> Result<ast::SceneDescription, ParseError> {
+    progress.start("parse", text.len() as u64);
+    let reach = cursor::Reach::new(progress);
+    let result = match options.dialect {
+        Some(ast::Dialect::Tokenizer) => tokenizer_dialect::parse(text, scene_dir, &reach),
+        Some(ast::Dialect::Dictionary) => dictionary_dialect::parse(text, scene_dir, &reach),
+        None => detect::parse_auto(text, scene_dir, &reach),
+    };
+    if result.is_ok() {
+        reach.reached(text.len());
     }
+    progress.finish();
+    result
 }

@@ -5,6 +5,7 @@ use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
 use super::{Node, END, LEAF, WIDTH};
+use crate::integrator::Progress;
 use crate::math::Aabb;
 
 /// SAH bins per axis.
@@ -238,7 +239,8 @@ pub(super) struct Bvh2 {
 }
 
 /// Builds the binary tree over the hittable primitives (finite, non-empty bounds).
-pub(super) fn build_bvh2(prim_bounds: &[Aabb]) -> Bvh2 {
+/// Progress is reported per subtree built on one thread, so the report costs nothing per node.
+pub(super) fn build_bvh2(prim_bounds: &[Aabb], progress: &dyn Progress) -> Bvh2 {
     assert!(
         prim_bounds.len() < LEAF as usize,
         "BVH supports fewer than 2^31 primitives"
@@ -256,6 +258,7 @@ pub(super) fn build_bvh2(prim_bounds: &[Aabb]) -> Bvh2 {
     } else {
         prim_bounds.iter().enumerate().filter_map(make).collect()
     };
+    progress.advance((prim_bounds.len() - refs.len()) as u64);
     if refs.is_empty() {
         return Bvh2 {
             nodes: Vec::new(),
@@ -264,7 +267,10 @@ pub(super) fn build_bvh2(prim_bounds: &[Aabb]) -> Bvh2 {
     }
     let mut nodes = vec![Node2::default(); 2 * refs.len() - 1];
     let (bounds, cbounds) = range_bounds(&refs);
-    build_node(&mut nodes, 0, &mut refs, 0, bounds, cbounds, 0);
+    build_node(&mut nodes, 0, &mut refs, 0, bounds, cbounds, 0, progress);
+    if refs.len() < PARALLEL_MIN {
+        progress.advance(refs.len() as u64);
+    }
     let ids = refs.iter().map(PrimRef::id).collect();
     Bvh2 { nodes, ids }
 }
@@ -278,6 +284,7 @@ fn build_node(
     bounds: Box4,
     cbounds: Box4,
     depth: u32,
+    progress: &dyn Progress,
 ) {
     let n = refs.len();
     let leaf = Node2 {
@@ -348,7 +355,7 @@ fn build_node(
         b: node_base + 2 * m as u32,
         count: 0,
     };
-    let mut left = move || build_node(ln, node_base + 1, lr, prim_base, lb, lc, depth + 1);
+    let mut left = move || build_node(ln, node_base + 1, lr, prim_base, lb, lc, depth + 1, progress);
     let mut right = move || {
         build_node(
             rn,
@@ -358,10 +365,26 @@ fn build_node(
             rb,
             rc,
             depth + 1,
+            progress,
         )
     };
     if parallel {
-        rayon::join(left, right);
+        // A child small enough to be built on one thread reports all its primitives at once.
+        let report = |size: usize| {
+            if size < PARALLEL_MIN {
+                progress.advance(size as u64);
+            }
+        };
+        rayon::join(
+            || {
+                left();
+                report(m);
+            },
+            || {
+                right();
+                report(n - m);
+            },
+        );
     } else {
         left();
         right();

@@ -443,3 +443,32 @@ fn box_overlap_query_matches_brute_force() {
         }
     }
 }
+
+/// Counts the units reported, as a progress bar would.
+#[derive(Default)]
+struct Count(std::sync::atomic::AtomicU64);
+
+impl crate::integrator::Progress for Count {
+    fn start(&self, _: &str, _: u64) {}
+    fn advance(&self, n: u64) {
+        self.0.fetch_add(n, std::sync::atomic::Ordering::Relaxed);
+    }
+    fn finish(&self) {}
+}
+
+#[test]
+fn build_reports_every_primitive_once() {
+    let mut rng = Rng(11);
+    // Large enough for parallel subtrees; the bad boxes are counted too.
+    let mut bounds: Vec<Aabb> = random_triangles(&mut rng, 30_000)
+        .iter()
+        .map(Triangle::bounds)
+        .collect();
+    bounds.push(Aabb::EMPTY);
+    for n in [0, 1, 7, 5000, bounds.len()] {
+        let count = Count::default();
+        let bvh = Bvh::build_reporting(&bounds[..n], &count);
+        assert_eq!(count.0.into_inner(), n as u64, "{n} primitives");
+        assert_eq!(snapshot(&bvh), snapshot(&Bvh::build(&bounds[..n])));
+    }
+}

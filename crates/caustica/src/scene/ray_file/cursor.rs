@@ -2,7 +2,36 @@
 
 use super::ast::Span;
 use super::lexer::{Tok, Token};
+use crate::integrator::Progress;
 use crate::ParseError;
+use std::cell::Cell;
+
+/// Bytes of the file between two reports of the parse position.
+const REPORT_STEP: usize = 1 << 16;
+
+/// How far parsing got, in bytes of the file, for a progress bar. Detection may read the file
+/// twice: the second reading moves the bar only once it passes the furthest point.
+pub(crate) struct Reach<'p> {
+    progress: &'p dyn Progress,
+    furthest: Cell<usize>,
+}
+
+impl<'p> Reach<'p> {
+    pub fn new(progress: &'p dyn Progress) -> Reach<'p> {
+        Reach {
+            progress,
+            furthest: Cell::new(0),
+        }
+    }
+
+    pub fn reached(&self, offset: usize) {
+        let furthest = self.furthest.get();
+        if offset > furthest {
+            self.progress.advance((offset - furthest) as u64);
+            self.furthest.set(offset);
+        }
+    }
+}
 
 /// How a punctuation token is written.
 pub(crate) fn punct(tok: Tok) -> &'static str {
@@ -27,12 +56,21 @@ pub(crate) struct Cursor<'a> {
     pub text: &'a str,
     tokens: Vec<Token>,
     pos: usize,
+    reach: &'a Reach<'a>,
+    /// The byte offset past which the position is reported next.
+    next_report: usize,
 }
 
 impl<'a> Cursor<'a> {
     /// A cursor at the first token; `tokens` must end with [`Tok::Eof`].
-    pub fn new(text: &'a str, tokens: Vec<Token>) -> Cursor<'a> {
-        Cursor { text, tokens, pos: 0 }
+    pub fn new(text: &'a str, tokens: Vec<Token>, reach: &'a Reach<'a>) -> Cursor<'a> {
+        Cursor {
+            text,
+            tokens,
+            pos: 0,
+            reach,
+            next_report: REPORT_STEP,
+        }
     }
 
     /// The next token, without consuming it.
@@ -49,10 +87,19 @@ impl<'a> Cursor<'a> {
     /// Consumes and returns the next token (the end-of-file token repeats forever).
     pub fn next(&mut self) -> Token {
         let token = self.peek().clone();
+        if token.span.start >= self.next_report {
+            self.report(token.span.start);
+        }
         if self.pos + 1 < self.tokens.len() {
             self.pos += 1;
         }
         token
+    }
+
+    #[cold]
+    fn report(&mut self, offset: usize) {
+        self.reach.reached(offset);
+        self.next_report = offset + REPORT_STEP;
     }
 
     /// The end of the previously consumed token.

@@ -1,6 +1,7 @@
 //! Choosing the dialect of a file: decisive markers first, then whichever reader accepts it.
 
 use super::ast::{Dialect, SceneDescription};
+use super::cursor::Reach;
 use super::dictionary_dialect::{self, IGNORED_KEY};
 use super::keywords::{is_extension_error, COLOUR_FIELDS};
 use super::lexer::{self, Tok};
@@ -75,25 +76,25 @@ pub(crate) fn markers(text: &str) -> Markers {
 /// that O ignores and that is no misspelling of a known field (e.g. `focaldistance`). When both
 /// readers fail, a student-extension error wins, then the error of the marked dialect, then the
 /// one found further into the file (dialect T on a tie).
-pub(crate) fn parse_auto(text: &str, scene_dir: &Path) -> Result<SceneDescription, ParseError> {
+pub(crate) fn parse_auto(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<SceneDescription, ParseError> {
     let found = markers(text);
     let o_first = found.dictionary > 0 && found.tokenizer == 0;
     if o_first {
-        let o_error = match dictionary_dialect::parse(text, scene_dir) {
+        let o_error = match dictionary_dialect::parse(text, scene_dir, reach) {
             Ok(scene) => return Ok(scene),
             Err(error) => error,
         };
-        let t_error = match tokenizer_dialect::parse(text, scene_dir) {
+        let t_error = match tokenizer_dialect::parse(text, scene_dir, reach) {
             Ok(scene) => return Ok(scene),
             Err(error) => error,
         };
         return Err(choose(t_error, o_error, true));
     }
-    let t_error = match tokenizer_dialect::parse(text, scene_dir) {
+    let t_error = match tokenizer_dialect::parse(text, scene_dir, reach) {
         Ok(scene) => return Ok(scene),
         Err(error) => error,
     };
-    match dictionary_dialect::parse(text, scene_dir) {
+    match dictionary_dialect::parse(text, scene_dir, reach) {
         Ok(scene) => {
             // A key close to any keyword of the format is a misspelling in a T file, not an
             // old modeller's extra key: report it rather than reading the file as dialect O.

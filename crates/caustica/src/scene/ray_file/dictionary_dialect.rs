@@ -7,7 +7,7 @@
 use super::ast::{
     CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
 };
-use super::cursor::Cursor;
+use super::cursor::{Cursor, Reach};
 use super::keywords::{extension_error, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok};
 use super::named_materials::NamedMaterials;
@@ -23,9 +23,9 @@ use std::path::Path;
 pub(crate) const IGNORED_KEY: &str = "ignored unknown key";
 
 /// Parses a whole dialect-O file.
-pub(crate) fn parse(text: &str, scene_dir: &Path) -> Result<SceneDescription, ParseError> {
+pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<SceneDescription, ParseError> {
     let tokens = lexer::lex(text, Dialect::Dictionary)?;
-    let mut cur = Cursor::new(text, tokens);
+    let mut cur = Cursor::new(text, tokens, reach);
     if !cur.at_word("SBT-raytracer") {
         return Err(cur
             .unexpected("the header `SBT-raytracer 1.0`")

@@ -6,7 +6,7 @@
 use super::ast::{
     CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
 };
-use super::cursor::Cursor;
+use super::cursor::{Cursor, Reach};
 use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok, Token};
 use super::named_materials::NamedMaterials;
@@ -71,10 +71,10 @@ const MESH_FIELDS: &[&str] = &[
 ];
 
 /// Parses a whole dialect-T file.
-pub(crate) fn parse(text: &str, scene_dir: &Path) -> Result<SceneDescription, ParseError> {
+pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<SceneDescription, ParseError> {
     let tokens = lexer::lex(text, Dialect::Tokenizer)?;
     let mut parser = Parser {
-        cur: Cursor::new(text, tokens),
+        cur: Cursor::new(text, tokens, reach),
         scene_dir,
         default_material: MaterialDesc::default(),
         named: NamedMaterials::default(),
