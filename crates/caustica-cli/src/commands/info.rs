@@ -52,6 +52,22 @@ pub fn run(args: InfoArgs) -> Result<u8> {
             }
         }
     }
+    let area_lights = caustica::area_light::AreaLight::collect(scene);
+    if !area_lights.is_empty() {
+        println!(
+            "area lights {} (emissive objects; lights in the physical model)",
+            area_lights.len()
+        );
+        for light in &area_lights {
+            println!(
+                "  {:?}  area {:.4}  radiance {:?}{}",
+                light.object,
+                light.area,
+                light.radiance.to_array(),
+                if light.uniform { "" } else { " (textured: mean guess)" }
+            );
+        }
+    }
     println!("ambient    {:?}", scene.ambient.to_array());
     println!(
         "objects    {} shapes, {} meshes ({} triangles)",
@@ -160,8 +176,9 @@ fn info_json(args: &InfoArgs, loaded: &Loaded) -> String {
         .collect();
     let _ = write!(
         s,
-        "\"lights\":[{}],\"ambient\":{},\"shapes\":{},\"meshes\":{},\"triangles\":{},\"objects\":[{}],\"materials\":[{}],\"textures\":{},\"bounds\":{},\"warnings\":{},\"seconds\":{{\"parse\":{:.4},\"build\":{:.4}}}}}",
+        "\"lights\":[{}],\"area_lights\":{},\"ambient\":{},\"shapes\":{},\"meshes\":{},\"triangles\":{},\"objects\":[{}],\"materials\":[{}],\"textures\":{},\"bounds\":{},\"warnings\":{},\"seconds\":{{\"parse\":{:.4},\"build\":{:.4}}}}}",
         lights.join(","),
+        caustica::area_light::AreaLight::collect(scene).len(),
         json::numbers(&scene.ambient.to_array()),
         scene.shapes.len(),
         scene.meshes.len(),
