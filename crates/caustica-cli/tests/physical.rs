@@ -19,6 +19,8 @@ fn scene() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/glass_sphere.ray")
 }
 
+const TINY: [&str; 6] = ["--model", "physical", "--width", "32", "--photons", "2000"];
+
 const SMALL: [&str; 6] = ["--width", "48", "--photons", "5000", "--quiet", "--model"];
 
 fn render(dir: &Path, extra: &[&str]) {
@@ -140,28 +142,14 @@ fn time_budget_renders_at_least_one_pass_and_reports_json() {
         .current_dir(&dir)
         .arg("render")
         .arg(scene())
-        .args([
-            "--model",
-            "physical",
-            "--width",
-            "32",
-            "--photons",
-            "2000",
-            "--time",
-            "0.3",
-            "--json",
-        ])
+        .args(TINY)
+        .args(["--time", "0.3", "--json"])
         .assert()
         .success();
-    let stdout = String::from_utf8(out.get_output().stdout.clone()).unwrap();
-    assert!(stdout.contains("\"integrator\":\"ppm\""), "{stdout}");
-    let passes: u64 = stdout
-        .split("\"passes\":")
-        .nth(1)
-        .and_then(|s| s.split(',').next())
-        .and_then(|s| s.parse().ok())
-        .unwrap();
-    assert!(passes >= 1, "{stdout}");
+    let summary: serde_json::Value = serde_json::from_slice(&out.get_output().stdout).unwrap();
+    assert_eq!(summary["integrator"], "ppm", "{summary}");
+    assert!(summary["passes"].as_u64().unwrap() >= 1, "{summary}");
+    assert!(summary["seconds"]["build"].as_f64().is_some(), "{summary}");
     assert!(dir.join("caustica.png").exists());
 }
 
@@ -173,13 +161,8 @@ fn ctrl_c_keeps_the_passes_done() {
         .current_dir(&dir)
         .arg("render")
         .arg(scene())
+        .args(TINY)
         .args([
-            "--model",
-            "physical",
-            "--width",
-            "32",
-            "--photons",
-            "2000",
             "--passes",
             "1000000",
             "--partial",

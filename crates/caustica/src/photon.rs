@@ -18,6 +18,30 @@ pub use trace::{PhotonSettings, PhotonStats};
 
 use crate::math::{Vec2, Vec3};
 
+/// The median distance to the k-th nearest item, measured around up to 256 items spread
+/// through `items` (in tree order): how wide a gather of about k photons is where they are
+/// typical. 0 for fewer than two items.
+pub(crate) fn typical_knn_distance<T: kd_tree::KdPoint>(tree: &kd_tree::KdTree, items: &[T], k: usize) -> f32 {
+    let n = items.len();
+    if n < 2 || k == 0 {
+        return 0.0;
+    }
+    let samples = 256.min(n);
+    let mut out = Vec::new();
+    let mut radii: Vec<f32> = (0..samples)
+        .map(|i| {
+            let p = items[i * n / samples].position();
+            tree.k_nearest(items, p, k, f32::INFINITY, &mut out).sqrt()
+        })
+        .filter(|r| r.is_finite())
+        .collect();
+    if radii.is_empty() {
+        return 0.0;
+    }
+    radii.sort_by(f32::total_cmp);
+    radii[radii.len() / 2]
+}
+
 /// The path reached the surface by at least one specular reflection.
 pub const REFLECTED: u8 = 1;
 /// The path reached the surface by at least one refraction.

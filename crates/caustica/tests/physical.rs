@@ -47,12 +47,21 @@ fn assert_close(what: &str, got: Vec3, expected: Vec3, tolerance: f32) {
     }
 }
 
+/// Renders the furnace with `passes` passes of a 24×24 image and checks the mean radiance.
+fn furnace(name: &str, renderer: &dyn Progressive, passes: u64, tolerance: f32) {
+    let got = mean(&render(renderer, 24, 24, 0, passes).film());
+    assert_close(name, got, furnace_expected(), tolerance);
+}
+
 #[test]
 fn furnace_path() {
     let s = scene(FURNACE);
-    let path = PathTracer::new(&s, PathSettings::default(), 24, 24, 1);
-    let got = mean(&render(&path, 24, 24, 0, 64).film());
-    assert_close("path", got, furnace_expected(), 0.01);
+    furnace(
+        "path",
+        &PathTracer::new(&s, PathSettings::default(), 24, 24, 1),
+        64,
+        0.01,
+    );
 }
 
 #[test]
@@ -62,9 +71,7 @@ fn furnace_ppm() {
         photons_per_pass: 20_000,
         ..PpmSettings::default()
     };
-    let ppm = Ppm::new(&s, settings, 24, 24, 2);
-    let got = mean(&render(&ppm, 24, 24, 0, 16).film());
-    assert_close("ppm", got, furnace_expected(), 0.015);
+    furnace("ppm", &Ppm::new(&s, settings, 24, 24, 2), 16, 0.015);
 }
 
 #[test]
@@ -74,9 +81,7 @@ fn furnace_gi() {
         photons_per_pass: 20_000,
         ..GiSettings::default()
     };
-    let gi = Gi::new(&s, settings, 24, 24, 3);
-    let got = mean(&render(&gi, 24, 24, 0, 16).film());
-    assert_close("gi", got, furnace_expected(), 0.015);
+    furnace("gi", &Gi::new(&s, settings, 24, 24, 3), 16, 0.015);
 }
 
 fn reference_dir() -> Option<PathBuf> {

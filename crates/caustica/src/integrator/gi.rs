@@ -15,7 +15,7 @@
 //! A gather ray that reaches a light, directly or by a specular chain, adds nothing: next-event
 //! estimation and the caustic map already count those paths.
 
-use super::physical::{direct_light, emitted, Lights};
+use super::physical::{camera_chain, direct_light, Lights};
 use super::ppm::{pixel_angle, InitialRadius, PHOTON_SEED};
 use super::progressive::{radius_factor, sample_pass, Progressive};
 use super::Control;
@@ -120,48 +120,23 @@ impl<'a> Gi<'a> {
     }
 
     fn radiance(&self, maps: &GiMaps, ray: Ray, rng: &mut Rng) -> Vec3 {
-        let scene = self.scene;
         let s = &self.settings;
-        let mut ray = ray;
-        let mut beta = Vec3::ONE;
-        let mut l = Vec3::ZERO;
-        let mut path_length = 0.0f32;
-        for depth in 0..=s.max_depth {
-            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                break;
-            };
-            let hit = scene.surface(&ray, &isect);
-            path_length += isect.t;
-            let wo = -ray.dir;
-            l += beta * emitted(&hit);
-            let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
-            if bsdf.is_black() {
-                break;
-            }
-            if bsdf.is_smooth() {
-                l += beta * direct_light(scene, &self.lights, &hit, &bsdf, wo, false, rng);
+        camera_chain(
+            self.scene,
+            ray,
+            s.max_depth,
+            s.specular_camera_paths,
+            rng,
+            |hit, bsdf, wo, path_length, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                l += beta * maps.caustic.radiance_within(hit.point, &bsdf, wo, r);
-            }
-            if depth == s.max_depth {
-                break;
-            }
-            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
-                break;
-            };
-            let origin = offset_origin(hit.point, hit.geometric_normal, sample.wi);
-            if sample.specular {
-                if depth == 0 && !s.specular_camera_paths {
-                    break;
-                }
-                beta *= sample.weight;
-                ray = Ray::new(origin, sample.wi);
-                continue;
-            }
-            l += beta * sample.weight * self.gather(maps, Ray::new(origin, sample.wi), path_length, rng, 0);
-            break;
-        }
-        l
+                direct_light(self.scene, &self.lights, hit, bsdf, wo, false, rng)
+                    + maps.caustic.radiance_within(hit.point, bsdf, wo, r)
+            },
+            |hit, sample, path_length, rng| {
+                let origin = offset_origin(hit.point, hit.geometric_normal, sample.wi);
+                sample.weight * self.gather(maps, Ray::new(origin, sample.wi), path_length, rng, 0)
+            },
+        )
     }
 
     /// Light arriving along a gather ray, emission excluded: the global map's estimate at the

@@ -8,7 +8,7 @@
 //! ke (W/m²/sr) from both faces.
 
 use crate::area_light::{AreaLight, AreaSample};
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::light::Light;
 use crate::math::{luminance, offset_origin, Frame, Ray, Vec2, Vec3};
 use crate::sampling::{sample_cosine_hemisphere, sample_uniform_disc, sample_uniform_sphere, Rng};
@@ -298,4 +298,62 @@ pub fn direct_light(
 #[inline]
 pub fn emitted(hit: &SurfaceHit) -> Vec3 {
     hit.params.emissive.max(Vec3::ZERO)
+}
+
+/// Follows a camera ray through mirrors and glass, adding the emission it meets. At each smooth
+/// surface it adds `beta · at_smooth(hit, bsdf, wo, path length)`; where the surface's BSDF then
+/// samples a smooth lobe the chain ends with `beta · beyond(hit, sample, path length)` (nothing
+/// for photon mapping, a final gather for Jensen's method). With `through_specular` off, a
+/// camera ray that meets a mirror or glass first stops there.
+#[allow(clippy::too_many_arguments)]
+pub fn camera_chain<S, B>(
+    scene: &Scene,
+    ray: Ray,
+    max_depth: u32,
+    through_specular: bool,
+    rng: &mut Rng,
+    mut at_smooth: S,
+    mut beyond: B,
+) -> Vec3
+where
+    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, &mut Rng) -> Vec3,
+    B: FnMut(&SurfaceHit, &BsdfSample, f32, &mut Rng) -> Vec3,
+{
+    let mut ray = ray;
+    let mut beta = Vec3::ONE;
+    let mut l = Vec3::ZERO;
+    let mut path_length = 0.0f32;
+    for depth in 0..=max_depth {
+        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+            break;
+        };
+        let hit = scene.surface(&ray, &isect);
+        path_length += isect.t;
+        let wo = -ray.dir;
+        // Only the camera and specular chains reach here: emission counts in full.
+        l += beta * emitted(&hit);
+        let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+        if bsdf.is_black() {
+            break;
+        }
+        if bsdf.is_smooth() {
+            l += beta * at_smooth(&hit, &bsdf, wo, path_length, rng);
+        }
+        if depth == max_depth {
+            break;
+        }
+        let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
+            break;
+        };
+        if !sample.specular {
+            l += beta * beyond(&hit, &sample, path_length, rng);
+            break;
+        }
+        if depth == 0 && !through_specular {
+            break;
+        }
+        beta *= sample.weight;
+        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+    }
+    l
 }

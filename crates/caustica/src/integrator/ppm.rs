@@ -9,11 +9,10 @@
 //! light comes from next-event estimation and everything else (caustics, indirect diffuse light)
 //! from the photons within the pass's radius.
 
-use super::physical::{direct_light, emitted, Lights};
+use super::physical::{camera_chain, direct_light, Lights};
 use super::progressive::{radius_factor, sample_pass, Progressive};
 use super::Control;
-use crate::bsdf::{Bsdf, Transport};
-use crate::math::{offset_origin, Ray, Vec3};
+use crate::math::{Ray, Vec3};
 use crate::photon::estimate::DensityMap;
 use crate::photon::physical::{is_direct, trace};
 use crate::sampling::Rng;
@@ -118,48 +117,23 @@ impl<'a> Ppm<'a> {
         DensityMap::new(photons)
     }
 
-    /// Radiance along a camera ray with the photons of one pass.
+    /// Radiance along a camera ray with the photons of one pass: smooth lobes are counted in
+    /// full at the first smooth surface (next-event estimation and photons), only specular ones
+    /// continue the path.
     fn radiance(&self, map: &DensityMap, ray: Ray, radius_factor: f32, rng: &mut Rng) -> Vec3 {
-        let scene = self.scene;
-        let mut ray = ray;
-        let mut beta = Vec3::ONE;
-        let mut l = Vec3::ZERO;
-        let mut path_length = 0.0f32;
-        for depth in 0..=self.settings.max_depth {
-            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                break;
-            };
-            let hit = scene.surface(&ray, &isect);
-            path_length += isect.t;
-            let wo = -ray.dir;
-            // Only the camera and specular chains reach here: emission counts in full.
-            l += beta * emitted(&hit);
-            let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
-            if bsdf.is_black() {
-                break;
-            }
-            if bsdf.is_smooth() {
-                l += beta * direct_light(scene, &self.lights, &hit, &bsdf, wo, false, rng);
+        camera_chain(
+            self.scene,
+            ray,
+            self.settings.max_depth,
+            self.settings.specular_camera_paths,
+            rng,
+            |hit, bsdf, wo, path_length, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
-                l += beta * map.radiance_within(hit.point, &bsdf, wo, r);
-            }
-            if depth == self.settings.max_depth {
-                break;
-            }
-            // Smooth lobes were fully counted above; only specular ones continue the path.
-            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
-                break;
-            };
-            if !sample.specular || (depth == 0 && !self.settings.specular_camera_paths) {
-                break;
-            }
-            beta *= sample.weight;
-            if beta.max_element() <= 0.0 {
-                break;
-            }
-            ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
-        }
-        l
+                direct_light(self.scene, &self.lights, hit, bsdf, wo, false, rng)
+                    + map.radiance_within(hit.point, bsdf, wo, r)
+            },
+            |_, _, _, _| Vec3::ZERO,
+        )
     }
 }
 

@@ -100,26 +100,7 @@ impl PhotonMap {
     }
 
     fn density_radius(&self, k: usize) -> f32 {
-        let n = self.photons.len();
-        if n < 2 {
-            return 0.0;
-        }
-        let samples = 256.min(n);
-        let mut out = Vec::new();
-        let mut radii: Vec<f32> = (0..samples)
-            .map(|i| {
-                let p = self.photons[i * n / samples].position;
-                self.tree
-                    .k_nearest(&self.photons, p, k.max(1), f32::INFINITY, &mut out)
-                    .sqrt()
-            })
-            .filter(|r| r.is_finite())
-            .collect();
-        if radii.is_empty() {
-            return 0.0;
-        }
-        radii.sort_by(f32::total_cmp);
-        2.0 * radii[radii.len() / 2]
+        2.0 * super::typical_knn_distance(&self.tree, &self.photons, k.max(1))
     }
 
     /// Reflected radiance at a surface point towards `wo` from the photons nearby; `n` is the
