@@ -61,6 +61,9 @@ pub struct AreaLight {
     /// Centre and radius of a sphere under a similarity transform: seen from outside it is
     /// sampled by the cone of directions it subtends (no sample wasted on its far side).
     sphere: Option<(Vec3, f32)>,
+    /// A closed convex lamp that absorbs all light and holds nothing: what it emits inwards
+    /// dies on its own inside, so photons leave it outwards only.
+    pub outward_only: bool,
 }
 
 /// A point on a light sampled for a shading point, with the density in solid angle there.
@@ -104,6 +107,28 @@ impl AreaLight {
                 }
                 _ => None,
             };
+            let closed = match shape.kind {
+                ShapeKind::Sphere | ShapeKind::Cube => true,
+                ShapeKind::Cone(cone) => cone.capped,
+                ShapeKind::Square => false,
+            };
+            let absorbs = [
+                material.diffuse,
+                material.specular,
+                material.reflective,
+                material.transmissive,
+            ]
+            .iter()
+            .all(|c| !c.may_be_nonzero());
+            let outward_only = closed
+                && absorbs
+                && scene
+                    .occluders_near(
+                        shape.bounds.center(),
+                        0.5 * shape.bounds.extent().max_element(),
+                        i as u32,
+                    )
+                    .is_empty();
             lights.push(AreaLight {
                 object: ObjectRef::Shape(i as u32),
                 radiance,
@@ -111,6 +136,7 @@ impl AreaLight {
                 area,
                 sampler,
                 sphere,
+                outward_only,
             });
         }
         let n_shapes = scene.shapes.len() as u32;
@@ -153,14 +179,17 @@ impl AreaLight {
                 area,
                 sampler: Sampler::Mesh { triangles, cdf, area },
                 sphere: None,
+                outward_only: false,
             });
         }
         lights
     }
 
-    /// Emitted power (luminance) guess from both faces: 2·π·A·L, used to share samples.
+    /// Emitted power (luminance) guess, π·A·L from each face that emits usefully, used to
+    /// share samples.
     pub fn power(&self) -> f32 {
-        2.0 * PI * self.area * crate::math::luminance(self.radiance).max(0.0)
+        let faces = if self.outward_only { 1.0 } else { 2.0 };
+        faces * PI * self.area * crate::math::luminance(self.radiance).max(0.0)
     }
 
     /// A point on the light; `u_pick` chooses the triangle of a mesh.

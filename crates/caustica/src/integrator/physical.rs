@@ -217,9 +217,15 @@ impl Lights {
         } else {
             emission_at(scene, &sample)
         };
-        // A face at random, then a cosine-weighted direction: pdf ½·cos/π.
-        let side = if u_dir.x < 0.5 { 1.0 } else { -1.0 };
-        let u2 = Vec2::new((u_dir.x * 2.0).fract(), u_dir.y);
+        // A face at random (the outer one of a closed lamp that absorbs its own inward light),
+        // then a cosine-weighted direction: pdf ½·cos/π, or cos/π.
+        let (side, u2, faces) = if light.outward_only {
+            (1.0, u_dir, 1.0)
+        } else if u_dir.x < 0.5 {
+            (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y), 2.0)
+        } else {
+            (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y), 2.0)
+        };
         let normal = sample.normal * side;
         let dir = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2));
         if dir.dot(normal) <= 0.0 {
@@ -227,7 +233,7 @@ impl Lights {
         }
         Some(EmittedPhoton {
             ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
-            flux: le * (2.0 * PI / (sample.pdf_area * p_pick)),
+            flux: le * (faces * PI / (sample.pdf_area * p_pick)),
         })
     }
 }
@@ -356,4 +362,58 @@ where
         ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
     }
     l
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::build::{from_text, BuildSettings};
+    use std::path::Path;
+
+    fn scene(objects: &str) -> Scene {
+        let text = format!(
+            "SBT-raytracer 1.0\ncamera {{ position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); }}\n{objects}"
+        );
+        from_text(&text, Path::new("."), &BuildSettings::default()).unwrap()
+    }
+
+    /// Photons carry the lamp's whole useful power: π·A·Le from each face that lights anything,
+    /// the outer face only for a closed lamp that absorbs its own inward light.
+    #[test]
+    fn emitted_flux_is_the_lamps_power() {
+        let lamp = "scale(0.5, sphere { material = { emissive = (2, 2, 2); } })";
+        for (objects, faces, outward) in [
+            (lamp.to_string(), 1.0, true),
+            (
+                format!("{lamp} scale(0.1, sphere {{ material = {{ diffuse = (1,1,1); }} }})"),
+                2.0,
+                false,
+            ),
+            (
+                "scale(0.5, sphere { material = { emissive = (2, 2, 2); diffuse = (0.5, 0.5, 0.5); } })".to_string(),
+                2.0,
+                false,
+            ),
+        ] {
+            let s = scene(&objects);
+            let lights = Lights::new(&s);
+            assert_eq!(lights.area[0].outward_only, outward, "{objects}");
+            let mut rng = Rng::new(3, 0);
+            let n = 100_000;
+            let mut sum = 0.0f64;
+            for _ in 0..n {
+                if let Some(p) = lights.emit(&s, &mut rng) {
+                    sum += p.flux.x as f64;
+                    let outside = (p.ray.origin - Vec3::ZERO).dot(p.ray.dir) > 0.0;
+                    assert!(outside || !outward, "an outward-only lamp emitted inwards");
+                }
+            }
+            let exact = faces * std::f64::consts::PI * (4.0 * std::f64::consts::PI * 0.25) * 2.0;
+            assert!(
+                (sum / n as f64 / exact - 1.0).abs() < 0.01,
+                "{objects}: {} vs {exact}",
+                sum / n as f64
+            );
+        }
+    }
 }
