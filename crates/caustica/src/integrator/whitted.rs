@@ -149,7 +149,10 @@ pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec
         let mut crossing = Some(*isect);
         for _ in 0..MAX_CROSSINGS_PER_SHAPE {
             let Some(hit) = crossing else { break };
-            filter *= scene.surface(&ray, &hit).params.transmissive;
+            filter *= match scene.uniform_transmissive(hit.prim) {
+                Some(kt) => kt,
+                None => scene.surface(&ray, &hit).params.transmissive,
+            };
             if filter == Vec3::ZERO {
                 return true;
             }
