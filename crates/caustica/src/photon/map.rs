@@ -86,6 +86,11 @@ impl PhotonMap {
         self.photons.len()
     }
 
+    /// Heap bytes the map owns: the photons and the tree.
+    pub fn heap_bytes(&self) -> usize {
+        self.photons.capacity() * std::mem::size_of::<Photon>() + self.tree.heap_bytes()
+    }
+
     /// Whether the map holds no photon.
     pub fn is_empty(&self) -> bool {
         self.photons.is_empty()
