@@ -218,12 +218,14 @@ pub fn render(
                     return map.radiance(scene, hit, n, wo, estimate);
                 }
                 let mut entries = cache.get();
+                let mut nearby = None;
                 if let Some((prim, point, r, flux)) = entries.entries[slot] {
                     if prim == hit.prim && point.distance(hit.point) <= REUSE_FRACTION * r {
                         return p.diffuse * flux;
                     }
+                    nearby = (prim == hit.prim && r > 0.0).then_some(r);
                 }
-                let (flux, r) = map.irradiance(scene, hit, n, estimate);
+                let (flux, r) = map.irradiance_near(scene, hit, n, estimate, nearby);
                 if entries.entries[slot].is_none() {
                     entries.entries[slot] = Some((hit.prim, hit.point, r, flux));
                     cache.set(entries);

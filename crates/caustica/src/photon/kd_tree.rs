@@ -318,6 +318,21 @@ impl KdTree {
         max_dist2: f32,
         out: &mut Vec<Neighbor>,
     ) -> f32 {
+        let r2 = self.k_nearest_unordered(items, p, k, max_dist2, out);
+        heapify(out);
+        r2
+    }
+
+    /// [`KdTree::k_nearest`] without the heap order: the same items and radius, in no
+    /// particular order (for callers that only sum over them).
+    pub fn k_nearest_unordered<T: KdPoint>(
+        &self,
+        items: &[T],
+        p: Vec3,
+        k: usize,
+        max_dist2: f32,
+        out: &mut Vec<Neighbor>,
+    ) -> f32 {
         out.clear();
         assert_eq!(items.len(), self.len(), "items are not the tree's slice");
         if k == 0 || p.is_nan() || max_dist2.is_nan() || max_dist2 < 0.0 {
@@ -339,9 +354,8 @@ impl KdTree {
         if out.len() > k {
             keep_nearest(out, k);
         }
-        heapify(out);
         if out.len() == k {
-            out[0].dist2
+            out.iter().fold(0.0, |m, n| max_f(m, n.dist2))
         } else {
             max_dist2
         }
@@ -384,7 +398,7 @@ struct Knn<'a, T> {
 impl<T: KdPoint> Knn<'_, T> {
     /// Visits the subtree at `node` (`size` internal nodes, leftmost leaf `leaf << levels`)
     /// covering items `lo..lo + len`; `off` holds the query's per-axis offsets to its cell.
-    fn visit(&mut self, node: usize, size: usize, leaf: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+    fn visit(&mut self, node: usize, size: usize, leaf: usize, lo: usize, len: usize, off: [f32; 3]) {
         if size == 0 {
             if self.leaves[leaf].dist2(self.p) < self.bound {
                 self.leaf(lo, len);
@@ -403,7 +417,7 @@ impl<T: KdPoint> Knn<'_, T> {
             (right, 2 * leaf + 1, lo + half, len - half, left, 2 * leaf, lo, half)
         };
         self.visit(near, child, near_leaf, near_lo, near_len, off);
-        off[axis] = diff;
+        let off = far_offsets(off, axis, diff);
         if dist2(off, [0.0; 3]) < self.bound {
             self.visit(far, child, far_leaf, far_lo, far_len, off);
         }
@@ -441,6 +455,17 @@ fn max_f(a: f32, b: f32) -> f32 {
     } else {
         a
     }
+}
+
+/// The far child's offsets: `off` with `axis` replaced by `diff`. Built by selects, not by a
+/// store into the array: reading the array back right after a one-lane store stalls the CPU.
+#[inline(always)]
+fn far_offsets(off: [f32; 3], axis: usize, diff: f32) -> [f32; 3] {
+    [
+        if axis == 0 { diff } else { off[0] },
+        if axis == 1 { diff } else { off[1] },
+        if axis == 2 { diff } else { off[2] },
+    ]
 }
 
 /// Keeps the `k` nearest of more than `k` candidates; returns the k-th distance.
@@ -498,7 +523,7 @@ struct Within<'a, T, F> {
 }
 
 impl<T: KdPoint, F: FnMut(u32, f32)> Within<'_, T, F> {
-    fn visit(&mut self, node: usize, size: usize, leaf: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+    fn visit(&mut self, node: usize, size: usize, leaf: usize, lo: usize, len: usize, off: [f32; 3]) {
         if size == 0 {
             if self.leaves[leaf].dist2(self.p) >= self.bound {
                 return;
@@ -523,7 +548,7 @@ impl<T: KdPoint, F: FnMut(u32, f32)> Within<'_, T, F> {
             (right, 2 * leaf + 1, lo + half, len - half, left, 2 * leaf, lo, half)
         };
         self.visit(near, child, near_leaf, near_lo, near_len, off);
-        off[axis] = diff;
+        let off = far_offsets(off, axis, diff);
         if dist2(off, [0.0; 3]) < self.bound {
             self.visit(far, child, far_leaf, far_lo, far_len, off);
         }

@@ -153,6 +153,13 @@ fn check_knn<T: KdPoint>(
     for i in 1..out.len() {
         assert!(out[(i - 1) / 2].dist2 >= out[i].dist2, "{ctx}: not a heap");
     }
+    // The unordered query finds the same distances and radius.
+    let mut plain = Vec::new();
+    let r_plain = tree.k_nearest_unordered(items, p, k, max_d2, &mut plain);
+    let mut plain: Vec<f32> = plain.iter().map(|n| n.dist2).collect();
+    plain.sort_by(f32::total_cmp);
+    assert_eq!(plain, want, "{ctx}: unordered k={k} r2={max_d2} p={p}");
+    assert_eq!(r_plain.to_bits(), r.to_bits(), "{ctx}: unordered radius");
     if k > 0 && out.len() == k {
         assert_eq!(r, out[0].dist2, "{ctx}: radius");
         assert_eq!(r, *want.last().unwrap(), "{ctx}: radius");
