@@ -72,6 +72,23 @@ impl Shape {
         })
     }
 
+    /// A world-space sphere (centre, radius) holding the whole shape: the object-space one,
+    /// carried over. Tighter than a sphere around the world bounds of a rotated shape.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        let (center, radius) = match &self.kind {
+            ShapeKind::Sphere => (Vec3::ZERO, 1.0),
+            ShapeKind::Cube => (Vec3::ZERO, 0.75f32.sqrt()),
+            ShapeKind::Square => (Vec3::ZERO, 0.5f32.sqrt()),
+            ShapeKind::Cone(cone) => {
+                let h = 0.5 * cone.height;
+                let r = cone.bottom_radius.max(cone.top_radius);
+                (Vec3::new(0.0, 0.0, h), (r * r + h * h).sqrt())
+            }
+        };
+        let stretch = max_stretch(Mat3::from_mat4(self.world_from_object));
+        (self.world_from_object.transform_point3(center), radius * stretch)
+    }
+
     /// Whether the surface may come within world distance `r` of `point`; false only when it
     /// certainly does not (an object-space distance bound divided by the largest stretch).
     #[inline]
@@ -328,6 +345,48 @@ mod tests {
             }
         }
         assert!(pruned > 500, "the bound prunes: {pruned}");
+    }
+
+    /// Surface points found by casting rays lie inside the bounding sphere.
+    #[test]
+    fn bounding_sphere_holds_the_shape() {
+        let kinds = [
+            ShapeKind::Sphere,
+            ShapeKind::Cube,
+            ShapeKind::Square,
+            ShapeKind::cylinder(true),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
+        ];
+        let transforms = [
+            Mat4::from_scale(Vec3::new(20.0, 20.0, 0.5)),
+            Mat4::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 0.785)
+                * Mat4::from_translation(Vec3::new(0.5, -1.0, 2.0))
+                * Mat4::from_scale(Vec3::new(3.0, 0.2, 1.5)),
+            Mat4::from_cols_array(&[
+                1.0, 0.3, 0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 0.2, 0.0, 0.7, 0.0, 1.0, -2.0, 0.5, 1.0,
+            ]),
+        ];
+        let mut rng = crate::sampling::Rng::new(3, 0);
+        for kind in kinds {
+            for m in transforms {
+                let s = Shape::new(kind, m).unwrap();
+                let (center, radius) = s.bounding_sphere();
+                let mut hits = 0;
+                // Rays start in or near the world bounds, where the object-space solve is precise.
+                for _ in 0..2000 {
+                    let u = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+                    let from = s.bounds.min - Vec3::ONE + (s.bounds.extent() + Vec3::splat(2.0)) * u;
+                    let ray = Ray::new(from, crate::sampling::sample_uniform_sphere(rng.uniform2()));
+                    if let Some(hit) = s.intersect(&ray, f32::INFINITY) {
+                        hits += 1;
+                        let d = ray.at(hit.t).distance(center);
+                        assert!(d <= radius * (1.0 + 1e-4), "{kind:?}: hit at {d} > {radius}");
+                    }
+                }
+                assert!(hits > 20, "{kind:?}: {hits} hits");
+            }
+        }
     }
 
     #[test]
