@@ -128,7 +128,13 @@ fn decode_rgbe(c: [u8; 4]) -> Vec3 {
     if c[3] == 0 {
         return Vec3::ZERO;
     }
-    let f = ((c[3] as i32 - 128 - 8) as f32).exp2();
+    // 2^(e − 136) built from its bits (a normal float for every stored exponent but the lowest).
+    let e = c[3] as i32 - 136;
+    let f = if e > -127 {
+        f32::from_bits(((e + 127) as u32) << 23)
+    } else {
+        (e as f32).exp2()
+    };
     Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * f
 }
 
@@ -185,6 +191,14 @@ mod tests {
         }
         assert_eq!(decode_rgbe(encode_rgbe(Vec3::ZERO)), Vec3::ZERO);
         assert_eq!(decode_rgbe(encode_rgbe(Vec3::splat(f32::NAN))), Vec3::ZERO);
+    }
+
+    #[test]
+    fn rgbe_exponents_decode_exactly() {
+        for e in 1..=255u8 {
+            let want = Vec3::splat(200.0) * ((e as i32 - 136) as f32).exp2();
+            assert_eq!(decode_rgbe([200, 200, 200, e]), want, "exponent byte {e}");
+        }
     }
 
     #[test]

@@ -241,6 +241,26 @@ impl Scene {
         }
     }
 
+    /// The primitive's `transmissive` colour when it is the same all over it (no texture, no
+    /// per-vertex materials): shadow rays then need no surface evaluation.
+    #[inline]
+    pub fn uniform_transmissive(&self, prim: u32) -> Option<Vec3> {
+        let n_shapes = self.shapes.len() as u32;
+        let material = if prim < n_shapes {
+            self.shape_materials[prim as usize]
+        } else {
+            let mesh = &self.meshes[self.triangle_refs[(prim - n_shapes) as usize].mesh as usize];
+            if mesh.vertex_materials.is_some() {
+                return None;
+            }
+            mesh.material
+        };
+        match self.materials[material as usize].transmissive {
+            crate::material::Channel::Constant(c) => Some(c),
+            crate::material::Channel::Texture(_) => None,
+        }
+    }
+
     /// The next crossing of the same primitive beyond `hit` (a closed shape is crossed twice),
     /// as an intersection along the same `ray` with `t < t_max`. Triangles are crossed once.
     pub fn next_crossing(&self, ray: &Ray, hit: &Intersection, t_max: f32) -> Option<Intersection> {
@@ -327,11 +347,20 @@ impl Scene {
 
     /// The primitives other than `except` whose bounds come within the cube of half-size `r`
     /// around `point`: only they can stand between the point and photons gathered nearby.
+    /// Shapes whose surface provably stays farther than `r` are left out too.
     pub fn occluders_near(&self, point: Vec3, r: f32, except: u32) -> Occluders {
         let query = Aabb::new(point - Vec3::splat(r), point + Vec3::splat(r));
+        // Segments from the point end at photons within `r`, both ends moved off their surfaces.
+        let reach = r * (1.0 + 1e-3) + 2e-4 * (1.0 + point.abs().max_element());
+        let n_shapes = self.shapes.len() as u32;
         let mut found = Occluders::default();
         self.bvh.any_overlap(&query, |prim| {
-            if prim != except {
+            let near = if prim < n_shapes {
+                self.shapes[prim as usize].may_come_within(point, reach)
+            } else {
+                self.triangles[(prim - n_shapes) as usize].plane_distance(point) <= reach
+            };
+            if prim != except && near {
                 found.push(prim);
             }
             found.overflowed

@@ -48,6 +48,28 @@ impl Cone {
         Aabb::new(Vec3::new(-r, -r, 0.0), Vec3::new(r, r, self.height))
     }
 
+    /// A lower bound on the distance from `p` to the surface: the side lies in the annulus
+    /// between the two radii over `0 ≤ z ≤ height`, the caps are discs.
+    pub fn distance_lower_bound(&self, p: Vec3) -> f32 {
+        let rho = (p.x * p.x + p.y * p.y).sqrt();
+        let (r_min, r_max) = (
+            self.bottom_radius.min(self.top_radius),
+            self.bottom_radius.max(self.top_radius),
+        );
+        let dz = (-p.z).max(p.z - self.height).max(0.0);
+        let dr = (rho - r_max).max(r_min - rho).max(0.0);
+        let side = (dr * dr + dz * dz).sqrt();
+        if !self.capped {
+            return side;
+        }
+        let disc = |z: f32, radius: f32| {
+            let d = (rho - radius).max(0.0);
+            (d * d + (p.z - z) * (p.z - z)).sqrt()
+        };
+        side.min(disc(0.0, self.bottom_radius))
+            .min(disc(self.height, self.top_radius))
+    }
+
     fn slope(&self) -> f32 {
         (self.top_radius - self.bottom_radius) / self.height
     }

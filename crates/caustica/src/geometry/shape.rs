@@ -36,6 +36,9 @@ pub struct Shape {
     pub normal_to_world: Mat3,
     /// World-space bounds.
     pub bounds: Aabb,
+    /// An upper bound on how much `object_from_world` stretches any length, for
+    /// [`Shape::may_come_within`].
+    pub object_stretch: f32,
 }
 
 /// A hit on a shape, in world space.
@@ -65,7 +68,47 @@ impl Shape {
             object_from_world,
             normal_to_world,
             bounds,
+            object_stretch: max_stretch(Mat3::from_mat4(object_from_world)),
         })
+    }
+
+    /// A world-space sphere (centre, radius) holding the whole shape: the object-space one,
+    /// carried over. Tighter than a sphere around the world bounds of a rotated shape.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        let (center, radius) = match &self.kind {
+            ShapeKind::Sphere => (Vec3::ZERO, 1.0),
+            ShapeKind::Cube => (Vec3::ZERO, 0.75f32.sqrt()),
+            ShapeKind::Square => (Vec3::ZERO, 0.5f32.sqrt()),
+            ShapeKind::Cone(cone) => {
+                let h = 0.5 * cone.height;
+                let r = cone.bottom_radius.max(cone.top_radius);
+                (Vec3::new(0.0, 0.0, h), (r * r + h * h).sqrt())
+            }
+        };
+        let stretch = max_stretch(Mat3::from_mat4(self.world_from_object));
+        (self.world_from_object.transform_point3(center), radius * stretch)
+    }
+
+    /// Whether the surface may come within world distance `r` of `point`; false only when it
+    /// certainly does not (an object-space distance bound divided by the largest stretch).
+    #[inline]
+    pub fn may_come_within(&self, point: Vec3, r: f32) -> bool {
+        let p = self.object_from_world.transform_point3(point);
+        let d = match &self.kind {
+            ShapeKind::Sphere => (p.length() - 1.0).abs(),
+            ShapeKind::Cube => {
+                let q = p.abs() - Vec3::splat(0.5);
+                if q.max_element() > 0.0 {
+                    q.max(Vec3::ZERO).length()
+                } else {
+                    -q.max_element()
+                }
+            }
+            ShapeKind::Square => Vec3::new((p.x.abs() - 0.5).max(0.0), (p.y.abs() - 0.5).max(0.0), p.z).length(),
+            ShapeKind::Cone(cone) => cone.distance_lower_bound(p),
+        };
+        // Rounding in the transform: a relative margin on the object-space distance.
+        d * (1.0 - 1e-4) - 1e-6 * (1.0 + p.abs().max_element()) <= r * self.object_stretch
     }
 
     /// Nearest hit in `(0, t_max)` along the world ray.
@@ -90,6 +133,20 @@ impl Shape {
             normal,
             uv: hit.uv,
         })
+    }
+}
+
+/// An upper bound on the largest singular value of `m`: the square root of a Gershgorin bound on
+/// the largest eigenvalue of `mᵀm` (exact for rotations and axis scales), with a little margin.
+fn max_stretch(m: Mat3) -> f32 {
+    let g = m.transpose() * m;
+    let rows = [g.row(0), g.row(1), g.row(2)];
+    let bound = rows.iter().map(|r| r.abs().element_sum()).fold(0.0, f32::max);
+    let s = bound.sqrt() * (1.0 + 1e-4);
+    if s.is_finite() {
+        s
+    } else {
+        f32::INFINITY
     }
 }
 
@@ -240,6 +297,96 @@ mod tests {
             "the doubled z tilts the normal: {:?}",
             qh.normal
         );
+    }
+
+    /// Rays cast from a point hit the surface within `r` only if `may_come_within` says so;
+    /// and it never answers false for a shape that passes within `r` (checked by casting).
+    #[test]
+    fn proximity_bound_is_conservative() {
+        let kinds = [
+            ShapeKind::Sphere,
+            ShapeKind::Cube,
+            ShapeKind::Square,
+            ShapeKind::cylinder(false),
+            ShapeKind::cylinder(true),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
+        ];
+        let transforms = [
+            Mat4::IDENTITY,
+            Mat4::from_scale(Vec3::new(20.0, 20.0, 0.5)),
+            Mat4::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 0.785)
+                * Mat4::from_scale(Vec3::new(3.0, 0.2, 1.5)),
+            Mat4::from_cols_array(&[
+                1.0, 0.3, 0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 0.2, 0.0, 0.7, 0.0, 1.0, -2.0, 0.5, 1.0,
+            ]),
+        ];
+        let mut rng = crate::sampling::Rng::new(7, 0);
+        let mut pruned = 0;
+        for kind in kinds {
+            for m in transforms {
+                let s = Shape::new(kind, m).unwrap();
+                let (lo, hi) = (s.bounds.min, s.bounds.max);
+                let ext = (hi - lo).max_element();
+                for _ in 0..200 {
+                    let u = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+                    let point = lo - Vec3::splat(0.2 * ext) + (hi - lo + Vec3::splat(0.4 * ext)) * u;
+                    let r = ext * 0.15 * rng.uniform();
+                    if s.may_come_within(point, r) {
+                        continue;
+                    }
+                    pruned += 1;
+                    for _ in 0..400 {
+                        let d = crate::sampling::sample_uniform_sphere(rng.uniform2());
+                        let hit = s.intersect(&Ray::new(point, d), r);
+                        assert!(hit.is_none(), "{kind:?} within {r} of {point:?}");
+                    }
+                }
+            }
+        }
+        assert!(pruned > 500, "the bound prunes: {pruned}");
+    }
+
+    /// Surface points found by casting rays lie inside the bounding sphere.
+    #[test]
+    fn bounding_sphere_holds_the_shape() {
+        let kinds = [
+            ShapeKind::Sphere,
+            ShapeKind::Cube,
+            ShapeKind::Square,
+            ShapeKind::cylinder(true),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
+        ];
+        let transforms = [
+            Mat4::from_scale(Vec3::new(20.0, 20.0, 0.5)),
+            Mat4::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 0.785)
+                * Mat4::from_translation(Vec3::new(0.5, -1.0, 2.0))
+                * Mat4::from_scale(Vec3::new(3.0, 0.2, 1.5)),
+            Mat4::from_cols_array(&[
+                1.0, 0.3, 0.0, 0.0, 0.0, 1.0, 0.5, 0.0, 0.2, 0.0, 0.7, 0.0, 1.0, -2.0, 0.5, 1.0,
+            ]),
+        ];
+        let mut rng = crate::sampling::Rng::new(3, 0);
+        for kind in kinds {
+            for m in transforms {
+                let s = Shape::new(kind, m).unwrap();
+                let (center, radius) = s.bounding_sphere();
+                let mut hits = 0;
+                // Rays start in or near the world bounds, where the object-space solve is precise.
+                for _ in 0..2000 {
+                    let u = Vec3::new(rng.uniform(), rng.uniform(), rng.uniform());
+                    let from = s.bounds.min - Vec3::ONE + (s.bounds.extent() + Vec3::splat(2.0)) * u;
+                    let ray = Ray::new(from, crate::sampling::sample_uniform_sphere(rng.uniform2()));
+                    if let Some(hit) = s.intersect(&ray, f32::INFINITY) {
+                        hits += 1;
+                        let d = ray.at(hit.t).distance(center);
+                        assert!(d <= radius * (1.0 + 1e-4), "{kind:?}: hit at {d} > {radius}");
+                    }
+                }
+                assert!(hits > 20, "{kind:?}: {hits} hits");
+            }
+        }
     }
 
     #[test]

@@ -76,6 +76,21 @@ impl Triangle {
         }
     }
 
+    /// Distance from `p` to the triangle's plane, a lower bound on the distance to the triangle
+    /// (0 for a degenerate triangle).
+    #[inline]
+    pub fn plane_distance(&self, p: Vec3) -> f32 {
+        let [a, b, c] = self.vertices();
+        let n = (b - a).cross(c - a);
+        let len = n.length();
+        if len > 0.0 && len.is_finite() {
+            // Shrunk a little against rounding in the cross product.
+            ((p - a).dot(n) / len).abs() * (1.0 - 1e-4)
+        } else {
+            0.0
+        }
+    }
+
     /// The three vertices `[a, b, c]`.
     #[inline]
     pub fn vertices(&self) -> [Vec3; 3] {

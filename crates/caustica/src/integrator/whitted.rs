@@ -149,7 +149,10 @@ pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec
         let mut crossing = Some(*isect);
         for _ in 0..MAX_CROSSINGS_PER_SHAPE {
             let Some(hit) = crossing else { break };
-            filter *= scene.surface(&ray, &hit).params.transmissive;
+            filter *= match scene.uniform_transmissive(hit.prim) {
+                Some(kt) => kt,
+                None => scene.surface(&ray, &hit).params.transmissive,
+            };
             if filter == Vec3::ZERO {
                 return true;
             }
@@ -215,12 +218,14 @@ pub fn render(
                     return map.radiance(scene, hit, n, wo, estimate);
                 }
                 let mut entries = cache.get();
+                let mut nearby = None;
                 if let Some((prim, point, r, flux)) = entries.entries[slot] {
                     if prim == hit.prim && point.distance(hit.point) <= REUSE_FRACTION * r {
                         return p.diffuse * flux;
                     }
+                    nearby = (prim == hit.prim && r > 0.0).then_some(r);
                 }
-                let (flux, r) = map.irradiance(scene, hit, n, estimate);
+                let (flux, r) = map.irradiance_near(scene, hit, n, estimate, nearby);
                 if entries.entries[slot].is_none() {
                     entries.entries[slot] = Some((hit.prim, hit.point, r, flux));
                     cache.set(entries);

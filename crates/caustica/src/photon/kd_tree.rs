@@ -1,8 +1,9 @@
 //! A balanced, pointer-free kd-tree over a slice of points, for photon gathering.
 //!
-//! [`KdTree::build`] reorders the caller's items in place into tree order and keeps only one
-//! small record (split value + axis, 8 bytes) per internal node. Leaves hold `LEAF_MAX / 2 ..=
-//! LEAF_MAX` items, so there are `n / 16 .. n / 8` internal nodes: 0.5–1 byte per point.
+//! [`KdTree::build`] reorders the caller's items in place into tree order and keeps one small
+//! record (split value + axis, 8 bytes) per internal node and the tight bounds of each leaf's
+//! points (24 bytes). Leaves hold `LEAF_MAX / 2 ..= LEAF_MAX` items, so there are `n / 16 .. n /
+//! 8` internal nodes and as many leaves: 2–4 bytes per point.
 //!
 //! # Layout
 //!
@@ -19,6 +20,8 @@
 //! Depth-first, nearer child first, with the far child pruned by the exact squared distance from
 //! the query to the child's cell (per-axis offsets carried down, as in Arya & Mount), computed
 //! with the same rounding as a point distance so pruning never drops a point on the boundary.
+//! A leaf is scanned only if its tight bounds come within the current radius: photons lie on
+//! surfaces, often oblique to the axes, so a cell is mostly empty space.
 //! k-NN candidates collect in the caller's `Vec` (up to `2k`, then a selection keeps the `k`
 //! nearest and tightens the radius); the result is heapified at the end. A query allocates
 //! nothing once that vector has grown to `2k`.
@@ -67,8 +70,40 @@ struct Node {
 pub struct KdTree {
     /// Internal nodes in pre-order; `2^D - 1` of them.
     nodes: Vec<Node>,
+    /// Bounds of each leaf's points, leaves left to right; `2^D` of them.
+    leaves: Vec<LeafBounds>,
     /// Number of items the tree was built over.
     len: u32,
+}
+
+/// Tight bounds of one leaf's points (empty, lo > hi, for a leaf without finite points).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct LeafBounds {
+    lo: [f32; 3],
+    hi: [f32; 3],
+}
+
+impl Default for LeafBounds {
+    fn default() -> Self {
+        LeafBounds {
+            lo: [f32::INFINITY; 3],
+            hi: [f32::NEG_INFINITY; 3],
+        }
+    }
+}
+
+impl LeafBounds {
+    /// Squared distance from `p` to the box, rounded as [`dist2`] so it never exceeds the
+    /// distance to a point inside (infinite for an empty box).
+    #[inline(always)]
+    fn dist2(&self, p: [f32; 3]) -> f32 {
+        let d = [0, 1, 2].map(|a| {
+            let below = self.lo[a] - p[a];
+            let above = p[a] - self.hi[a];
+            max_f(max_f(below, above), 0.0)
+        });
+        dist2(d, [0.0; 3])
+    }
 }
 
 /// Squared distance with a fixed summation order; the cell bounds use the same order, which
@@ -185,12 +220,13 @@ fn select_by<T: KdPoint>(items: &mut [T], mid: usize, key: impl Fn(Vec3) -> f32)
     });
 }
 
-fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], items: &mut [T]) {
-    if nodes.is_empty() {
-        return;
-    }
+fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], leaves: &mut [LeafBounds], items: &mut [T]) {
     let n = items.len();
     let b = bounds(items);
+    if nodes.is_empty() {
+        leaves[0] = LeafBounds { lo: b.lo, hi: b.hi };
+        return;
+    }
     let ext = [0, 1, 2].map(|a| b.hi[a] - b.lo[a]);
     // Widest axis; a NaN extent never wins a comparison.
     let mut axis = 0;
@@ -219,14 +255,15 @@ fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], items: &mut [T]) {
     let half = nodes.len() / 2;
     let (left_nodes, right_nodes) = nodes[1..].split_at_mut(half);
     let (left_items, right_items) = items.split_at_mut(mid);
+    let (left_leaves, right_leaves) = leaves.split_at_mut(leaves.len() / 2);
     if n >= PAR_MIN {
         rayon::join(
-            || build_rec(left_nodes, left_items),
-            || build_rec(right_nodes, right_items),
+            || build_rec(left_nodes, left_leaves, left_items),
+            || build_rec(right_nodes, right_leaves, right_items),
         );
     } else {
-        build_rec(left_nodes, left_items);
-        build_rec(right_nodes, right_items);
+        build_rec(left_nodes, left_leaves, left_items);
+        build_rec(right_nodes, right_leaves, right_items);
     }
 }
 
@@ -243,8 +280,9 @@ impl KdTree {
         let len = u32::try_from(n).expect("KdTree holds at most u32::MAX items");
         let depth = depth_for(n);
         let mut nodes = vec![Node::default(); (1usize << depth) - 1];
-        build_rec(&mut nodes, items);
-        KdTree { nodes, len }
+        let mut leaves = vec![LeafBounds::default(); 1usize << depth];
+        build_rec(&mut nodes, &mut leaves, items);
+        KdTree { nodes, leaves, len }
     }
 
     /// Number of items the tree was built over.
@@ -261,7 +299,7 @@ impl KdTree {
 
     /// Heap bytes the tree itself owns (the items are the caller's).
     pub fn heap_bytes(&self) -> usize {
-        self.nodes.capacity() * std::mem::size_of::<Node>()
+        self.nodes.capacity() * std::mem::size_of::<Node>() + self.leaves.capacity() * std::mem::size_of::<LeafBounds>()
     }
 
     /// The k nearest items within squared distance `max_dist2` (inclusive) of `p`.
@@ -280,6 +318,21 @@ impl KdTree {
         max_dist2: f32,
         out: &mut Vec<Neighbor>,
     ) -> f32 {
+        let r2 = self.k_nearest_unordered(items, p, k, max_dist2, out);
+        heapify(out);
+        r2
+    }
+
+    /// [`KdTree::k_nearest`] without the heap order: the same items and radius, in no
+    /// particular order (for callers that only sum over them).
+    pub fn k_nearest_unordered<T: KdPoint>(
+        &self,
+        items: &[T],
+        p: Vec3,
+        k: usize,
+        max_dist2: f32,
+        out: &mut Vec<Neighbor>,
+    ) -> f32 {
         out.clear();
         assert_eq!(items.len(), self.len(), "items are not the tree's slice");
         if k == 0 || p.is_nan() || max_dist2.is_nan() || max_dist2 < 0.0 {
@@ -290,19 +343,19 @@ impl KdTree {
         let mut q = Knn {
             items,
             nodes: &self.nodes,
+            leaves: &self.leaves,
             p: p.to_array(),
             k,
             cap,
             bound: strict_bound(max_dist2),
             out,
         };
-        q.visit(0, self.nodes.len(), 0, items.len(), [0.0; 3]);
+        q.visit(0, self.nodes.len(), 0, 0, items.len(), [0.0; 3]);
         if out.len() > k {
             keep_nearest(out, k);
         }
-        heapify(out);
         if out.len() == k {
-            out[0].dist2
+            out.iter().fold(0.0, |m, n| max_f(m, n.dist2))
         } else {
             max_dist2
         }
@@ -320,11 +373,12 @@ impl KdTree {
         let mut q = Within {
             items,
             nodes: &self.nodes,
+            leaves: &self.leaves,
             p: p.to_array(),
             bound: strict_bound(r2),
             f: &mut f,
         };
-        q.visit(0, self.nodes.len(), 0, items.len(), [0.0; 3]);
+        q.visit(0, self.nodes.len(), 0, 0, items.len(), [0.0; 3]);
     }
 }
 
@@ -332,6 +386,7 @@ impl KdTree {
 struct Knn<'a, T> {
     items: &'a [T],
     nodes: &'a [Node],
+    leaves: &'a [LeafBounds],
     p: [f32; 3],
     k: usize,
     /// Candidates held before a selection: `2k`.
@@ -341,11 +396,13 @@ struct Knn<'a, T> {
 }
 
 impl<T: KdPoint> Knn<'_, T> {
-    /// Visits the subtree at `node` (`size` internal nodes) covering items `lo..lo + len`;
-    /// `off` holds the query's per-axis offsets to that subtree's cell.
-    fn visit(&mut self, node: usize, size: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+    /// Visits the subtree at `node` (`size` internal nodes, leftmost leaf `leaf << levels`)
+    /// covering items `lo..lo + len`; `off` holds the query's per-axis offsets to its cell.
+    fn visit(&mut self, node: usize, size: usize, leaf: usize, lo: usize, len: usize, off: [f32; 3]) {
         if size == 0 {
-            self.leaf(lo, len);
+            if self.leaves[leaf].dist2(self.p) < self.bound {
+                self.leaf(lo, len);
+            }
             return;
         }
         let Node { split, axis } = self.nodes[node];
@@ -354,15 +411,15 @@ impl<T: KdPoint> Knn<'_, T> {
         let child = size / 2;
         let half = len / 2;
         let (left, right) = (node + 1, node + 1 + child);
-        let (near, near_lo, near_len, far, far_lo, far_len) = if diff < 0.0 {
-            (left, lo, half, right, lo + half, len - half)
+        let (near, near_leaf, near_lo, near_len, far, far_leaf, far_lo, far_len) = if diff < 0.0 {
+            (left, 2 * leaf, lo, half, right, 2 * leaf + 1, lo + half, len - half)
         } else {
-            (right, lo + half, len - half, left, lo, half)
+            (right, 2 * leaf + 1, lo + half, len - half, left, 2 * leaf, lo, half)
         };
-        self.visit(near, child, near_lo, near_len, off);
-        off[axis] = diff;
+        self.visit(near, child, near_leaf, near_lo, near_len, off);
+        let off = far_offsets(off, axis, diff);
         if dist2(off, [0.0; 3]) < self.bound {
-            self.visit(far, child, far_lo, far_len, off);
+            self.visit(far, child, far_leaf, far_lo, far_len, off);
         }
     }
 
@@ -398,6 +455,17 @@ fn max_f(a: f32, b: f32) -> f32 {
     } else {
         a
     }
+}
+
+/// The far child's offsets: `off` with `axis` replaced by `diff`. Built by selects, not by a
+/// store into the array: reading the array back right after a one-lane store stalls the CPU.
+#[inline(always)]
+fn far_offsets(off: [f32; 3], axis: usize, diff: f32) -> [f32; 3] {
+    [
+        if axis == 0 { diff } else { off[0] },
+        if axis == 1 { diff } else { off[1] },
+        if axis == 2 { diff } else { off[2] },
+    ]
 }
 
 /// Keeps the `k` nearest of more than `k` candidates; returns the k-th distance.
@@ -448,14 +516,18 @@ fn sift_down(h: &mut [Neighbor], mut i: usize) {
 struct Within<'a, T, F> {
     items: &'a [T],
     nodes: &'a [Node],
+    leaves: &'a [LeafBounds],
     p: [f32; 3],
     bound: f32,
     f: &'a mut F,
 }
 
 impl<T: KdPoint, F: FnMut(u32, f32)> Within<'_, T, F> {
-    fn visit(&mut self, node: usize, size: usize, lo: usize, len: usize, mut off: [f32; 3]) {
+    fn visit(&mut self, node: usize, size: usize, leaf: usize, lo: usize, len: usize, off: [f32; 3]) {
         if size == 0 {
+            if self.leaves[leaf].dist2(self.p) >= self.bound {
+                return;
+            }
             for (i, it) in self.items[lo..lo + len].iter().enumerate() {
                 let d2 = dist2(it.position().to_array(), self.p);
                 if d2 < self.bound {
@@ -470,15 +542,15 @@ impl<T: KdPoint, F: FnMut(u32, f32)> Within<'_, T, F> {
         let child = size / 2;
         let half = len / 2;
         let (left, right) = (node + 1, node + 1 + child);
-        let (near, near_lo, near_len, far, far_lo, far_len) = if diff < 0.0 {
-            (left, lo, half, right, lo + half, len - half)
+        let (near, near_leaf, near_lo, near_len, far, far_leaf, far_lo, far_len) = if diff < 0.0 {
+            (left, 2 * leaf, lo, half, right, 2 * leaf + 1, lo + half, len - half)
         } else {
-            (right, lo + half, len - half, left, lo, half)
+            (right, 2 * leaf + 1, lo + half, len - half, left, 2 * leaf, lo, half)
         };
-        self.visit(near, child, near_lo, near_len, off);
-        off[axis] = diff;
+        self.visit(near, child, near_leaf, near_lo, near_len, off);
+        let off = far_offsets(off, axis, diff);
         if dist2(off, [0.0; 3]) < self.bound {
-            self.visit(far, child, far_lo, far_len, off);
+            self.visit(far, child, far_leaf, far_lo, far_len, off);
         }
     }
 }

@@ -52,6 +52,10 @@ pub struct PhotonMap {
     pub stats: PhotonStats,
 }
 
+/// A nearby estimate's radius times this bounds the first photon search: the density rarely
+/// falls by more than its square (2.25×) within a pixel.
+const NARROW_SCALE: f32 = 1.5;
+
 thread_local! {
     static NEIGHBORS: RefCell<Vec<Neighbor>> = const { RefCell::new(Vec::new()) };
 }
@@ -86,6 +90,11 @@ impl PhotonMap {
         self.photons.len()
     }
 
+    /// Heap bytes the map owns: the photons and the tree.
+    pub fn heap_bytes(&self) -> usize {
+        self.photons.capacity() * std::mem::size_of::<Photon>() + self.tree.heap_bytes()
+    }
+
     /// Whether the map holds no photon.
     pub fn is_empty(&self) -> bool {
         self.photons.is_empty()
@@ -108,7 +117,7 @@ impl PhotonMap {
     /// point cannot see in a straight line (behind a wall, across a ring's rim) are left out.
     pub fn radiance(&self, scene: &Scene, hit: &SurfaceHit, n: Vec3, wo: Vec3, settings: &EstimateSettings) -> Vec3 {
         let params = &hit.params;
-        self.gather(scene, hit, n, settings, |wi| params.phong_reflectance(n, wo, wi))
+        self.gather(scene, hit, n, settings, None, |wi| params.phong_reflectance(n, wo, wi))
             .0
     }
 
@@ -116,7 +125,20 @@ impl PhotonMap {
     /// radiance of a white Lambertian receiver, kd = 1), and the gather radius used. Multiplied
     /// by kd it equals [`PhotonMap::radiance`] on any receiver without a specular lobe.
     pub fn irradiance(&self, scene: &Scene, hit: &SurfaceHit, n: Vec3, settings: &EstimateSettings) -> (Vec3, f32) {
-        self.gather(scene, hit, n, settings, |wi| {
+        self.irradiance_near(scene, hit, n, settings, None)
+    }
+
+    /// [`PhotonMap::irradiance`] given the gather radius of an estimate made nearby, which
+    /// narrows the photon search; the result is the same (the search widens if it must).
+    pub fn irradiance_near(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        n: Vec3,
+        settings: &EstimateSettings,
+        radius_nearby: Option<f32>,
+    ) -> (Vec3, f32) {
+        self.gather(scene, hit, n, settings, radius_nearby, |wi| {
             if n.dot(wi) > 0.0 {
                 Vec3::ONE
             } else {
@@ -132,6 +154,7 @@ impl PhotonMap {
         hit: &SurfaceHit,
         n: Vec3,
         settings: &EstimateSettings,
+        radius_nearby: Option<f32>,
         reflectance: impl Fn(Vec3) -> Vec3,
     ) -> (Vec3, f32) {
         let point = hit.point;
@@ -144,9 +167,23 @@ impl PhotonMap {
         }
         NEIGHBORS.with(|cell| {
             let mut neighbors = cell.borrow_mut();
-            let r2 = self
-                .tree
-                .k_nearest(&self.photons, point, settings.k, max_r * max_r, &mut neighbors);
+            let full = max_r * max_r;
+            // The k nearest within a narrower radius, when there are k, are the k nearest.
+            let narrow = radius_nearby.map_or(f32::INFINITY, |r| (NARROW_SCALE * r) * (NARROW_SCALE * r));
+            let mut r2 = f32::NAN;
+            if narrow < full {
+                r2 = self
+                    .tree
+                    .k_nearest_unordered(&self.photons, point, settings.k, narrow, &mut neighbors);
+                if neighbors.len() < settings.k {
+                    r2 = f32::NAN;
+                }
+            }
+            if r2.is_nan() {
+                r2 = self
+                    .tree
+                    .k_nearest_unordered(&self.photons, point, settings.k, full, &mut neighbors);
+            }
             if neighbors.is_empty() || r2.is_nan() || r2 <= 0.0 {
                 return (Vec3::ZERO, 0.0);
             }

@@ -15,7 +15,7 @@ use crate::integrator::Control;
 use crate::light::{distance_attenuation, Light};
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
 use crate::sampling::Rng;
-use crate::scene::Scene;
+use crate::scene::{ObjectRef, Scene};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -89,12 +89,30 @@ impl PhotonStats {
     }
 }
 
-/// The bounding spheres photons are aimed at: one per reflective or transmissive object.
+/// The bounding spheres photons are aimed at: one per reflective or transmissive object. For a
+/// shape, the smaller of the sphere around its world bounds and its own bounding sphere: a
+/// rotated ring's world box is much larger than the ring, and every photon aimed past the ring
+/// is traced for nothing.
 pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
     scene
         .objects()
         .filter(|(object, bounds)| scene.object_is_specular(*object) && !bounds.is_empty())
-        .map(|(_, bounds)| Target::around(&bounds))
+        .map(|(object, bounds)| {
+            let around = Target::around(&bounds);
+            let ObjectRef::Shape(i) = object else {
+                return around;
+            };
+            let (center, radius) = scene.shapes[i as usize].bounding_sphere();
+            let own = Target {
+                center,
+                radius: radius * 1.001 + 1e-4,
+            };
+            if own.radius < around.radius && own.radius.is_finite() && center.is_finite() {
+                own
+            } else {
+                around
+            }
+        })
         .collect()
 }
 

@@ -153,6 +153,13 @@ fn check_knn<T: KdPoint>(
     for i in 1..out.len() {
         assert!(out[(i - 1) / 2].dist2 >= out[i].dist2, "{ctx}: not a heap");
     }
+    // The unordered query finds the same distances and radius.
+    let mut plain = Vec::new();
+    let r_plain = tree.k_nearest_unordered(items, p, k, max_d2, &mut plain);
+    let mut plain: Vec<f32> = plain.iter().map(|n| n.dist2).collect();
+    plain.sort_by(f32::total_cmp);
+    assert_eq!(plain, want, "{ctx}: unordered k={k} r2={max_d2} p={p}");
+    assert_eq!(r_plain.to_bits(), r.to_bits(), "{ctx}: unordered radius");
     if k > 0 && out.len() == k {
         assert_eq!(r, out[0].dist2, "{ctx}: radius");
         assert_eq!(r, *want.last().unwrap(), "{ctx}: radius");
@@ -389,8 +396,8 @@ fn build_is_deterministic_across_thread_counts() {
 fn tree_overhead_is_small() {
     for n in [1, 12, 13, 1000, 123_457, 1 << 20, 10_000_000] {
         let nodes = (1usize << depth_for(n)) - 1;
-        let bytes = nodes * std::mem::size_of::<Node>();
-        assert!(bytes <= n, "n={n}: {bytes} bytes");
+        let bytes = nodes * std::mem::size_of::<Node>() + (nodes + 1) * std::mem::size_of::<LeafBounds>();
+        assert!(bytes <= 4 * n.max(8), "n={n}: {bytes} bytes");
         // Leaves hold at most LEAF_MAX items.
         assert!(n.div_ceil(nodes + 1) <= LEAF_MAX);
     }
