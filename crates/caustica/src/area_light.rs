@@ -139,7 +139,8 @@ impl AreaLight {
                 outward_only,
             });
         }
-        let n_shapes = scene.shapes.len() as u32;
+        // Triangles by mesh, gathered in one pass over the scene's triangles.
+        let mut by_mesh: Vec<Vec<u32>> = Vec::new();
         for (m, mesh) in scene.meshes.iter().enumerate() {
             let emissive_base = scene.materials[mesh.material as usize].is_emissive();
             let per_vertex = mesh
@@ -149,13 +150,17 @@ impl AreaLight {
             if !emissive_base && !per_vertex {
                 continue;
             }
+            if by_mesh.is_empty() {
+                by_mesh = vec![Vec::new(); scene.meshes.len()];
+                for (t, r) in scene.triangle_refs.iter().enumerate() {
+                    by_mesh[r.mesh as usize].push(t as u32);
+                }
+            }
             let mut triangles = Vec::new();
             let mut cdf = Vec::new();
             let mut area = 0.0f32;
-            for (t, r) in scene.triangle_refs.iter().enumerate() {
-                if r.mesh as usize != m {
-                    continue;
-                }
+            for &t in &by_mesh[m] {
+                let t = t as usize;
                 let [a, b, c] = scene.triangles[t].vertices();
                 let tri_area = 0.5 * (b - a).cross(c - a).length();
                 if tri_area > 0.0 && tri_area.is_finite() {
@@ -171,7 +176,6 @@ impl AreaLight {
                 (None, crate::material::Channel::Constant(c)) => (c, true),
                 _ => (Vec3::splat(0.5), false),
             };
-            let _ = n_shapes;
             lights.push(AreaLight {
                 object: ObjectRef::Mesh(m as u32),
                 radiance,
