@@ -448,15 +448,7 @@ fn sample_object(kind: &ShapeKind, u_pick: f32, u: Vec2) -> Option<(Vec3, Vec3)>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::build::{from_text, BuildSettings};
-    use std::path::Path;
-
-    fn scene(objects: &str) -> Scene {
-        let text = format!(
-            "SBT-raytracer 1.0\ncamera {{ position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); }}\n{objects}"
-        );
-        from_text(&text, Path::new("."), &BuildSettings::default()).unwrap()
-    }
+    use crate::scene::build::test_scene as scene;
 
     /// Σ 1/pdf over samples estimates the area; it must match the closed form for each kind
     /// under a non-uniform scale (where a similarity-only formula would be wrong).

@@ -75,11 +75,49 @@ where
     F: Fn(f32, f32, &mut Rng, &mut S) -> crate::math::Vec3 + Sync,
 {
     let (w, h) = (settings.width, settings.height);
-    let tiles_x = w.div_ceil(TILE);
-    let tiles_y = h.div_ceil(TILE);
     control.progress.start(phase, (w * h) as u64);
     let aa = settings.aa.max(1);
     let inv_samples = 1.0 / (aa * aa) as f32;
+    let (pixels, complete) = shade_tiles(w, h, control, true, |x, y| {
+        let mut rng = Rng::new(settings.seed, (y * w + x) as u64);
+        let mut state = S::default();
+        let mut sum = crate::math::Vec3::ZERO;
+        for sy in 0..aa {
+            for sx in 0..aa {
+                let (jx, jy) = if aa == 1 {
+                    (0.5, 0.5)
+                } else {
+                    (rng.uniform(), rng.uniform())
+                };
+                let px = x as f32 + (sx as f32 + jx) / aa as f32;
+                let py = y as f32 + (sy as f32 + jy) / aa as f32;
+                // Screen y runs upwards; film rows run downwards.
+                sum += sample(px / w as f32, 1.0 - py / h as f32, &mut rng, &mut state);
+            }
+        }
+        sum * inv_samples
+    });
+    control.progress.finish();
+    let mut film = Film::new(w, h);
+    film.pixels = pixels;
+    (film, complete)
+}
+
+/// Computes `pixel(x, y)` for every pixel, 16×16 tiles in parallel, into rows from the top;
+/// tiles not begun before cancellation stay black. With `report`, each finished tile advances
+/// the progress by its pixel count. Returns the pixels and whether every tile was done.
+pub(crate) fn shade_tiles<F>(
+    width: usize,
+    height: usize,
+    control: Control,
+    report: bool,
+    pixel: F,
+) -> (Vec<crate::math::Vec3>, bool)
+where
+    F: Fn(usize, usize) -> crate::math::Vec3 + Sync,
+{
+    let tiles_x = width.div_ceil(TILE);
+    let tiles_y = height.div_ceil(TILE);
     let tiles: Vec<Option<Vec<crate::math::Vec3>>> = (0..tiles_x * tiles_y)
         .into_par_iter()
         .map(|tile| {
@@ -87,48 +125,33 @@ where
                 return None;
             }
             let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-            let (x1, y1) = ((x0 + TILE).min(w), (y0 + TILE).min(h));
+            let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
             let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
             for y in y0..y1 {
                 for x in x0..x1 {
-                    let mut rng = Rng::new(settings.seed, (y * w + x) as u64);
-                    let mut state = S::default();
-                    let mut sum = crate::math::Vec3::ZERO;
-                    for sy in 0..aa {
-                        for sx in 0..aa {
-                            let (jx, jy) = if aa == 1 {
-                                (0.5, 0.5)
-                            } else {
-                                (rng.uniform(), rng.uniform())
-                            };
-                            let px = x as f32 + (sx as f32 + jx) / aa as f32;
-                            let py = y as f32 + (sy as f32 + jy) / aa as f32;
-                            // Screen y runs upwards; film rows run downwards.
-                            sum += sample(px / w as f32, 1.0 - py / h as f32, &mut rng, &mut state);
-                        }
-                    }
-                    out.push(sum * inv_samples);
+                    out.push(pixel(x, y));
                 }
             }
-            control.progress.advance(out.len() as u64);
+            if report {
+                control.progress.advance(out.len() as u64);
+            }
             Some(out)
         })
         .collect();
-    control.progress.finish();
-    let mut film = Film::new(w, h);
+    let mut pixels = vec![crate::math::Vec3::ZERO; width * height];
     let mut complete = true;
-    for (tile, pixels) in tiles.into_iter().enumerate() {
-        let Some(pixels) = pixels else {
+    for (tile, values) in tiles.into_iter().enumerate() {
+        let Some(values) = values else {
             complete = false;
             continue;
         };
         let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-        let tw = (x0 + TILE).min(w) - x0;
-        for (i, p) in pixels.into_iter().enumerate() {
-            film.pixels[(y0 + i / tw) * w + x0 + i % tw] = p;
+        let tw = (x0 + TILE).min(width) - x0;
+        for (i, v) in values.into_iter().enumerate() {
+            pixels[(y0 + i / tw) * width + x0 + i % tw] = v;
         }
     }
-    (film, complete)
+    (pixels, complete)
 }
 
 /// The image size for a camera: `width` as given, height from the aspect ratio unless given.

@@ -367,15 +367,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::build::{from_text, BuildSettings};
-    use std::path::Path;
-
-    fn scene(objects: &str) -> Scene {
-        let text = format!(
-            "SBT-raytracer 1.0\ncamera {{ position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); }}\n{objects}"
-        );
-        from_text(&text, Path::new("."), &BuildSettings::default()).unwrap()
-    }
+    use crate::scene::build::test_scene as scene;
 
     /// Photons carry the lamp's whole useful power: π·A·Le from each face that lights anything,
     /// the outer face only for a closed lamp that absorbs its own inward light.

@@ -10,12 +10,11 @@
 //! size, the run's settings fingerprint, the passes it holds) and then the sums as little-endian
 //! f64 triples, rows from the top.
 
-use super::{Control, TILE};
+use super::{shade_tiles, Control};
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::math::Vec3;
 use crate::sampling::Rng;
-use rayon::prelude::*;
 use std::path::Path;
 
 /// An integrator that renders the image as a series of independent passes.
@@ -37,41 +36,19 @@ pub fn sample_pass<F>(
 where
     F: Fn(f32, f32, &mut Rng) -> Vec3 + Sync,
 {
-    let tiles_x = width.div_ceil(TILE);
-    let tiles_y = height.div_ceil(TILE);
-    let tiles: Vec<Option<Vec<Vec3>>> = (0..tiles_x * tiles_y)
-        .into_par_iter()
-        .map(|tile| {
-            if control.cancelled() {
-                return None;
-            }
-            let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-            let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
-            let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    let pixel = (y * width + x) as u64;
-                    let mut rng = Rng::new(seed, (pass << 32) ^ pixel);
-                    let (jx, jy) = (rng.uniform(), rng.uniform());
-                    let sx = (x as f32 + jx) / width as f32;
-                    let sy = 1.0 - (y as f32 + jy) / height as f32;
-                    let v = sample(sx, sy, &mut rng);
-                    out.push(if v.is_finite() { v } else { Vec3::ZERO });
-                }
-            }
-            Some(out)
-        })
-        .collect();
-    let mut pixels = vec![Vec3::ZERO; width * height];
-    for (tile, values) in tiles.into_iter().enumerate() {
-        let values = values?;
-        let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-        let tw = (x0 + TILE).min(width) - x0;
-        for (i, v) in values.into_iter().enumerate() {
-            pixels[(y0 + i / tw) * width + x0 + i % tw] = v;
+    let (pixels, complete) = shade_tiles(width, height, control, false, |x, y| {
+        let mut rng = Rng::new(seed, (pass << 32) ^ (y * width + x) as u64);
+        let (jx, jy) = (rng.uniform(), rng.uniform());
+        let sx = (x as f32 + jx) / width as f32;
+        let sy = 1.0 - (y as f32 + jy) / height as f32;
+        let v = sample(sx, sy, &mut rng);
+        if v.is_finite() {
+            v
+        } else {
+            Vec3::ZERO
         }
-    }
-    Some(pixels)
+    });
+    complete.then_some(pixels)
 }
 
 /// The sums of a set of passes.

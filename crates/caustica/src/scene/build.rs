@@ -393,6 +393,14 @@ fn singular(span: &Span) -> ParseError {
     )
 }
 
+/// A scene of `objects` seen by a camera at (0, 0, 5) looking down −z, for unit tests.
+#[cfg(test)]
+pub(crate) fn test_scene(objects: &str) -> Scene {
+    let text =
+        format!("SBT-raytracer 1.0\ncamera {{ position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); }}\n{objects}");
+    from_text(&text, Path::new("."), &BuildSettings::default()).unwrap()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
