@@ -184,6 +184,14 @@ fn triangle_bvh(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     acc
 }
 
+fn triangle_bvh_any(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let n = rays
+        .iter()
+        .filter(|ray| black_box(s.tri_bvh.any_hit(ray, f32::INFINITY)))
+        .count();
+    (n, 0.0)
+}
+
 fn shadow(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     let mut n = 0;
     for ray in rays {
@@ -239,10 +247,11 @@ fn obvhs_our_triangle(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     acc
 }
 
-const TRACERS: [(&str, Tracer); 7] = [
+const TRACERS: [(&str, Tracer); 8] = [
     ("closure", generic),
     ("closure+pre", generic_pre),
     ("TriangleBvh", triangle_bvh),
+    ("TriangleBvh-any", triangle_bvh_any),
     ("any_hit", shadow),
     ("obvhs", obvhs_indexed),
     ("obvhs-ordered", obvhs_ordered),

@@ -11,6 +11,7 @@ pub mod shape;
 pub mod sphere;
 pub mod square;
 pub mod triangle;
+pub mod triangle_packet;
 
 pub use shape::{Shape, ShapeKind, ShapeSettings};
 

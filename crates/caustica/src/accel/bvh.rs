@@ -153,7 +153,12 @@ impl Bvh {
     /// [`Bvh::build`], advancing `progress` by one unit per primitive placed in the tree (the
     /// caller starts and finishes the phase).
     pub fn build_reporting(prim_bounds: &[Aabb], progress: &dyn Progress) -> Bvh {
-        let c = build::collapse(build::build_bvh2(prim_bounds, progress));
+        Bvh::build_priced(prim_bounds, build::LeafCost::SINGLE, progress)
+    }
+
+    /// [`Bvh::build_reporting`] with leaves priced by `leaf`.
+    fn build_priced(prim_bounds: &[Aabb], leaf: build::LeafCost, progress: &dyn Progress) -> Bvh {
+        let c = build::collapse(build::build_bvh2(prim_bounds, leaf, progress));
         Bvh {
             nodes: c.nodes,
             order: c.order,
@@ -312,6 +317,23 @@ impl Bvh {
                 i += 1;
             }
         })
+    }
+
+    /// [`Bvh::traverse`] with the stack size the tree needs.
+    #[inline(always)]
+    fn traverse_any_stack(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        leaf: impl FnMut(&[u32], usize, &mut f32) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            false
+        } else if self.small_stack() {
+            self.traverse::<SMALL_STACK>(ray, t_max, leaf)
+        } else {
+            self.traverse::<LARGE_STACK>(ray, t_max, leaf)
+        }
     }
 
     /// Near-first traversal. `leaf(order, first, t_max)` handles the leaf starting at `first`

@@ -36,12 +36,13 @@ pub struct TriangleHit {
 #[derive(Clone, Copy, Debug)]
 pub struct TriangleRay {
     /// Axes permuted so `dir[kz]` is the largest component.
-    k: [usize; 3],
+    pub(crate) k: [usize; 3],
     /// Origin components in permuted order, splatted.
-    origin: [Vec4; 3],
-    /// Shear `dir[kx] / dir[kz]`, `dir[ky] / dir[kz]`, and `1 / dir[kz]`, splatted.
-    shear: [Vec4; 2],
-    inv_dz: f32,
+    pub(crate) origin: [Vec4; 3],
+    /// Shear `dir[kx] / dir[kz]`, `dir[ky] / dir[kz]`, splatted.
+    pub(crate) shear: [Vec4; 2],
+    /// `1 / dir[kz]`.
+    pub(crate) inv_dz: f32,
 }
 
 impl TriangleRay {

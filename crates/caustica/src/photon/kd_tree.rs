@@ -339,7 +339,8 @@ impl KdTree {
             return max_dist2;
         }
         let cap = k.saturating_mul(2);
-        out.reserve(cap.min(items.len()));
+        // A leaf's candidates are added at once, so the count may pass `cap` by a leaf's worth.
+        out.reserve((cap + LEAF_MAX).min(items.len()));
         let mut q = Knn {
             items,
             nodes: &self.nodes,
@@ -423,27 +424,41 @@ impl<T: KdPoint> Knn<'_, T> {
         }
     }
 
+    /// Scans a leaf without a branch per item (whether a photon is a candidate is a coin flip
+    /// near the radius): each is written to a buffer whose length advances only for candidates,
+    /// and the bound is updated once per leaf. Candidates found with the bound of the leaf's
+    /// start are a superset of those a per-item update would keep, so the result is the same.
     #[inline]
     fn leaf(&mut self, lo: usize, len: usize) {
-        for (i, it) in self.items[lo..lo + len].iter().enumerate() {
-            let d2 = dist2(it.position().to_array(), self.p);
-            if d2 < self.bound {
-                self.push((lo + i) as u32, d2);
+        for (start, chunk) in (lo..).step_by(LEAF_MAX).zip(self.items[lo..lo + len].chunks(LEAF_MAX)) {
+            let mut buf = [Neighbor { slot: 0, dist2: 0.0 }; LEAF_MAX];
+            let mut found = 0;
+            for (i, it) in chunk.iter().enumerate() {
+                let d2 = dist2(it.position().to_array(), self.p);
+                buf[found % LEAF_MAX] = Neighbor {
+                    slot: (start + i) as u32,
+                    dist2: d2,
+                };
+                found += usize::from(d2 < self.bound);
+            }
+            if found > 0 {
+                self.extend(&buf[..found]);
             }
         }
     }
 
-    /// Candidates collect unsorted; at `k` the bound drops to their maximum, and every further
-    /// `k` candidates a selection keeps the `k` nearest and tightens the bound. That is O(1)
-    /// amortised per candidate, against O(log k) mispredicted sifts for a heap.
+    /// Adds candidates. When their count first reaches `k` the bound drops to their maximum,
+    /// and whenever it reaches `2k` a selection keeps the `k` nearest and tightens the bound:
+    /// O(1) amortised per candidate, against O(log k) mispredicted sifts for a heap.
     #[inline]
-    fn push(&mut self, slot: u32, dist2: f32) {
-        self.out.push(Neighbor { slot, dist2 });
+    fn extend(&mut self, candidates: &[Neighbor]) {
+        let before = self.out.len();
+        self.out.extend_from_slice(candidates);
         let len = self.out.len();
-        if len == self.k {
-            self.bound = self.out.iter().fold(0.0, |m, n| max_f(m, n.dist2));
-        } else if len == self.cap {
+        if len >= self.cap {
             self.bound = keep_nearest(self.out, self.k);
+        } else if before < self.k && len >= self.k {
+            self.bound = self.out.iter().fold(0.0, |m, n| max_f(m, n.dist2));
         }
     }
 }

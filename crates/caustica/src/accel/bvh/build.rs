@@ -10,10 +10,8 @@ use crate::math::Aabb;
 
 /// SAH bins per axis.
 const BINS: usize = 32;
-/// Relative cost of visiting a binary node versus intersecting one primitive.
+/// Cost of visiting a binary node, the unit of [`LeafCost`].
 const TRAVERSAL_COST: f32 = 1.0;
-/// Leaves never hold more primitives than this (unless the depth limit forces them to).
-pub(super) const MAX_LEAF: usize = 8;
 /// Beyond this depth splits become object medians, so the depth stays below about
 /// `MEDIAN_DEPTH + log2(n)` and the traversal stack stays bounded.
 const MEDIAN_DEPTH: u32 = 40;
@@ -23,6 +21,31 @@ const SWEEP_MAX: usize = 32;
 const PARALLEL_MIN: usize = 4096;
 /// Binning runs in parallel chunks of this many primitives for large nodes.
 const BIN_CHUNK: usize = 1 << 15;
+
+/// How the surface-area heuristic prices primitives in leaves.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LeafCost {
+    /// Primitives are intersected in blocks of this many (1, or a packet's lanes).
+    pub(crate) block: usize,
+    /// Cost of one block, relative to visiting a binary node.
+    pub(crate) block_cost: f32,
+    /// Leaves never hold more primitives than this (unless the depth limit forces them to).
+    pub(crate) max_leaf: usize,
+}
+
+impl LeafCost {
+    /// One primitive at a time, each costing a node visit.
+    pub(crate) const SINGLE: LeafCost = LeafCost {
+        block: 1,
+        block_cost: 1.0,
+        max_leaf: 8,
+    };
+
+    #[inline]
+    fn of(&self, n: usize) -> f32 {
+        n.div_ceil(self.block) as f32 * self.block_cost
+    }
+}
 
 /// A primitive's bounds; the primitive id rides in the w lanes as two exact 16-bit halves
 /// (plain small floats, so no NaN payloads to lose).
@@ -178,7 +201,7 @@ struct Split {
     cost: f32,
 }
 
-fn best_split(bins: &Bins) -> Option<Split> {
+fn best_split(bins: &Bins, leaf: &LeafCost) -> Option<Split> {
     let mut best: Option<Split> = None;
     for axis in 0..3 {
         let counts = &bins.counts[axis];
@@ -188,7 +211,7 @@ fn best_split(bins: &Bins) -> Option<Split> {
         for i in (1..BINS).rev() {
             acc = acc.union(bins.bounds[axis][i]);
             n += counts[i];
-            right_cost[i] = acc.half_area() * n as f32;
+            right_cost[i] = acc.half_area() * leaf.of(n as usize);
         }
         let mut acc = Box4::EMPTY;
         let mut left_n = 0u32;
@@ -199,7 +222,7 @@ fn best_split(bins: &Bins) -> Option<Split> {
             if left_n == 0 || left_n == total {
                 continue;
             }
-            let cost = acc.half_area() * left_n as f32 + right_cost[i];
+            let cost = acc.half_area() * leaf.of(left_n as usize) + right_cost[i];
             // Strict comparison keeps the first minimum: deterministic ties.
             if !matches!(&best, Some(b) if b.cost <= cost) {
                 best = Some(Split { axis, bin: i, cost });
@@ -240,7 +263,7 @@ pub(super) struct Bvh2 {
 
 /// Builds the binary tree over the hittable primitives (finite, non-empty bounds).
 /// Progress is reported per subtree built on one thread, so the report costs nothing per node.
-pub(super) fn build_bvh2(prim_bounds: &[Aabb], progress: &dyn Progress) -> Bvh2 {
+pub(super) fn build_bvh2(prim_bounds: &[Aabb], leaf: LeafCost, progress: &dyn Progress) -> Bvh2 {
     assert!(
         prim_bounds.len() < LEAF as usize,
         "BVH supports fewer than 2^31 primitives"
@@ -267,7 +290,7 @@ pub(super) fn build_bvh2(prim_bounds: &[Aabb], progress: &dyn Progress) -> Bvh2 
     }
     let mut nodes = vec![Node2::default(); 2 * refs.len() - 1];
     let (bounds, cbounds) = range_bounds(&refs);
-    build_node(&mut nodes, 0, &mut refs, 0, bounds, cbounds, 0, progress);
+    build_node(&mut nodes, 0, &mut refs, 0, bounds, cbounds, 0, &leaf, progress);
     if refs.len() < PARALLEL_MIN {
         progress.advance(refs.len() as u64);
     }
@@ -284,9 +307,11 @@ fn build_node(
     bounds: Box4,
     cbounds: Box4,
     depth: u32,
+    leaf_cost: &LeafCost,
     progress: &dyn Progress,
 ) {
     let n = refs.len();
+    let max_leaf = leaf_cost.max_leaf;
     let leaf = Node2 {
         bounds,
         a: prim_base,
@@ -300,9 +325,9 @@ fn build_node(
     let degenerate = (cbounds.hi - cbounds.lo).truncate().max_element() <= 0.0;
     let mut split_at = None;
     if n <= SWEEP_MAX && depth < MEDIAN_DEPTH {
-        let (m, cost) = sweep_split(refs);
+        let (m, cost) = sweep_split(refs, leaf_cost);
         let split_cost = TRAVERSAL_COST + cost / bounds.half_area();
-        if n <= MAX_LEAF && (split_cost >= n as f32 || split_cost.is_nan()) {
+        if n <= max_leaf && (split_cost >= leaf_cost.of(n) || split_cost.is_nan()) {
             nodes[0] = leaf;
             return;
         }
@@ -317,11 +342,11 @@ fn build_node(
         } else {
             binner.fill(refs)
         };
-        if let Some(split) = best_split(&bins) {
+        if let Some(split) = best_split(&bins, leaf_cost) {
             let area = bounds.half_area();
             let split_cost = TRAVERSAL_COST + split.cost / area;
             // Also reached when the parent area is zero (cost NaN): then only size decides.
-            if n <= MAX_LEAF && (split_cost >= n as f32 || split_cost.is_nan()) {
+            if n <= max_leaf && (split_cost >= leaf_cost.of(n) || split_cost.is_nan()) {
                 nodes[0] = leaf;
                 return;
             }
@@ -331,7 +356,7 @@ fn build_node(
     let parallel = n >= PARALLEL_MIN;
     let (m, (lb, lc), (rb, rc)) = match split_at {
         Some(split) => split,
-        None if n <= MAX_LEAF => {
+        None if n <= max_leaf => {
             nodes[0] = leaf;
             return;
         }
@@ -355,7 +380,7 @@ fn build_node(
         b: node_base + 2 * m as u32,
         count: 0,
     };
-    let mut left = move || build_node(ln, node_base + 1, lr, prim_base, lb, lc, depth + 1, progress);
+    let mut left = move || build_node(ln, node_base + 1, lr, prim_base, lb, lc, depth + 1, leaf_cost, progress);
     let mut right = move || {
         build_node(
             rn,
@@ -365,6 +390,7 @@ fn build_node(
             rb,
             rc,
             depth + 1,
+            leaf_cost,
             progress,
         )
     };
@@ -393,7 +419,7 @@ fn build_node(
 
 /// Exact SAH over all object splits along each axis (for small nodes, where it is cheaper
 /// than binning); leaves `refs` ordered for the best split and returns its left size and cost.
-fn sweep_split(refs: &mut [PrimRef]) -> (usize, f32) {
+fn sweep_split(refs: &mut [PrimRef], leaf: &LeafCost) -> (usize, f32) {
     let n = refs.len();
     let mut best = (f32::INFINITY, 0, 1);
     let mut right_cost = [0.0f32; SWEEP_MAX];
@@ -402,12 +428,12 @@ fn sweep_split(refs: &mut [PrimRef]) -> (usize, f32) {
         let mut acc = Box4::EMPTY;
         for i in (1..n).rev() {
             acc.grow(refs[i].lo, refs[i].hi);
-            right_cost[i] = acc.half_area() * (n - i) as f32;
+            right_cost[i] = acc.half_area() * leaf.of(n - i);
         }
         let mut acc = Box4::EMPTY;
         for i in 1..n {
             acc.grow(refs[i - 1].lo, refs[i - 1].hi);
-            let cost = acc.half_area() * i as f32 + right_cost[i];
+            let cost = acc.half_area() * leaf.of(i) + right_cost[i];
             // Ties (e.g. identical boxes) go to the most balanced split.
             let balance = |m: usize| m.abs_diff(n / 2);
             if cost < best.0 || (cost == best.0 && balance(i) < balance(best.2)) {

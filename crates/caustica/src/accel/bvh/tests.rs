@@ -128,6 +128,19 @@ fn check_against_brute_force(tris: &[Triangle], rng: &mut Rng, rays: usize) {
         });
         assert_eq!(occluded, expect.is_some(), "any_hit {ray:?}");
         assert_eq!(tbvh.any_hit(&ray, t_max), expect.is_some(), "triangle any_hit {ray:?}");
+        // Every triangle the segment meets is visited once, with the scalar test's hit.
+        let mut visited = Vec::new();
+        assert!(!tbvh.each_hit(&ray, t_max, |h| {
+            visited.push((h.prim, h.t));
+            false
+        }));
+        visited.sort_by_key(|&(p, _)| p);
+        let all: Vec<(u32, f32)> = tris
+            .iter()
+            .enumerate()
+            .filter_map(|(i, t)| t.intersect(&ray, t_max).map(|h| (i as u32, h.t)))
+            .collect();
+        assert_eq!(visited, all, "each_hit {ray:?}");
     }
     assert!(
         tris.len() < 3 || hits > rays / 10,
@@ -405,7 +418,32 @@ fn bounds_contain_children() {
             }
         }
     }
-    assert!(leaves > 5000 / build::MAX_LEAF);
+    assert!(leaves > 5000 / build::LeafCost::SINGLE.max_leaf);
+}
+
+#[test]
+fn triangle_overlap_query_finds_every_triangle_touching_the_box() {
+    let mut rng = Rng(21);
+    let tris = random_triangles(&mut rng, 2000);
+    let tbvh = TriangleBvh::new(&tris);
+    for _ in 0..200 {
+        let c = rng.v() * 10.0;
+        let h = Vec3::splat(rng.f() * 2.0);
+        let query = Aabb::new(c - h, c + h);
+        let mut found = HashSet::new();
+        assert!(!tbvh.any_overlap(&query, |p| {
+            assert!(found.insert(p), "visited twice");
+            false
+        }));
+        for (i, t) in tris.iter().enumerate() {
+            let [a, b, c] = t.vertices();
+            let b_ = t.bounds();
+            let hittable = a != b && b != c && c != a;
+            if hittable && b_.min.cmple(query.max).all() && b_.max.cmpge(query.min).all() {
+                assert!(found.contains(&(i as u32)), "triangle {i} missed");
+            }
+        }
+    }
 }
 
 #[test]
