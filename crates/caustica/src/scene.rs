@@ -7,7 +7,7 @@ pub mod ray_file;
 
 pub use build::{build, load, parse_file, parse_text, BuildSettings, ParsedScene};
 
-use crate::accel::bvh::Bvh;
+use crate::accel::bvh::{Bvh, TriangleBvh, TriangleBvhHit};
 use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::Shape;
@@ -108,7 +108,10 @@ pub struct Scene {
     pub triangle_refs: Vec<TriangleRef>,
     /// Remarks made while reading and building (dropped triangles, ignored keys, …).
     pub warnings: Vec<String>,
-    bvh: Bvh,
+    /// Hierarchy over the analytic shapes (primitive ids `0..shapes.len()`).
+    shape_bvh: Bvh,
+    /// Hierarchy over the triangles, tested four at a time (primitive id `shapes.len() + i`).
+    triangle_bvh: TriangleBvh,
 }
 
 /// The minimal record of a closest hit: enough to build a [`SurfaceHit`] when needed.
@@ -161,12 +164,9 @@ impl Scene {
         warnings: Vec<String>,
         progress: &dyn Progress,
     ) -> Scene {
-        let prim_bounds: Vec<Aabb> = shapes
-            .iter()
-            .map(|s| s.bounds)
-            .chain(triangles.iter().map(|t| t.bounds()))
-            .collect();
-        let bvh = Bvh::build_reporting(&prim_bounds, progress);
+        let shape_bounds: Vec<Aabb> = shapes.iter().map(|s| s.bounds).collect();
+        let shape_bvh = Bvh::build_reporting(&shape_bounds, progress);
+        let triangle_bvh = TriangleBvh::build_reporting(&triangles, progress);
         Scene {
             camera,
             lights,
@@ -179,18 +179,14 @@ impl Scene {
             triangles,
             triangle_refs,
             warnings,
-            bvh,
+            shape_bvh,
+            triangle_bvh,
         }
     }
 
     /// World bounds of everything.
     pub fn bounds(&self) -> Aabb {
-        self.bvh.bounds()
-    }
-
-    /// The BVH over all primitives.
-    pub fn bvh(&self) -> &Bvh {
-        &self.bvh
+        self.shape_bvh.bounds().union(self.triangle_bvh.bounds())
     }
 
     /// Number of primitives (shapes plus triangles).
@@ -201,20 +197,49 @@ impl Scene {
     /// The closest hit in `(0, t_max)`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Intersection> {
-        let mut best: Option<Intersection> = None;
-        self.bvh.closest_hit(ray, t_max, |prim, t_max| {
-            let hit = self.intersect_prim(prim, ray, t_max)?;
+        let mut best = self
+            .triangle_bvh
+            .closest_hit(ray, t_max)
+            .map(|h| self.triangle_intersection(h));
+        let t_max = best.map_or(t_max, |h| h.t);
+        self.shape_bvh.closest_hit(ray, t_max, |prim, t_max| {
+            let hit = self.intersect_shape(prim, ray, t_max)?;
             best = Some(hit);
             Some(hit.t)
-        })?;
+        });
         best
     }
 
     /// Calls `visit(hit)` for each primitive the segment `(0, t_max)` meets (its nearest hit
     /// within the segment), until `visit` returns true; returns whether it did.
     pub fn any_hit(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&Intersection) -> bool) -> bool {
-        self.bvh.any_hit(ray, t_max, |prim, t_max| {
-            self.intersect_prim(prim, ray, t_max).is_some_and(|h| visit(&h))
+        self.shape_bvh.any_hit(ray, t_max, |prim, t_max| {
+            self.intersect_shape(prim, ray, t_max).is_some_and(|h| visit(&h))
+        }) || self
+            .triangle_bvh
+            .each_hit(ray, t_max, |h| visit(&self.triangle_intersection(h)))
+    }
+
+    /// A triangle hit as an intersection.
+    #[inline]
+    fn triangle_intersection(&self, h: TriangleBvhHit) -> Intersection {
+        Intersection {
+            t: h.t,
+            prim: self.shapes.len() as u32 + h.prim,
+            normal_or_bary: Vec3::new(h.u, h.v, 0.0),
+            uv: Vec2::ZERO,
+        }
+    }
+
+    /// The nearest hit of shape `prim` in `(0, t_max)`.
+    #[inline]
+    fn intersect_shape(&self, prim: u32, ray: &Ray, t_max: f32) -> Option<Intersection> {
+        let hit = self.shapes[prim as usize].intersect(ray, t_max)?;
+        Some(Intersection {
+            t: hit.t,
+            prim,
+            normal_or_bary: hit.normal,
+            uv: hit.uv,
         })
     }
 
@@ -223,13 +248,7 @@ impl Scene {
     fn intersect_prim(&self, prim: u32, ray: &Ray, t_max: f32) -> Option<Intersection> {
         let n_shapes = self.shapes.len() as u32;
         if prim < n_shapes {
-            let hit = self.shapes[prim as usize].intersect(ray, t_max)?;
-            Some(Intersection {
-                t: hit.t,
-                prim,
-                normal_or_bary: hit.normal,
-                uv: hit.uv,
-            })
+            self.intersect_shape(prim, ray, t_max)
         } else {
             let hit = self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max)?;
             Some(Intersection {
@@ -354,17 +373,21 @@ impl Scene {
         let reach = r * (1.0 + 1e-3) + 2e-4 * (1.0 + point.abs().max_element());
         let n_shapes = self.shapes.len() as u32;
         let mut found = Occluders::default();
-        self.bvh.any_overlap(&query, |prim| {
-            let near = if prim < n_shapes {
-                self.shapes[prim as usize].may_come_within(point, reach)
-            } else {
-                self.triangles[(prim - n_shapes) as usize].plane_distance(point) <= reach
-            };
-            if prim != except && near {
+        let overflowed = self.shape_bvh.any_overlap(&query, |prim| {
+            if prim != except && self.shapes[prim as usize].may_come_within(point, reach) {
                 found.push(prim);
             }
             found.overflowed
         });
+        if !overflowed {
+            self.triangle_bvh.any_overlap(&query, |tri| {
+                let prim = n_shapes + tri;
+                if prim != except && self.triangles[tri as usize].plane_distance(point) <= reach {
+                    found.push(prim);
+                }
+                found.overflowed
+            });
+        }
         found
     }
 
@@ -437,4 +460,60 @@ fn segment_ray(a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> Option<(Ray,
     let d = to - from;
     let len = d.length();
     (len > 0.0).then(|| (Ray::new(from, d / len), len))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Shapes and a mesh in one scene: the closest hit and the hits visited by `any_hit` are
+    /// those of testing every primitive, whichever hierarchy holds it.
+    #[test]
+    fn queries_match_testing_every_primitive() {
+        let scene = build::test_scene(
+            "sphere { material = { diffuse = (1,1,1); } }
+             translate(1.5, 0, 0, box { material = { diffuse = (1,1,1); } })
+             scale(2, 2, 2, cone { height = 1; bottom_radius = 0.5; top_radius = 0.2; material = { diffuse = (1,1,1); } })
+             polymesh { points = ((-2,-2,-1), (2,-2,-1), (2,2,-1), (-2,2,-1), (0,0,1.2), (-1,0.5,-0.5));
+                        faces = ((0,1,2), (0,2,3), (0,1,4), (1,2,4), (2,3,4), (3,0,4), (5,4,0), (5,5,1));
+                        material = { diffuse = (1,1,1); } }",
+        );
+        assert!(!scene.shapes.is_empty() && scene.triangles.len() >= 7);
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut f = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let prims = scene.primitive_count() as u32;
+        let mut hits = 0;
+        for _ in 0..4000 {
+            let origin = Vec3::new(f(), f(), f()) * 4.0;
+            let target = Vec3::new(f(), f(), f()) * 1.5;
+            let ray = Ray::new(origin, target - origin);
+            let t_max = if f() > 0.5 { f32::INFINITY } else { 0.5 + f().abs() };
+            let every: Vec<Intersection> = (0..prims)
+                .filter_map(|p| scene.intersect_prim(p, &ray, t_max))
+                .collect();
+            let nearest = every.iter().map(|h| h.t).fold(f32::INFINITY, f32::min);
+            let got = scene.intersect(&ray, t_max);
+            match got {
+                Some(h) => {
+                    assert_eq!(h.t, nearest, "{ray:?}");
+                    assert!(every.contains(&h), "{h:?} is one primitive's own hit");
+                    hits += 1;
+                }
+                None => assert!(every.is_empty(), "{ray:?} missed {every:?}"),
+            }
+            let mut visited = Vec::new();
+            assert!(!scene.any_hit(&ray, t_max, |h| {
+                visited.push(*h);
+                false
+            }));
+            visited.sort_by_key(|h| h.prim);
+            assert_eq!(visited, every, "{ray:?}");
+        }
+        assert!(hits > 1000, "{hits} hits");
+    }
 }
