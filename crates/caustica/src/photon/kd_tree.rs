@@ -70,6 +70,8 @@ struct Node {
 pub struct KdTree {
     /// Internal nodes in pre-order; `2^D - 1` of them.
     nodes: Vec<Node>,
+    /// Bounds of the points under each internal node, parallel to `nodes`.
+    inner: Vec<LeafBounds>,
     /// Bounds of each leaf's points, leaves left to right; `2^D` of them.
     leaves: Vec<LeafBounds>,
     /// Number of items the tree was built over.
@@ -218,13 +220,19 @@ fn select_by<T: KdPoint>(items: &mut [T], mid: usize, key: impl Fn(Vec3) -> f32)
     });
 }
 
-fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], leaves: &mut [LeafBounds], items: &mut [T]) {
+fn build_rec<T: KdPoint + Send>(
+    nodes: &mut [Node],
+    inner: &mut [LeafBounds],
+    leaves: &mut [LeafBounds],
+    items: &mut [T],
+) {
     let n = items.len();
     let b = bounds(items);
     if nodes.is_empty() {
         leaves[0] = LeafBounds { lo: b.lo, hi: b.hi };
         return;
     }
+    inner[0] = LeafBounds { lo: b.lo, hi: b.hi };
     let ext = [0, 1, 2].map(|a| b.hi[a] - b.lo[a]);
     // Widest axis; a NaN extent never wins a comparison.
     let mut axis = 0;
@@ -252,16 +260,17 @@ fn build_rec<T: KdPoint + Send>(nodes: &mut [Node], leaves: &mut [LeafBounds], i
     };
     let half = nodes.len() / 2;
     let (left_nodes, right_nodes) = nodes[1..].split_at_mut(half);
+    let (left_inner, right_inner) = inner[1..].split_at_mut(half);
     let (left_items, right_items) = items.split_at_mut(mid);
     let (left_leaves, right_leaves) = leaves.split_at_mut(leaves.len() / 2);
     if n >= PAR_MIN {
         rayon::join(
-            || build_rec(left_nodes, left_leaves, left_items),
-            || build_rec(right_nodes, right_leaves, right_items),
+            || build_rec(left_nodes, left_inner, left_leaves, left_items),
+            || build_rec(right_nodes, right_inner, right_leaves, right_items),
         );
     } else {
-        build_rec(left_nodes, left_leaves, left_items);
-        build_rec(right_nodes, right_leaves, right_items);
+        build_rec(left_nodes, left_inner, left_leaves, left_items);
+        build_rec(right_nodes, right_inner, right_leaves, right_items);
     }
 }
 
@@ -278,9 +287,15 @@ impl KdTree {
         let len = u32::try_from(n).expect("KdTree holds at most u32::MAX items");
         let depth = depth_for(n);
         let mut nodes = vec![Node::default(); (1usize << depth) - 1];
+        let mut inner = vec![LeafBounds::default(); nodes.len()];
         let mut leaves = vec![LeafBounds::default(); 1usize << depth];
-        build_rec(&mut nodes, &mut leaves, items);
-        KdTree { nodes, leaves, len }
+        build_rec(&mut nodes, &mut inner, &mut leaves, items);
+        KdTree {
+            nodes,
+            inner,
+            leaves,
+            len,
+        }
     }
 
     /// Number of items the tree was built over.
@@ -297,7 +312,8 @@ impl KdTree {
 
     /// Heap bytes the tree itself owns (the items are the caller's).
     pub fn heap_bytes(&self) -> usize {
-        self.nodes.capacity() * std::mem::size_of::<Node>() + self.leaves.capacity() * std::mem::size_of::<LeafBounds>()
+        self.nodes.capacity() * std::mem::size_of::<Node>()
+            + (self.inner.capacity() + self.leaves.capacity()) * std::mem::size_of::<LeafBounds>()
     }
 
     /// The k nearest items within squared distance `max_dist2` (inclusive) of `p`.
@@ -347,7 +363,7 @@ impl KdTree {
             bound: strict_bound(max_dist2),
             out,
         };
-        search(&self.nodes, &self.leaves, items.len(), q.p, &mut q);
+        search(self, q.p, &mut q);
         if out.len() > k {
             keep_nearest(out, k);
         }
@@ -373,7 +389,7 @@ impl KdTree {
             bound: strict_bound(r2),
             f: &mut f,
         };
-        search(&self.nodes, &self.leaves, items.len(), q.p, &mut q);
+        search(self, q.p, &mut q);
     }
 }
 
@@ -416,16 +432,26 @@ trait Visitor {
 /// Searches the tree around `p`: depth-first, nearer child first, far children kept on a stack
 /// and skipped when the bound has shrunk past them by the time they are reached. The order is
 /// that of a recursive search, without a call per node (9% of a caustic render).
-fn search(nodes: &[Node], leaves: &[LeafBounds], len: usize, p: [f32; 3], v: &mut impl Visitor) {
+fn search(tree: &KdTree, p: [f32; 3], v: &mut impl Visitor) {
+    let KdTree {
+        nodes, inner, leaves, ..
+    } = tree;
     let mut stack = [Subtree::default(); SEARCH_STACK];
     let mut sp = 0;
     let mut cur = Subtree {
         size: nodes.len() as u32,
-        len: len as u32,
+        len: tree.len,
         ..Subtree::default()
     };
     loop {
+        let mut at_leaf = true;
         while cur.size != 0 {
+            // The points' own bounds prune subtrees that are mostly empty space around
+            // surfaces, and whole searches far from every photon.
+            if inner[cur.node as usize].dist2(p) >= v.bound() {
+                at_leaf = false;
+                break;
+            }
             let Node { split, axis } = nodes[cur.node as usize];
             let axis = axis as usize;
             let diff = p[axis] - split;
@@ -456,7 +482,7 @@ fn search(nodes: &[Node], leaves: &[LeafBounds], len: usize, p: [f32; 3], v: &mu
             }
             cur = near;
         }
-        if leaves[cur.leaf as usize].dist2(p) < v.bound() {
+        if at_leaf && leaves[cur.leaf as usize].dist2(p) < v.bound() {
             v.leaf(cur.lo as usize, cur.len as usize);
         }
         loop {

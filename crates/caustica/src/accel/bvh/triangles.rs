@@ -125,6 +125,10 @@ impl TriangleBvh {
     /// Closest hit with `0 < t < t_max`.
     #[inline]
     pub fn closest_hit(&self, ray: &Ray, t_max: f32) -> Option<TriangleBvhHit> {
+        // Scenes without triangles skip the per-ray setup.
+        if self.packets.is_empty() {
+            return None;
+        }
         let tr = TriangleRay::new(ray);
         let mut t = t_max;
         let mut best = None;
@@ -159,6 +163,9 @@ impl TriangleBvh {
     /// returns whether it did. Visits each triangle at most once; order unspecified.
     #[inline]
     pub fn each_hit(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(TriangleBvhHit) -> bool) -> bool {
+        if self.packets.is_empty() {
+            return false;
+        }
         let tr = TriangleRay::new(ray);
         let mut t = t_max;
         self.bvh.traverse_any_stack(ray, &mut t, |order, first, t_max| {
