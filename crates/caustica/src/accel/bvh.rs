@@ -33,6 +33,9 @@ const HALVES: usize = WIDTH / 4;
 /// enough (nearly always) because the stack array is initialised on every query.
 const SMALL_STACK: usize = 64;
 const LARGE_STACK: usize = 512;
+/// For trees of one or two levels (scenes of a few shapes), where clearing even the small
+/// stack was a noticeable part of each query.
+const TINY_STACK: usize = 8;
 
 /// A wide node: child boxes as `[axis][min, max]` rows of lanes, then child references
 /// (inner node index, or `LEAF | first` for leaves). A whole number of cache lines.
@@ -194,6 +197,12 @@ impl Bvh {
         (WIDTH - 1) * self.depth as usize <= SMALL_STACK
     }
 
+    /// Whether the tiny traversal stack suffices.
+    #[inline(always)]
+    fn tiny_stack(&self) -> bool {
+        (WIDTH - 1) * self.depth as usize <= TINY_STACK
+    }
+
     /// Closest hit. `intersect(prim, t_max)` tests primitive `prim` (an index into the bounds
     /// given to [`Bvh::build`]) and returns `Some(t)` if it is hit at `t < t_max` (the closure
     /// keeps its own hit record). Returns the closest `(t, prim)`.
@@ -207,7 +216,9 @@ impl Bvh {
         if self.nodes.is_empty() {
             return None;
         }
-        if self.small_stack() {
+        if self.tiny_stack() {
+            self.closest_impl::<TINY_STACK, F>(ray, t_max, intersect)
+        } else if self.small_stack() {
             self.closest_impl::<SMALL_STACK, F>(ray, t_max, intersect)
         } else {
             self.closest_impl::<LARGE_STACK, F>(ray, t_max, intersect)
@@ -222,7 +233,9 @@ impl Bvh {
         if self.nodes.is_empty() {
             return false;
         }
-        if self.small_stack() {
+        if self.tiny_stack() {
+            self.any_impl::<TINY_STACK, F>(ray, t_max, visit)
+        } else if self.small_stack() {
             self.any_impl::<SMALL_STACK, F>(ray, t_max, visit)
         } else {
             self.any_impl::<LARGE_STACK, F>(ray, t_max, visit)
@@ -329,6 +342,8 @@ impl Bvh {
     ) -> bool {
         if self.nodes.is_empty() {
             false
+        } else if self.tiny_stack() {
+            self.traverse::<TINY_STACK>(ray, t_max, leaf)
         } else if self.small_stack() {
             self.traverse::<SMALL_STACK>(ray, t_max, leaf)
         } else {
