@@ -93,6 +93,12 @@ impl Photon {
         decode_oct(Vec2::new(self.direction[0] as f32, self.direction[1] as f32) / 65535.0)
     }
 
+    /// The packed normal: equal codes decode to equal normals.
+    #[inline]
+    pub fn normal_code(&self) -> [u8; 2] {
+        self.normal
+    }
+
     /// Unit normal of the surface it landed on, facing where it came from (8-bit precision).
     #[inline]
     pub fn normal(&self) -> Vec3 {

@@ -190,13 +190,19 @@ impl PhotonMap {
             let r = r2.sqrt();
             let occluders = scene.occluders_near(point, r, hit.prim);
             let mut sum = Vec3::ZERO;
+            // Photons on one surface share a normal code: decode it once.
+            let mut normal = (None, Vec3::ZERO);
             for nb in neighbors.iter() {
                 let photon = &self.photons[nb.slot as usize];
                 let offset = photon.position - point;
                 if offset.dot(n).abs() > settings.max_plane_distance * r {
                     continue;
                 }
-                if photon.normal().dot(n) < settings.min_normal_cosine {
+                let code = photon.normal_code();
+                if normal.0 != Some(code) {
+                    normal = (Some(code), photon.normal());
+                }
+                if normal.1.dot(n) < settings.min_normal_cosine {
                     continue;
                 }
                 let f = reflectance(-photon.direction());
