@@ -1,9 +1,10 @@
 //! A balanced, pointer-free kd-tree over a slice of points, for photon gathering.
 //!
-//! [`KdTree::build`] reorders the caller's items in place into tree order and keeps one small
-//! record (split value + axis, 8 bytes) per internal node and the tight bounds of each leaf's
-//! points (24 bytes). Leaves hold `LEAF_MAX / 2 ..= LEAF_MAX` items, so there are `n / 16 .. n /
-//! 8` internal nodes and as many leaves: 2–4 bytes per point.
+//! [`KdTree::build`] reorders the caller's items in place into tree order and keeps, per
+//! internal node, one small record (split value + axis, 8 bytes) and the tight bounds of the
+//! points beneath it (24 bytes), and the tight bounds of each leaf's points (24 bytes). Leaves
+//! hold `LEAF_MAX / 2 ..= LEAF_MAX` items, so there are `n / 16 .. n / 8` internal nodes and as
+//! many leaves: 3.5–7 bytes per point.
 //!
 //! # Layout
 //!
@@ -20,11 +21,12 @@
 //! Depth-first, nearer child first, with the far child pruned by the exact squared distance from
 //! the query to the child's cell (per-axis offsets carried down, as in Arya & Mount), computed
 //! with the same rounding as a point distance so pruning never drops a point on the boundary.
-//! A leaf is scanned only if its tight bounds come within the current radius: photons lie on
-//! surfaces, often oblique to the axes, so a cell is mostly empty space.
-//! k-NN candidates collect in the caller's `Vec` (up to `2k`, then a selection keeps the `k`
-//! nearest and tightens the radius); the result is heapified at the end. A query allocates
-//! nothing once that vector has grown to `2k`.
+//! A subtree or leaf is entered only if the tight bounds of its points come within the current
+//! radius: photons lie on surfaces, often oblique to the axes, so a cell is mostly empty space,
+//! and a query far from every photon ends at the root. One loop with an explicit stack does it.
+//! k-NN candidates collect in the caller's `Vec` a leaf at a time (up to about `2k`, then a
+//! selection keeps the `k` nearest and tightens the radius); the result is heapified at the end.
+//! A query allocates nothing once that vector has grown.
 
 use std::cmp::Ordering;
 
