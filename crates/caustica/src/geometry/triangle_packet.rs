@@ -184,48 +184,44 @@ impl Lanes {
 mod tests {
     use super::*;
     use crate::math::Ray;
+    use crate::sampling::Rng;
 
-    /// Small deterministic generator (xorshift64*).
-    struct Rng(u64);
-    impl Rng {
-        fn f(&mut self) -> f32 {
-            self.0 ^= self.0 >> 12;
-            self.0 ^= self.0 << 25;
-            self.0 ^= self.0 >> 27;
-            (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32
-        }
-        fn v(&mut self) -> Vec3 {
-            Vec3::new(self.f(), self.f(), self.f()) * 2.0 - Vec3::ONE
-        }
+    /// A point in [-1, 1)³.
+    fn v(rng: &mut Rng) -> Vec3 {
+        Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE
     }
 
     /// The packet's closest hit and hit list equal the scalar test's on each triangle, bit for
     /// bit, including rays through shared edges and vertices and partly filled packets.
     #[test]
     fn packet_agrees_with_scalar_test() {
-        let mut rng = Rng(0x1234_5678_9abc_def1);
+        let mut rng = Rng::new(0x1234_5678_9abc_def1, 0);
         let mut hits = 0;
         for case in 0..20_000 {
             let count = 1 + case % LANES;
-            let shared = rng.v();
+            let shared = v(&mut rng);
             let tris: Vec<Triangle> = (0..count)
                 .map(|i| {
                     // Some triangles share a vertex or an edge with the first.
-                    let a = if i > 0 && case % 3 == 0 { shared } else { rng.v() };
-                    Triangle::new(a, rng.v(), if case % 5 == 0 { shared * 0.5 } else { rng.v() })
+                    let a = if i > 0 && case % 3 == 0 { shared } else { v(&mut rng) };
+                    Triangle::new(a, v(&mut rng), if case % 5 == 0 { shared * 0.5 } else { v(&mut rng) })
                 })
                 .collect();
             let packet = TrianglePacket::new(&tris);
             // Aim at a vertex, an edge or the inside of one of the triangles.
             let target = match case % 4 {
                 0 => tris[0].vertices()[case % 3],
-                1 => tris[count - 1].point(rng.f(), 0.0),
-                _ => tris[case % count].point(rng.f() * 0.5, rng.f() * 0.5),
+                1 => tris[count - 1].point(rng.uniform(), 0.0),
+                _ => tris[case % count].point(rng.uniform() * 0.5, rng.uniform() * 0.5),
             };
-            let origin = rng.v() * 3.0;
-            let ray = Ray::new(origin, (target - origin) * (0.5 + rng.f()));
+            let origin = v(&mut rng) * 3.0;
+            let ray = Ray::new(origin, (target - origin) * (0.5 + rng.uniform()));
             let tr = TriangleRay::new(&ray);
-            let t_max = if case % 7 == 0 { rng.f() * 2.0 } else { f32::INFINITY };
+            let t_max = if case % 7 == 0 {
+                rng.uniform() * 2.0
+            } else {
+                f32::INFINITY
+            };
 
             let mut expected = None;
             let mut t_best = t_max;
