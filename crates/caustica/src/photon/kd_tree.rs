@@ -73,30 +73,31 @@ pub struct KdTree {
     /// Internal nodes in pre-order; `2^D - 1` of them.
     nodes: Vec<Node>,
     /// Bounds of the points under each internal node, parallel to `nodes`.
-    inner: Vec<LeafBounds>,
+    inner: Vec<PointBounds>,
     /// Bounds of each leaf's points, leaves left to right; `2^D` of them.
-    leaves: Vec<LeafBounds>,
+    leaves: Vec<PointBounds>,
     /// Number of items the tree was built over.
     len: u32,
 }
 
-/// Tight bounds of one leaf's points (empty, lo > hi, for a leaf without finite points).
+/// Tight bounds of the points of a leaf or under an inner node (empty, lo > hi, when none is
+/// finite).
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct LeafBounds {
+struct PointBounds {
     lo: [f32; 3],
     hi: [f32; 3],
 }
 
-impl Default for LeafBounds {
+impl Default for PointBounds {
     fn default() -> Self {
-        LeafBounds {
+        PointBounds {
             lo: [f32::INFINITY; 3],
             hi: [f32::NEG_INFINITY; 3],
         }
     }
 }
 
-impl LeafBounds {
+impl PointBounds {
     /// Squared distance from `p` to the box, rounded as [`dist2`] so it never exceeds the
     /// distance to a point inside (infinite for an empty box).
     #[inline(always)]
@@ -224,17 +225,17 @@ fn select_by<T: KdPoint>(items: &mut [T], mid: usize, key: impl Fn(Vec3) -> f32)
 
 fn build_rec<T: KdPoint + Send>(
     nodes: &mut [Node],
-    inner: &mut [LeafBounds],
-    leaves: &mut [LeafBounds],
+    inner: &mut [PointBounds],
+    leaves: &mut [PointBounds],
     items: &mut [T],
 ) {
     let n = items.len();
     let b = bounds(items);
     if nodes.is_empty() {
-        leaves[0] = LeafBounds { lo: b.lo, hi: b.hi };
+        leaves[0] = PointBounds { lo: b.lo, hi: b.hi };
         return;
     }
-    inner[0] = LeafBounds { lo: b.lo, hi: b.hi };
+    inner[0] = PointBounds { lo: b.lo, hi: b.hi };
     let ext = [0, 1, 2].map(|a| b.hi[a] - b.lo[a]);
     // Widest axis; a NaN extent never wins a comparison.
     let mut axis = 0;
@@ -289,8 +290,8 @@ impl KdTree {
         let len = u32::try_from(n).expect("KdTree holds at most u32::MAX items");
         let depth = depth_for(n);
         let mut nodes = vec![Node::default(); (1usize << depth) - 1];
-        let mut inner = vec![LeafBounds::default(); nodes.len()];
-        let mut leaves = vec![LeafBounds::default(); 1usize << depth];
+        let mut inner = vec![PointBounds::default(); nodes.len()];
+        let mut leaves = vec![PointBounds::default(); 1usize << depth];
         build_rec(&mut nodes, &mut inner, &mut leaves, items);
         KdTree {
             nodes,
@@ -315,7 +316,7 @@ impl KdTree {
     /// Heap bytes the tree itself owns (the items are the caller's).
     pub fn heap_bytes(&self) -> usize {
         self.nodes.capacity() * std::mem::size_of::<Node>()
-            + (self.inner.capacity() + self.leaves.capacity()) * std::mem::size_of::<LeafBounds>()
+            + (self.inner.capacity() + self.leaves.capacity()) * std::mem::size_of::<PointBounds>()
     }
 
     /// The k nearest items within squared distance `max_dist2` (inclusive) of `p`.

@@ -396,8 +396,14 @@ fn build_is_deterministic_across_thread_counts() {
 fn tree_overhead_is_small() {
     for n in [1, 12, 13, 1000, 123_457, 1 << 20, 10_000_000] {
         let nodes = (1usize << depth_for(n)) - 1;
-        let bytes = nodes * std::mem::size_of::<Node>() + (nodes + 1) * std::mem::size_of::<LeafBounds>();
-        assert!(bytes <= 4 * n.max(8), "n={n}: {bytes} bytes");
+        // Per inner node its split and the bounds of its points; per leaf its points' bounds.
+        let bytes = nodes * (std::mem::size_of::<Node>() + std::mem::size_of::<PointBounds>())
+            + (nodes + 1) * std::mem::size_of::<PointBounds>();
+        assert!(bytes <= 7 * n.max(8), "n={n}: {bytes} bytes");
+        if n <= 123_457 {
+            let mut points: Vec<Vec3> = (0..n).map(|i| Vec3::new(i as f32, (i % 7) as f32, 0.0)).collect();
+            assert_eq!(KdTree::build(&mut points).heap_bytes(), bytes, "n={n}");
+        }
         // Leaves hold at most LEAF_MAX items.
         assert!(n.div_ceil(nodes + 1) <= LEAF_MAX);
     }
