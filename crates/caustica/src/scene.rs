@@ -1,4 +1,4 @@
-//! The renderable scene: world-space shapes and triangles under one BVH, materials, textures,
+//! The renderable scene: world-space shapes and triangles in their BVHs, materials, textures,
 //! lights and the camera. Built from a parsed `.ray` description by [`build`].
 
 pub mod build;
