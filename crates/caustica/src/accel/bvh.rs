@@ -29,13 +29,15 @@ const ROBUST: f32 = 1.0 + 4.0 * f32::EPSILON;
 const WIDTH: usize = 4;
 /// Four-lane vectors per row of child bounds.
 const HALVES: usize = WIDTH / 4;
-/// Stack sizes of the two traversal variants; the small one is used when the tree is shallow
-/// enough (nearly always) because the stack array is initialised on every query.
-const SMALL_STACK: usize = 64;
-const LARGE_STACK: usize = 512;
-/// For trees of one or two levels (scenes of a few shapes), where clearing even the small
-/// stack was a noticeable part of each query.
+/// Stack sizes of the traversal variants: a query uses the smallest that the tree's depth
+/// allows, because the stack array is cleared on every query and clearing a larger one than
+/// needed cost 5–10% of an incoherent query (the `bvh` bench, 37k and 1M triangles). Each level
+/// pushes at most `WIDTH - 1` entries: 8 entries hold trees of two levels (scenes of a few
+/// shapes), 32 of ten (tens of thousands of triangles), 64 of twenty-one (millions).
 const TINY_STACK: usize = 8;
+const SMALL_STACK: usize = 32;
+const MEDIUM_STACK: usize = 64;
+const LARGE_STACK: usize = 512;
 
 /// A wide node: child boxes as `[axis][min, max]` rows of lanes, then child references
 /// (inner node index, or `LEAF | first` for leaves). A whole number of cache lines.
@@ -197,6 +199,12 @@ impl Bvh {
         (WIDTH - 1) * self.depth as usize <= SMALL_STACK
     }
 
+    /// Whether the medium traversal stack suffices.
+    #[inline(always)]
+    fn medium_stack(&self) -> bool {
+        (WIDTH - 1) * self.depth as usize <= MEDIUM_STACK
+    }
+
     /// Whether the tiny traversal stack suffices.
     #[inline(always)]
     fn tiny_stack(&self) -> bool {
@@ -220,6 +228,8 @@ impl Bvh {
             self.closest_impl::<TINY_STACK, F>(ray, t_max, intersect)
         } else if self.small_stack() {
             self.closest_impl::<SMALL_STACK, F>(ray, t_max, intersect)
+        } else if self.medium_stack() {
+            self.closest_impl::<MEDIUM_STACK, F>(ray, t_max, intersect)
         } else {
             self.closest_impl::<LARGE_STACK, F>(ray, t_max, intersect)
         }
@@ -237,6 +247,8 @@ impl Bvh {
             self.any_impl::<TINY_STACK, F>(ray, t_max, visit)
         } else if self.small_stack() {
             self.any_impl::<SMALL_STACK, F>(ray, t_max, visit)
+        } else if self.medium_stack() {
+            self.any_impl::<MEDIUM_STACK, F>(ray, t_max, visit)
         } else {
             self.any_impl::<LARGE_STACK, F>(ray, t_max, visit)
         }
@@ -346,6 +358,8 @@ impl Bvh {
             self.traverse::<TINY_STACK>(ray, t_max, leaf)
         } else if self.small_stack() {
             self.traverse::<SMALL_STACK>(ray, t_max, leaf)
+        } else if self.medium_stack() {
+            self.traverse::<MEDIUM_STACK>(ray, t_max, leaf)
         } else {
             self.traverse::<LARGE_STACK>(ray, t_max, leaf)
         }
