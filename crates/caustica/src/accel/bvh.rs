@@ -193,22 +193,10 @@ impl Bvh {
         self.order.iter().map(|&p| p & !END)
     }
 
-    /// Whether the small traversal stack suffices (each level pushes at most `WIDTH - 1`).
+    /// Whether a traversal stack of `entries` suffices (each level pushes at most `WIDTH - 1`).
     #[inline(always)]
-    fn small_stack(&self) -> bool {
-        (WIDTH - 1) * self.depth as usize <= SMALL_STACK
-    }
-
-    /// Whether the medium traversal stack suffices.
-    #[inline(always)]
-    fn medium_stack(&self) -> bool {
-        (WIDTH - 1) * self.depth as usize <= MEDIUM_STACK
-    }
-
-    /// Whether the tiny traversal stack suffices.
-    #[inline(always)]
-    fn tiny_stack(&self) -> bool {
-        (WIDTH - 1) * self.depth as usize <= TINY_STACK
+    fn stack_fits(&self, entries: usize) -> bool {
+        (WIDTH - 1) * self.depth as usize <= entries
     }
 
     /// Closest hit. `intersect(prim, t_max)` tests primitive `prim` (an index into the bounds
@@ -219,39 +207,49 @@ impl Bvh {
         &self,
         ray: &Ray,
         t_max: f32,
-        intersect: F,
+        mut intersect: F,
     ) -> Option<(f32, u32)> {
-        if self.nodes.is_empty() {
-            return None;
-        }
-        if self.tiny_stack() {
-            self.closest_impl::<TINY_STACK, F>(ray, t_max, intersect)
-        } else if self.small_stack() {
-            self.closest_impl::<SMALL_STACK, F>(ray, t_max, intersect)
-        } else if self.medium_stack() {
-            self.closest_impl::<MEDIUM_STACK, F>(ray, t_max, intersect)
-        } else {
-            self.closest_impl::<LARGE_STACK, F>(ray, t_max, intersect)
-        }
+        let mut best = None;
+        let mut t_max = t_max;
+        self.traverse_any_stack(ray, &mut t_max, |order, first, t_max| {
+            let mut i = first;
+            loop {
+                let p = order[i];
+                let prim = p & !END;
+                if let Some(t) = intersect(prim, *t_max) {
+                    if t < *t_max {
+                        *t_max = t;
+                        best = Some(prim);
+                    }
+                }
+                if p & END != 0 {
+                    return false;
+                }
+                i += 1;
+            }
+        });
+        best.map(|prim| (t_max, prim))
     }
 
     /// Any-hit / filtered shadow query: calls `visit(prim, t_max)` for primitives whose leaf
     /// bounds the segment `[0, t_max]` meets; stops and returns `true` as soon as `visit`
     /// returns `true` (an opaque blocker). Visits each primitive at most once; order unspecified.
     #[inline]
-    pub fn any_hit<F: FnMut(u32, f32) -> bool>(&self, ray: &Ray, t_max: f32, visit: F) -> bool {
-        if self.nodes.is_empty() {
-            return false;
-        }
-        if self.tiny_stack() {
-            self.any_impl::<TINY_STACK, F>(ray, t_max, visit)
-        } else if self.small_stack() {
-            self.any_impl::<SMALL_STACK, F>(ray, t_max, visit)
-        } else if self.medium_stack() {
-            self.any_impl::<MEDIUM_STACK, F>(ray, t_max, visit)
-        } else {
-            self.any_impl::<LARGE_STACK, F>(ray, t_max, visit)
-        }
+    pub fn any_hit<F: FnMut(u32, f32) -> bool>(&self, ray: &Ray, t_max: f32, mut visit: F) -> bool {
+        let mut t_max = t_max;
+        self.traverse_any_stack(ray, &mut t_max, |order, first, t_max| {
+            let mut i = first;
+            loop {
+                let p = order[i];
+                if visit(p & !END, *t_max) {
+                    return true;
+                }
+                if p & END != 0 {
+                    return false;
+                }
+                i += 1;
+            }
+        })
     }
 
     /// Calls `visit(prim)` for primitives whose leaf boxes overlap `query`, until `visit` returns
@@ -297,53 +295,6 @@ impl Bvh {
         false
     }
 
-    #[inline(always)]
-    fn closest_impl<const N: usize, F: FnMut(u32, f32) -> Option<f32>>(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        mut intersect: F,
-    ) -> Option<(f32, u32)> {
-        let mut best = None;
-        let mut t_max = t_max;
-        self.traverse::<N>(ray, &mut t_max, |order, first, t_max| {
-            let mut i = first;
-            loop {
-                let p = order[i];
-                let prim = p & !END;
-                if let Some(t) = intersect(prim, *t_max) {
-                    if t < *t_max {
-                        *t_max = t;
-                        best = Some(prim);
-                    }
-                }
-                if p & END != 0 {
-                    return false;
-                }
-                i += 1;
-            }
-        });
-        best.map(|prim| (t_max, prim))
-    }
-
-    #[inline(always)]
-    fn any_impl<const N: usize, F: FnMut(u32, f32) -> bool>(&self, ray: &Ray, t_max: f32, mut visit: F) -> bool {
-        let mut t_max = t_max;
-        self.traverse::<N>(ray, &mut t_max, |order, first, t_max| {
-            let mut i = first;
-            loop {
-                let p = order[i];
-                if visit(p & !END, *t_max) {
-                    return true;
-                }
-                if p & END != 0 {
-                    return false;
-                }
-                i += 1;
-            }
-        })
-    }
-
     /// [`Bvh::traverse`] with the stack size the tree needs.
     #[inline(always)]
     fn traverse_any_stack(
@@ -354,11 +305,11 @@ impl Bvh {
     ) -> bool {
         if self.nodes.is_empty() {
             false
-        } else if self.tiny_stack() {
+        } else if self.stack_fits(TINY_STACK) {
             self.traverse::<TINY_STACK>(ray, t_max, leaf)
-        } else if self.small_stack() {
+        } else if self.stack_fits(SMALL_STACK) {
             self.traverse::<SMALL_STACK>(ray, t_max, leaf)
-        } else if self.medium_stack() {
+        } else if self.stack_fits(MEDIUM_STACK) {
             self.traverse::<MEDIUM_STACK>(ray, t_max, leaf)
         } else {
             self.traverse::<LARGE_STACK>(ray, t_max, leaf)
