@@ -184,6 +184,15 @@ fn triangle_bvh(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     acc
 }
 
+fn triangle_bvh_stream(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut hits = vec![None; rays.len()];
+    s.tri_bvh.closest_hits(rays, f32::INFINITY, &mut hits);
+    black_box(&hits)
+        .iter()
+        .flatten()
+        .fold((0, 0.0), |acc, h| (acc.0 + 1, acc.1 + h.t as f64))
+}
+
 fn triangle_bvh_any(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     let n = rays
         .iter()
@@ -247,10 +256,11 @@ fn obvhs_our_triangle(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     acc
 }
 
-const TRACERS: [(&str, Tracer); 8] = [
+const TRACERS: [(&str, Tracer); 9] = [
     ("closure", generic),
     ("closure+pre", generic_pre),
     ("TriangleBvh", triangle_bvh),
+    ("TriangleBvh-stream", triangle_bvh_stream),
     ("TriangleBvh-any", triangle_bvh_any),
     ("any_hit", shadow),
     ("obvhs", obvhs_indexed),

@@ -295,25 +295,51 @@ impl Bvh {
         false
     }
 
+    /// Runs `work` with the smallest traversal stack the tree's depth allows.
+    #[inline(always)]
+    fn with_stack<W: StackSized>(&self, work: W) -> W::Output {
+        if self.stack_fits(TINY_STACK) {
+            work.run::<TINY_STACK>()
+        } else if self.stack_fits(SMALL_STACK) {
+            work.run::<SMALL_STACK>()
+        } else if self.stack_fits(MEDIUM_STACK) {
+            work.run::<MEDIUM_STACK>()
+        } else {
+            work.run::<LARGE_STACK>()
+        }
+    }
+
     /// [`Bvh::traverse`] with the stack size the tree needs.
     #[inline(always)]
-    fn traverse_any_stack(
+    fn traverse_any_stack<F: FnMut(&[u32], usize, &mut f32) -> bool>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
-        leaf: impl FnMut(&[u32], usize, &mut f32) -> bool,
+        leaf: F,
     ) -> bool {
-        if self.nodes.is_empty() {
-            false
-        } else if self.stack_fits(TINY_STACK) {
-            self.traverse::<TINY_STACK>(ray, t_max, leaf)
-        } else if self.stack_fits(SMALL_STACK) {
-            self.traverse::<SMALL_STACK>(ray, t_max, leaf)
-        } else if self.stack_fits(MEDIUM_STACK) {
-            self.traverse::<MEDIUM_STACK>(ray, t_max, leaf)
-        } else {
-            self.traverse::<LARGE_STACK>(ray, t_max, leaf)
+        /// One ray's traversal, generic over its stack size.
+        struct Walk<'a, F> {
+            bvh: &'a Bvh,
+            ray: &'a Ray,
+            t_max: &'a mut f32,
+            leaf: F,
         }
+        impl<F: FnMut(&[u32], usize, &mut f32) -> bool> StackSized for Walk<'_, F> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<const N: usize>(self) -> bool {
+                self.bvh.traverse::<N>(self.ray, self.t_max, self.leaf)
+            }
+        }
+        if self.nodes.is_empty() {
+            return false;
+        }
+        self.with_stack(Walk {
+            bvh: self,
+            ray,
+            t_max,
+            leaf,
+        })
     }
 
     /// Near-first traversal. `leaf(order, first, t_max)` handles the leaf starting at `first`
@@ -325,77 +351,142 @@ impl Bvh {
         t_max: &mut f32,
         mut leaf: impl FnMut(&[u32], usize, &mut f32) -> bool,
     ) -> bool {
-        // Non-finite rays could turn slab tests into NaN, which min/max would drop.
-        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+        let Some(mut walk) = Traversal::<N>::new(ray, *t_max) else {
             return false;
-        }
-        let r = RayPre::new(ray);
-        let mut stack = [(0u32, 0f32); N];
-        let mut sp = 0usize;
-        let mut cur = 0u32;
-        loop {
-            if cur & LEAF == 0 {
-                let node = &self.nodes[cur as usize];
-                let (mask, t_near) = r.hit(node, *t_max);
-                if mask != 0 {
-                    // Most visits hit one or two children: handle those without sorting.
-                    let first = mask.trailing_zeros() as usize % WIDTH;
-                    let rest = mask & (mask - 1);
-                    if rest == 0 {
-                        cur = node.children[first];
-                        continue;
+        };
+        let found = loop {
+            match walk.step(&self.nodes) {
+                Visit::Node => {}
+                Visit::Leaf(first) => {
+                    if leaf(&self.order, first, &mut walk.t_max) {
+                        break true;
                     }
-                    let t: [f32; WIDTH] = std::array::from_fn(|i| t_near[i / 4][i % 4]);
-                    if rest & (rest - 1) == 0 {
-                        let second = rest.trailing_zeros() as usize % WIDTH;
-                        let (c0, c1) = (node.children[first], node.children[second]);
-                        let (t0, t1) = (t[first], t[second]);
-                        let (near, far, far_t) = if t1 < t0 { (c1, c0, t0) } else { (c0, c1, t1) };
-                        stack[sp] = (far, far_t);
-                        sp += 1;
-                        cur = near;
-                        continue;
+                    if !walk.pop() {
+                        break false;
                     }
-                    // Three or more: insertion-sort keys (distance bits, which order like
-                    // non-negative floats, with the slot in the low bits), farthest first.
-                    let mut keys = [0u32; WIDTH];
-                    let mut count = 0;
-                    let mut m = mask;
-                    while m != 0 {
-                        let slot = m.trailing_zeros();
-                        m &= m - 1;
-                        let key = (t[slot as usize % WIDTH].to_bits() & !(WIDTH as u32 - 1)) | slot;
-                        let mut j = count;
-                        while j > 0 && keys[j - 1] < key {
-                            keys[j] = keys[j - 1];
-                            j -= 1;
-                        }
-                        keys[j % WIDTH] = key;
-                        count += 1;
-                    }
-                    for &key in &keys[..count - 1] {
-                        let slot = (key as usize) % WIDTH;
-                        stack[sp] = (node.children[slot], f32::from_bits(key & !(WIDTH as u32 - 1)));
-                        sp += 1;
-                    }
-                    cur = node.children[(keys[(count - 1) % WIDTH] as usize) % WIDTH];
-                    continue;
                 }
-            } else if leaf(&self.order, (cur & !LEAF) as usize, t_max) {
+                Visit::Done => break false,
+            }
+        };
+        *t_max = walk.t_max;
+        found
+    }
+}
+
+/// Work generic over the traversal stack size, run by [`Bvh::with_stack`].
+trait StackSized {
+    type Output;
+    fn run<const N: usize>(self) -> Self::Output;
+}
+
+/// What one [`Traversal::step`] reached.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Visit {
+    /// An inner node was visited; the walk goes on.
+    Node,
+    /// The leaf starting at this leaf-order position is next: the caller tests it, then calls
+    /// [`Traversal::pop`].
+    Leaf(usize),
+    /// Nothing is left to visit.
+    Done,
+}
+
+/// The state of one ray's near-first walk through a [`Bvh`], advanced one node at a time, so
+/// a caller can interleave the walks of several rays (see [`TriangleBvh::closest_hits`]).
+struct Traversal<const N: usize> {
+    ray: RayPre,
+    /// Pending children with their entry distances, nearest on top.
+    stack: [(u32, f32); N],
+    sp: usize,
+    /// The node or leaf to visit next.
+    cur: u32,
+    /// End of the searched segment; leaf tests shrink it.
+    t_max: f32,
+}
+
+impl<const N: usize> Traversal<N> {
+    /// A walk from the root, or `None` for a non-finite ray (whose slab tests could turn into
+    /// NaN, which min/max would drop).
+    #[inline(always)]
+    fn new(ray: &Ray, t_max: f32) -> Option<Traversal<N>> {
+        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+            return None;
+        }
+        Some(Traversal {
+            ray: RayPre::new(ray),
+            stack: [(0, 0.0); N],
+            sp: 0,
+            cur: 0,
+            t_max,
+        })
+    }
+
+    /// Visits the next inner node, or reports the next leaf or the end of the walk.
+    #[inline(always)]
+    fn step(&mut self, nodes: &[Node]) -> Visit {
+        if self.cur & LEAF != 0 {
+            return Visit::Leaf((self.cur & !LEAF) as usize);
+        }
+        let node = &nodes[self.cur as usize];
+        let (mask, t_near) = self.ray.hit(node, self.t_max);
+        if mask == 0 {
+            return if self.pop() { Visit::Node } else { Visit::Done };
+        }
+        // Most visits hit one or two children: handle those without sorting.
+        let first = mask.trailing_zeros() as usize % WIDTH;
+        let rest = mask & (mask - 1);
+        if rest == 0 {
+            self.cur = node.children[first];
+            return Visit::Node;
+        }
+        let t: [f32; WIDTH] = std::array::from_fn(|i| t_near[i / 4][i % 4]);
+        if rest & (rest - 1) == 0 {
+            let second = rest.trailing_zeros() as usize % WIDTH;
+            let (c0, c1) = (node.children[first], node.children[second]);
+            let (t0, t1) = (t[first], t[second]);
+            let (near, far, far_t) = if t1 < t0 { (c1, c0, t0) } else { (c0, c1, t1) };
+            self.stack[self.sp % N] = (far, far_t);
+            self.sp += 1;
+            self.cur = near;
+            return Visit::Node;
+        }
+        // Three or more: insertion-sort keys (distance bits, which order like non-negative
+        // floats, with the slot in the low bits), farthest first.
+        let mut keys = [0u32; WIDTH];
+        let mut count = 0;
+        let mut m = mask;
+        while m != 0 {
+            let slot = m.trailing_zeros();
+            m &= m - 1;
+            let key = (t[slot as usize % WIDTH].to_bits() & !(WIDTH as u32 - 1)) | slot;
+            let mut j = count;
+            while j > 0 && keys[j - 1] < key {
+                keys[j] = keys[j - 1];
+                j -= 1;
+            }
+            keys[j % WIDTH] = key;
+            count += 1;
+        }
+        for &key in &keys[..count - 1] {
+            let slot = (key as usize) % WIDTH;
+            self.stack[self.sp % N] = (node.children[slot], f32::from_bits(key & !(WIDTH as u32 - 1)));
+            self.sp += 1;
+        }
+        self.cur = node.children[(keys[(count - 1) % WIDTH] as usize) % WIDTH];
+        Visit::Node
+    }
+
+    /// Moves to the nearest pending child that can still beat `t_max`; `false` when none is left.
+    #[inline(always)]
+    fn pop(&mut self) -> bool {
+        while self.sp > 0 {
+            self.sp -= 1;
+            let (child, t_near) = self.stack[self.sp % N];
+            if t_near <= self.t_max {
+                self.cur = child;
                 return true;
             }
-            // Pop the nearest pending child that can still beat `t_max`.
-            loop {
-                if sp == 0 {
-                    return false;
-                }
-                sp -= 1;
-                let (child, t_near) = stack[sp];
-                if t_near <= *t_max {
-                    cur = child;
-                    break;
-                }
-            }
         }
+        false
     }
 }

@@ -510,3 +510,57 @@ fn build_reports_every_primitive_once() {
         assert_eq!(snapshot(&bvh), snapshot(&Bvh::build(&bounds[..n])));
     }
 }
+
+/// The interleaved stream gives each ray exactly its single-ray answer, whatever the tree's
+/// stack tier, ray order and number of rays (fewer, as many as, or more than the stream's lanes).
+#[test]
+fn stream_matches_single_rays() {
+    let mut rng = Rng(0x5eed);
+    let steps: Vec<Triangle> = (0..300)
+        .map(|i| {
+            let x = 1.07f32.powi(i) - 1.0;
+            Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0))
+        })
+        .collect();
+    let meshes = [
+        Vec::new(),
+        random_triangles(&mut rng, 1),
+        random_triangles(&mut rng, 40),
+        random_triangles(&mut rng, 3000),
+        sphere(40, 80),
+        steps,
+    ];
+    let nasty = [0.0, f32::NAN, f32::INFINITY, 1e-40, 5.0];
+    for tris in &meshes {
+        let tbvh = TriangleBvh::new(tris);
+        let mut rays: Vec<Ray> = (0..2000)
+            .map(|i| match (i % 7, tris.is_empty()) {
+                (0, _) | (_, true) => Ray::new(rng.v() * 4.0 - 1.0, rng.dir()),
+                (1, _) => Ray::new(Vec3::new(-1.0, rng.f(), rng.f()), Vec3::new(1.0, 0.001, 0.002)),
+                _ => random_ray(&mut rng, tris),
+            })
+            .collect();
+        rays.extend(
+            nasty
+                .iter()
+                .map(|&x| Ray::new(Vec3::new(x, 0.5, 0.5), Vec3::new(1.0, x, 0.0))),
+        );
+        for count in [0, 1, 5, 8, 9, rays.len()] {
+            for t_max in [f32::INFINITY, 3.0] {
+                let batch = &rays[..count];
+                let mut hits = vec![None; count];
+                tbvh.closest_hits(batch, t_max, &mut hits);
+                for (ray, hit) in batch.iter().zip(&hits) {
+                    assert_eq!(*hit, tbvh.closest_hit(ray, t_max), "{ray:?} t_max {t_max}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+#[should_panic(expected = "one hit slot per ray")]
+fn stream_needs_one_slot_per_ray() {
+    let tbvh = TriangleBvh::new(&random_triangles(&mut Rng(1), 10));
+    tbvh.closest_hits(&[Ray::new(Vec3::ZERO, Vec3::X)], f32::INFINITY, &mut []);
+}

@@ -3,7 +3,7 @@
 //! a time. The tree is built with leaves priced per packet, so it favours full packets.
 
 use super::build::LeafCost;
-use super::{Bvh, END, LEAF};
+use super::{Bvh, StackSized, Traversal, Visit, END, LEAF};
 use crate::geometry::triangle::{Triangle, TriangleRay};
 use crate::geometry::triangle_packet::{TrianglePacket, LANES};
 use crate::integrator::{NoProgress, Progress};
@@ -16,6 +16,10 @@ const PACKET_LEAVES: LeafCost = LeafCost {
     block_cost: 1.0,
     max_leaf: 2 * LANES,
 };
+
+/// Rays walked together by [`TriangleBvh::closest_hits`]: enough independent node reads in
+/// flight to overlap cache misses, few enough that their state stays in the L1 cache.
+const STREAM: usize = 8;
 
 /// Id of an unused packet lane.
 const NO_TRIANGLE: u32 = u32::MAX;
@@ -31,6 +35,15 @@ pub struct TriangleBvhHit {
     pub u: f32,
     /// Barycentric weight of vertex `c`.
     pub v: f32,
+}
+
+/// The closest hit found so far in a walk: a packet lane and its barycentrics.
+#[derive(Clone, Copy, Debug)]
+struct LeafHit {
+    packet: usize,
+    lane: usize,
+    u: f32,
+    v: f32,
 }
 
 /// A BVH over triangles that owns copies of them, packed four to a packet in leaf order.
@@ -132,25 +145,124 @@ impl TriangleBvh {
         let tr = TriangleRay::new(ray);
         let mut t = t_max;
         let mut best = None;
-        self.bvh.traverse_any_stack(ray, &mut t, |order, first, t_max| {
-            let mut i = first;
-            loop {
-                if let Some((lane, h)) = self.packets[i].closest_hit(&tr, *t_max) {
-                    *t_max = h.t;
-                    best = Some((i, lane, h.u, h.v));
-                }
-                if order[i] & END != 0 {
-                    return false;
-                }
-                i += 1;
-            }
+        self.bvh.traverse_any_stack(ray, &mut t, |_, first, t_max| {
+            self.closest_in_leaf(&tr, first, t_max, &mut best);
+            false
         });
-        best.map(|(i, lane, u, v)| TriangleBvhHit {
+        best.map(|b| self.hit(t, b))
+    }
+
+    /// The closest hit of each ray with `0 < t < t_max`, into `hits` (one per ray). The same
+    /// answers as [`TriangleBvh::closest_hit`] ray by ray, found faster on large meshes: the walks
+    /// of several rays are interleaved, so their cache misses overlap instead of queueing.
+    ///
+    /// # Panics
+    /// If `hits` and `rays` differ in length.
+    pub fn closest_hits(&self, rays: &[Ray], t_max: f32, hits: &mut [Option<TriangleBvhHit>]) {
+        /// The interleaved walks, generic over their stack size.
+        struct Stream<'a> {
+            bvh: &'a TriangleBvh,
+            rays: &'a [Ray],
+            t_max: f32,
+            hits: &'a mut [Option<TriangleBvhHit>],
+        }
+        impl StackSized for Stream<'_> {
+            type Output = ();
+            fn run<const N: usize>(self) {
+                self.bvh.closest_hits_with::<N>(self.rays, self.t_max, self.hits);
+            }
+        }
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        hits.fill(None);
+        if self.packets.is_empty() {
+            return;
+        }
+        self.bvh.with_stack(Stream {
+            bvh: self,
+            rays,
+            t_max,
+            hits,
+        });
+    }
+
+    /// [`TriangleBvh::closest_hits`] with a traversal stack of `N` entries.
+    fn closest_hits_with<const N: usize>(&self, rays: &[Ray], t_max: f32, hits: &mut [Option<TriangleBvhHit>]) {
+        /// One ray of the stream.
+        struct Lane<const N: usize> {
+            index: usize,
+            walk: Traversal<N>,
+            tri: TriangleRay,
+            best: Option<LeafHit>,
+        }
+        let mut pending = rays.iter().enumerate();
+        let mut start = || {
+            pending.find_map(|(index, ray)| {
+                Traversal::new(ray, t_max).map(|walk| Lane {
+                    index,
+                    walk,
+                    tri: TriangleRay::new(ray),
+                    best: None,
+                })
+            })
+        };
+        let mut lanes: Vec<Lane<N>> = std::iter::from_fn(&mut start).take(STREAM).collect();
+        while !lanes.is_empty() {
+            let mut slot = 0;
+            while slot < lanes.len() {
+                let lane = &mut lanes[slot];
+                let done = match lane.walk.step(&self.bvh.nodes) {
+                    Visit::Node => false,
+                    Visit::Leaf(first) => {
+                        self.closest_in_leaf(&lane.tri, first, &mut lane.walk.t_max, &mut lane.best);
+                        !lane.walk.pop()
+                    }
+                    Visit::Done => true,
+                };
+                if !done {
+                    slot += 1;
+                    continue;
+                }
+                hits[lane.index] = lane.best.map(|b| self.hit(lane.walk.t_max, b));
+                match start() {
+                    Some(next) => *lane = next,
+                    None => {
+                        lanes.swap_remove(slot);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Tests the packets of the leaf starting at `first` for hits closer than `t_max`, shrinking
+    /// `t_max` and recording the closest in `best`.
+    #[inline(always)]
+    fn closest_in_leaf(&self, tr: &TriangleRay, first: usize, t_max: &mut f32, best: &mut Option<LeafHit>) {
+        let mut i = first;
+        loop {
+            if let Some((lane, h)) = self.packets[i].closest_hit(tr, *t_max) {
+                *t_max = h.t;
+                *best = Some(LeafHit {
+                    packet: i,
+                    lane,
+                    u: h.u,
+                    v: h.v,
+                });
+            }
+            if self.bvh.order[i] & END != 0 {
+                return;
+            }
+            i += 1;
+        }
+    }
+
+    /// The public hit record of `best`, found at distance `t`.
+    fn hit(&self, t: f32, best: LeafHit) -> TriangleBvhHit {
+        TriangleBvhHit {
             t,
-            prim: self.ids[i][lane],
-            u,
-            v,
-        })
+            prim: self.ids[best.packet][best.lane],
+            u: best.u,
+            v: best.v,
+        }
     }
 
     /// Whether any triangle is hit with `0 < t < t_max`.
