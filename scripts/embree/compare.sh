@@ -12,7 +12,7 @@ if [ ! -x "$work/venv/bin/python" ]; then
 fi
 libs="$("$work/venv/bin/python" -c 'import embreex, os; print(os.path.join(os.path.dirname(os.path.dirname(embreex.__file__)), "embreex.libs"))')"
 lib="$(ls "$libs"/libembree4*.so* | head -1)"
-gcc -O2 -o "$work/embree_rays" "$root/scripts/embree/embree_rays.c" "$lib" -lm -Wl,-rpath,"$libs"
+gcc -O2 -std=gnu11 -o "$work/embree_rays" "$root/scripts/embree/embree_rays.c" "$lib" -lm -Wl,-rpath,"$libs"
 echo "sphere-37k (2 x 96 x 192 triangles):"
 "$work/embree_rays" 96 192 0
 echo "bumpy-1M (2 x 500 x 1000 triangles):"

@@ -1,4 +1,4 @@
-/* Embree's single-ray throughput on the meshes and rays of caustica's `bvh` bench, for an
+/* Embree's single-ray and 16-ray packet throughput on the meshes and rays of caustica's `bvh` bench, for an
  * apples-to-apples comparison (see BENCHMARKS.md). Built and run by ./compare.sh.
  *
  * Embree's headers are not needed: the few entry points and the ray layout used are declared
@@ -22,6 +22,7 @@ void rtcReleaseGeometry(Handle geometry);
 void rtcCommitScene(Handle scene);
 void rtcIntersect1(Handle scene, void *rayhit, void *args);
 void rtcOccluded1(Handle scene, void *ray, void *args);
+void rtcIntersect16(const int *valid, Handle scene, void *rayhit, void *args);
 
 enum { GEOMETRY_TRIANGLE = 0, BUFFER_INDEX = 0, BUFFER_VERTEX = 1, FORMAT_UINT3 = 0x5003, FORMAT_FLOAT3 = 0x9003 };
 #define INVALID_ID 0xffffffffu
@@ -33,6 +34,15 @@ typedef struct {
     float ng[3], u, v;
     unsigned prim_id, geom_id, inst_id[8];
 } __attribute__((aligned(16))) RayHit;
+
+/* Sixteen rays and hits as structure of arrays (Embree 4's packet layout), with room for
+ * instance ids at the tail. */
+typedef struct {
+    float org[3][16], tnear[16], dir[3][16], time[16], tfar[16];
+    unsigned mask[16], id[16], flags[16];
+    float ng[3][16], u[16], v[16];
+    unsigned prim_id[16], geom_id[16], inst_id[8][16];
+} __attribute__((aligned(64))) RayHit16;
 
 /* splitmix64, as the bench's generator. */
 static uint64_t rng_state;
@@ -118,7 +128,13 @@ int main(int argc, char **argv) {
         rays[i].dir[1] = s * sinf(phi);
         rays[i].dir[2] = z;
     }
-    for (int query = 0; query < 2; query++) {
+    /* The same rays, sixteen consecutive ones to a packet. */
+    int n_packets = n_rays / 16;
+    RayHit16 *packets = aligned_alloc(64, sizeof(RayHit16) * n_packets);
+    memset(packets, 0, sizeof(RayHit16) * n_packets);
+    int valid[16];
+    for (int l = 0; l < 16; l++) valid[l] = -1;
+    for (int query = 0; query < 3; query++) {
         double best = INFINITY, sum = 0;
         long hits = 0;
         for (int run = 0; run < runs; run++) {
@@ -128,8 +144,24 @@ int main(int argc, char **argv) {
                 rays[i].mask = INVALID_ID;
                 rays[i].geom_id = rays[i].prim_id = INVALID_ID;
             }
+            if (query == 2) {
+                for (int i = 0; i < n_packets * 16; i++) {
+                    RayHit16 *p = &packets[i / 16];
+                    int l = i % 16;
+                    for (int a = 0; a < 3; a++) {
+                        p->org[a][l] = rays[i].org[a];
+                        p->dir[a][l] = rays[i].dir[a];
+                    }
+                    p->tnear[l] = 0;
+                    p->tfar[l] = INFINITY;
+                    p->mask[l] = INVALID_ID;
+                    p->geom_id[l] = p->prim_id[l] = INVALID_ID;
+                }
+            }
             start = seconds();
-            if (query == 0)
+            if (query == 2)
+                for (int i = 0; i < n_packets; i++) rtcIntersect16(valid, scene, &packets[i], NULL);
+            else if (query == 0)
                 for (int i = 0; i < n_rays; i++) rtcIntersect1(scene, &rays[i], NULL);
             else
                 for (int i = 0; i < n_rays; i++) rtcOccluded1(scene, &rays[i], NULL);
@@ -139,12 +171,20 @@ int main(int argc, char **argv) {
             sum = 0;
             for (int i = 0; i < n_rays; i++) {
                 int hit = query == 0 ? rays[i].geom_id != INVALID_ID : rays[i].tfar < 0;
+                float t = rays[i].tfar;
+                if (query == 2) {
+                    if (i >= n_packets * 16) break;
+                    hit = packets[i / 16].geom_id[i % 16] != INVALID_ID;
+                    t = packets[i / 16].tfar[i % 16];
+                }
                 hits += hit;
-                if (hit && query == 0) sum += rays[i].tfar;
+                if (hit && query != 1) sum += t;
             }
         }
-        printf("| %s | %.2f Mrays/s | hits %ld | mean t %.4f |\n", query == 0 ? "rtcIntersect1" : "rtcOccluded1",
-               n_rays / best / 1e6, hits, hits ? sum / (double)hits : 0.0);
+        static const char *names[] = {"rtcIntersect1", "rtcOccluded1", "rtcIntersect16"};
+        int traced = query == 2 ? n_packets * 16 : n_rays;
+        printf("| %s | %.2f Mrays/s | hits %ld | mean t %.4f |\n", names[query], traced / best / 1e6, hits,
+               hits ? sum / (double)hits : 0.0);
     }
     return 0;
 }
