@@ -91,6 +91,22 @@ impl Material {
         }
     }
 
+    /// Whether any parameter is read from a texture (and so needs texture coordinates).
+    pub fn is_textured(&self) -> bool {
+        [
+            &self.emissive,
+            &self.ambient,
+            &self.specular,
+            &self.reflective,
+            &self.diffuse,
+            &self.transmissive,
+            &self.shininess,
+            &self.index,
+        ]
+        .iter()
+        .any(|c| matches!(c, Channel::Texture(_)))
+    }
+
     /// Whether the material can turn a photon specularly (mirror or glass): what makes caustics.
     pub fn is_specular(&self) -> bool {
         self.reflective.may_be_nonzero() || self.transmissive.may_be_nonzero()

@@ -156,7 +156,7 @@ impl Scene {
         ambient: Vec3,
         materials: Vec<Material>,
         textures: Vec<Texture>,
-        shapes: Vec<Shape>,
+        mut shapes: Vec<Shape>,
         shape_materials: Vec<u32>,
         meshes: Vec<Mesh>,
         triangles: Vec<Triangle>,
@@ -164,6 +164,9 @@ impl Scene {
         warnings: Vec<String>,
         progress: &dyn Progress,
     ) -> Scene {
+        for (shape, &material) in shapes.iter_mut().zip(&shape_materials) {
+            shape.needs_uv = materials[material as usize].is_textured();
+        }
         let shape_bounds: Vec<Aabb> = shapes.iter().map(|s| s.bounds).collect();
         let shape_bvh = Bvh::build_reporting(&shape_bounds, progress);
         let triangle_bvh = TriangleBvh::build_reporting(&triangles, progress);
@@ -515,5 +518,58 @@ mod tests {
             assert_eq!(visited, every, "{ray:?}");
         }
         assert!(hits > 1000, "{hits} hits");
+    }
+
+    /// Texture coordinates are computed for shapes whose material reads a texture, and left at
+    /// zero for the others (which do not need them).
+    #[test]
+    fn texture_coordinates_only_where_a_texture_reads_them() {
+        let dir = std::env::temp_dir().join(format!("caustica-uv-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // Red on the left half (u < 0.5), blue on the right.
+        let mut image = image::RgbImage::new(2, 1);
+        image.put_pixel(0, 0, image::Rgb([255, 0, 0]));
+        image.put_pixel(1, 0, image::Rgb([0, 0, 255]));
+        image.save(dir.join("halves.png")).unwrap();
+        let text = "SBT-raytracer 1.0
+            camera { position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); }
+            translate(-1.5, 0, 0, sphere { material = { diffuse = map(\"halves.png\"); } })
+            translate(1.5, 0, 0, sphere { material = { diffuse = (0.5, 0.5, 0.5); } })
+            translate(0, 2, 0, cone { height = 1; bottom_radius = 0.5; top_radius = 0.5; capped = false;
+                                      material = { specular = map(\"halves.png\"); } })
+            translate(0, -2, 0, cone { height = 1; bottom_radius = 0.5; top_radius = 0.5; capped = false;
+                                       material = { diffuse = (1, 1, 1); } })";
+        let scene = build::from_text(text, &dir, &build::BuildSettings::default());
+        std::fs::remove_dir_all(&dir).unwrap();
+        let scene = scene.unwrap();
+        assert_eq!(
+            scene.shapes.iter().map(|s| s.needs_uv).collect::<Vec<_>>(),
+            [true, false, true, false]
+        );
+        // Rays along −y meet each shape at its +y side: a quarter turn around z, so u = 0.25
+        // (the texture's red half), halfway up (v = 0.5).
+        let hit = |center: Vec3, dir: Vec3| {
+            let ray = Ray::new(center - dir * 3.0, dir);
+            let isect = scene.intersect(&ray, f32::INFINITY).expect("a hit");
+            scene.surface(&ray, &isect)
+        };
+        let textured = hit(Vec3::new(-1.5, 0.0, 0.0), Vec3::new(0.0, -1.0, 0.0));
+        assert!(
+            (textured.uv - Vec2::new(0.25, 0.5)).abs().max_element() < 1e-5,
+            "{:?}",
+            textured.uv
+        );
+        assert_eq!(textured.params.diffuse, Vec3::X);
+        let plain = hit(Vec3::new(1.5, 0.0, 0.0), Vec3::new(0.0, -1.0, 0.0));
+        assert_eq!(plain.uv, Vec2::ZERO);
+        assert_eq!(plain.params.diffuse, Vec3::splat(0.5));
+        let cone = hit(Vec3::new(0.0, 2.0, 0.5), Vec3::new(0.0, -1.0, 0.0));
+        assert!(
+            (cone.uv - Vec2::new(0.25, 0.5)).abs().max_element() < 1e-5,
+            "{:?}",
+            cone.uv
+        );
+        let plain_cone = hit(Vec3::new(0.0, -2.0, 0.5), Vec3::new(0.0, -1.0, 0.0));
+        assert_eq!(plain_cone.uv, Vec2::ZERO);
     }
 }

@@ -76,10 +76,11 @@ impl Cone {
 
     /// Nearest hit in `(0, t_max)`. Side normals point outward, except on an uncapped cone hit
     /// from inside, where they face the ray; cap normals are −z at the bottom and +z at the top.
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<LocalHit> {
+    /// Side texture coordinates (an arctangent) only `with_uv`, zero otherwise.
+    pub fn intersect(&self, ray: &Ray, t_max: f32, with_uv: bool) -> Option<LocalHit> {
         let mut best: Option<LocalHit> = None;
         let mut t_best = t_max;
-        if let Some(hit) = self.intersect_side(ray, t_best) {
+        if let Some(hit) = self.intersect_side(ray, t_best, with_uv) {
             t_best = hit.t;
             best = Some(hit);
         }
@@ -94,7 +95,7 @@ impl Cone {
         best
     }
 
-    fn intersect_side(&self, ray: &Ray, t_max: f32) -> Option<LocalHit> {
+    fn intersect_side(&self, ray: &Ray, t_max: f32, with_uv: bool) -> Option<LocalHit> {
         let (o, d) = (ray.origin, ray.dir);
         let s = self.slope();
         let r0 = self.bottom_radius;
@@ -118,13 +119,14 @@ impl Cone {
             if !self.capped && normal.dot(d) > 0.0 {
                 normal = -normal;
             }
-            let phi = p.y.atan2(p.x);
-            let u = if phi < 0.0 { phi + 2.0 * PI } else { phi } / (2.0 * PI);
-            return Some(LocalHit {
-                t,
-                normal,
-                uv: Vec2::new(u, p.z / self.height),
-            });
+            let uv = if with_uv {
+                let phi = p.y.atan2(p.x);
+                let u = if phi < 0.0 { phi + 2.0 * PI } else { phi } / (2.0 * PI);
+                Vec2::new(u, p.z / self.height)
+            } else {
+                Vec2::ZERO
+            };
+            return Some(LocalHit { t, normal, uv });
         }
         None
     }

@@ -39,6 +39,9 @@ pub struct Shape {
     /// An upper bound on how much `object_from_world` stretches any length, for
     /// [`Shape::may_come_within`].
     pub object_stretch: f32,
+    /// Whether hits report texture coordinates: scenes clear it for untextured materials, which
+    /// spares spheres and cones their inverse trigonometric calls on every hit.
+    pub needs_uv: bool,
 }
 
 /// A hit on a shape, in world space.
@@ -48,7 +51,7 @@ pub struct ShapeHit {
     pub t: f32,
     /// Unit world normal, oriented as the shape defines it (§7).
     pub normal: Vec3,
-    /// Texture coordinates.
+    /// Texture coordinates; zero unless the shape [`needs_uv`](Shape::needs_uv).
     pub uv: Vec2,
 }
 
@@ -69,6 +72,7 @@ impl Shape {
             normal_to_world,
             bounds,
             object_stretch: max_stretch(Mat3::from_mat4(object_from_world)),
+            needs_uv: true,
         })
     }
 
@@ -119,10 +123,10 @@ impl Shape {
             self.object_from_world.transform_vector3(ray.dir),
         );
         let hit: LocalHit = match &self.kind {
-            ShapeKind::Sphere => sphere::intersect(&local, t_max),
+            ShapeKind::Sphere => sphere::intersect(&local, t_max, self.needs_uv),
             ShapeKind::Cube => cube::intersect(&local, t_max),
             ShapeKind::Square => square::intersect(&local, t_max),
-            ShapeKind::Cone(cone) => cone.intersect(&local, t_max),
+            ShapeKind::Cone(cone) => cone.intersect(&local, t_max, self.needs_uv),
         }?;
         let normal = (self.normal_to_world * hit.normal).normalize_or_zero();
         if normal == Vec3::ZERO {
@@ -131,7 +135,7 @@ impl Shape {
         Some(ShapeHit {
             t: hit.t,
             normal,
-            uv: hit.uv,
+            uv: if self.needs_uv { hit.uv } else { Vec2::ZERO },
         })
     }
 }

@@ -9,8 +9,9 @@ pub fn bounds() -> Aabb {
     Aabb::new(Vec3::splat(-1.0), Vec3::splat(1.0))
 }
 
-/// Nearest hit in `(0, t_max)`; the normal is outward, also when the ray starts inside.
-pub fn intersect(ray: &Ray, t_max: f32) -> Option<LocalHit> {
+/// Nearest hit in `(0, t_max)`; the normal is outward, also when the ray starts inside. Texture
+/// coordinates (two inverse trigonometric calls) only `with_uv`, zero otherwise.
+pub fn intersect(ray: &Ray, t_max: f32, with_uv: bool) -> Option<LocalHit> {
     let (o, d) = (ray.origin, ray.dir);
     let (t0, t1) = solve_quadratic_half_b(d.dot(d), o.dot(d), o.dot(o) - 1.0)?;
     let t = if t0 > 0.0 { t0 } else { t1 };
@@ -21,7 +22,7 @@ pub fn intersect(ray: &Ray, t_max: f32) -> Option<LocalHit> {
     Some(LocalHit {
         t,
         normal: p,
-        uv: uv(p),
+        uv: if with_uv { uv(p) } else { Vec2::ZERO },
     })
 }
 
