@@ -3,7 +3,8 @@
  *
  * Embree's headers are not needed: the few entry points and the ray layout used are declared
  * here from its public API documentation. Usage: embree_rays RINGS SEGMENTS BUMPS
- * (the bench's meshes: 96 192 0 = sphere-37k, 500 1000 1 = bumpy-1M). */
+ * [RAYS_FILE|-] [DEVICE_CONFIG] (the bench's meshes: 96 192 0 = sphere-37k, 500 1000 1 = bumpy-1M;
+ * without a rays file, the bench's incoherent rays are generated here). */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -73,13 +74,33 @@ static double seconds(void) {
 
 int main(int argc, char **argv) {
     if (argc < 4) {
-        fprintf(stderr, "usage: %s RINGS SEGMENTS BUMPS [DEVICE_CONFIG]\n", argv[0]);
+        fprintf(stderr, "usage: %s RINGS SEGMENTS BUMPS [RAYS_FILE|-] [DEVICE_CONFIG]\n", argv[0]);
         return 2;
     }
+    const char *ray_file = argc > 4 && strcmp(argv[4], "-") != 0 ? argv[4] : NULL;
     int rings = atoi(argv[1]), segments = atoi(argv[2]);
     float bumps = (float)atof(argv[3]);
-    const int n_rays = 1 << 18, runs = 5;
-    Handle device = rtcNewDevice(argc > 4 ? argv[4] : NULL);
+    int n_rays = 1 << 18;
+    const int runs = 5;
+    /* Rays written by the bench (BVH_BENCH_DUMP): origin xyz, direction xyz as f32. */
+    float *loaded = NULL;
+    if (ray_file) {
+        FILE *f = fopen(ray_file, "rb");
+        if (!f) {
+            fprintf(stderr, "cannot open %s\n", ray_file);
+            return 1;
+        }
+        fseek(f, 0, SEEK_END);
+        n_rays = (int)(ftell(f) / 24);
+        fseek(f, 0, SEEK_SET);
+        loaded = malloc((size_t)n_rays * 24);
+        if (fread(loaded, 24, (size_t)n_rays, f) != (size_t)n_rays) {
+            fprintf(stderr, "short read from %s\n", ray_file);
+            return 1;
+        }
+        fclose(f);
+    }
+    Handle device = rtcNewDevice(argc > 5 ? argv[5] : NULL);
     Handle scene = rtcNewScene(device);
     Handle geometry = rtcNewGeometry(device, GEOMETRY_TRIANGLE);
     size_t n_tris = 2 * (size_t)rings * (size_t)segments;
@@ -119,10 +140,15 @@ int main(int argc, char **argv) {
     RayHit *rays = aligned_alloc(64, sizeof(RayHit) * n_rays);
     rng_state = 7;
     for (int i = 0; i < n_rays; i++) {
+        memset(&rays[i], 0, sizeof rays[i]);
+        if (loaded) {
+            memcpy(rays[i].org, loaded + 6 * i, 12);
+            memcpy(rays[i].dir, loaded + 6 * i + 3, 12);
+            continue;
+        }
         float o[3];
         for (int a = 0; a < 3; a++) o[a] = lo[a] + (hi[a] - lo[a]) * rng_f();
         float z = 2 * rng_f() - 1, phi = 2 * (float)M_PI * rng_f(), s = sqrtf(fmaxf(1 - z * z, 0));
-        memset(&rays[i], 0, sizeof rays[i]);
         memcpy(rays[i].org, o, 12);
         rays[i].dir[0] = s * cosf(phi);
         rays[i].dir[1] = s * sinf(phi);

@@ -95,6 +95,31 @@ fn incoherent_rays(bounds: Aabb, n: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
+/// Secondary rays as a path tracer casts them: from a point on a random triangle (uniform by
+/// index, then uniform on the triangle), cosine-distributed about the normal, reflected or
+/// transmitted with equal odds; the origin sits 1e-4 off the surface on the ray's side.
+fn bounce_rays(tris: &[Triangle], n: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = Rng(seed);
+    (0..n)
+        .map(|_| {
+            let tri = &tris[((rng.f() * tris.len() as f32) as usize).min(tris.len() - 1)];
+            let (mut u, mut v) = (rng.f(), rng.f());
+            if u + v > 1.0 {
+                (u, v) = (1.0 - u, 1.0 - v);
+            }
+            let [a, b, c] = tri.vertices();
+            let side = if rng.f() < 0.5 { 1.0 } else { -1.0 };
+            let normal = (b - a).cross(c - a).normalize() * side;
+            let tangent = normal.any_orthonormal_vector();
+            let bitangent = normal.cross(tangent);
+            let (r, phi) = (rng.f().sqrt(), std::f32::consts::TAU * rng.f());
+            let local = Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - r * r).max(0.0).sqrt());
+            let dir = tangent * local.x + bitangent * local.y + normal * local.z;
+            Ray::new(a + (b - a) * u + (c - a) * v + normal * 1e-4, dir)
+        })
+        .collect()
+}
+
 /// Everything built for one mesh.
 struct Scene {
     name: &'static str,
@@ -282,12 +307,34 @@ fn scenes(filter: &str) -> Vec<Scene> {
     out
 }
 
-fn ray_sets(s: &Scene) -> [(&'static str, Vec<Ray>); 2] {
+fn ray_sets(s: &Scene) -> [(&'static str, Vec<Ray>); 3] {
     let b = mesh_bounds(&s.tris);
-    [
+    let sets = [
         ("primary", primary_rays(b, ray_count())),
         ("incoherent", incoherent_rays(b, ray_count(), 7)),
-    ]
+        ("bounce", bounce_rays(&s.tris, ray_count(), 11)),
+    ];
+    if let Some(dir) = std::env::var_os("BVH_BENCH_DUMP") {
+        for (kind, rays) in &sets {
+            dump_rays(
+                &std::path::Path::new(&dir).join(format!("{}-{kind}.rays", s.name)),
+                rays,
+            );
+        }
+    }
+    sets
+}
+
+/// Writes rays as little-endian f32 (origin xyz, direction xyz), for the Embree harness
+/// (`scripts/embree/compare.sh`), so both programs trace exactly the same rays.
+fn dump_rays(path: &std::path::Path, rays: &[Ray]) {
+    let bytes: Vec<u8> = rays
+        .iter()
+        .flat_map(|r| [r.origin.to_array(), r.dir.to_array()])
+        .flatten()
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    std::fs::write(path, bytes).expect("writing the ray dump");
 }
 
 /// CPU time of this thread (Linux schedstat, ns), so numbers survive a machine shared with
