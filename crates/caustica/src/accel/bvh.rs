@@ -10,6 +10,9 @@ mod build;
 mod tests;
 mod triangles;
 
+use std::borrow::BorrowMut;
+use std::cell::RefCell;
+
 use glam::Vec4;
 
 use crate::integrator::{NoProgress, Progress};
@@ -30,10 +33,12 @@ const WIDTH: usize = 4;
 /// Four-lane vectors per row of child bounds.
 const HALVES: usize = WIDTH / 4;
 /// Stack sizes of the traversal variants: a query uses the smallest that the tree's depth
-/// allows, because the stack array is cleared on every query and clearing a larger one than
-/// needed cost 5–10% of an incoherent query (the `bvh` bench, 37k and 1M triangles). Each level
-/// pushes at most `WIDTH - 1` entries: 8 entries hold trees of two levels (scenes of a few
-/// shapes), 32 of ten (tens of thousands of triangles), 64 of twenty-one (millions).
+/// allows, because a stack the query owns (ray streams, queries nested in another's callback)
+/// is cleared when made, and clearing a larger one than needed cost 5–10% of an incoherent query
+/// (the `bvh` bench, 37k and 1M triangles). Single queries borrow the thread's scratch stack,
+/// which needs no clearing. Each level pushes at most `WIDTH - 1` entries: 8 entries hold trees
+/// of two levels (scenes of a few shapes), 32 of ten (tens of thousands of triangles), 64 of
+/// twenty-one (millions).
 const TINY_STACK: usize = 8;
 const SMALL_STACK: usize = 32;
 const MEDIUM_STACK: usize = 64;
@@ -351,9 +356,27 @@ impl Bvh {
         t_max: &mut f32,
         mut leaf: impl FnMut(&[u32], usize, &mut f32) -> bool,
     ) -> bool {
-        let Some(mut walk) = Traversal::<N>::new(ray, *t_max) else {
-            return false;
-        };
+        // The thread's scratch stack, so a query does not clear a fresh one; a query made from
+        // inside another's callback finds it in use and takes its own.
+        SCRATCH_STACK.with(|scratch| match scratch.try_borrow_mut() {
+            Ok(mut scratch) => {
+                let stack = scratch
+                    .first_chunk_mut::<N>()
+                    .expect("no tier exceeds the scratch stack");
+                Traversal::new(ray, *t_max, stack).is_some_and(|walk| self.walk(walk, t_max, &mut leaf))
+            }
+            Err(_) => Traversal::new(ray, *t_max, [(0, 0.0); N]).is_some_and(|walk| self.walk(walk, t_max, &mut leaf)),
+        })
+    }
+
+    /// Runs `walk` to its end, handing leaves to `leaf` (see [`Bvh::traverse`]).
+    #[inline(always)]
+    fn walk<const N: usize, S: BorrowMut<[(u32, f32); N]>>(
+        &self,
+        mut walk: Traversal<N, S>,
+        t_max: &mut f32,
+        leaf: &mut impl FnMut(&[u32], usize, &mut f32) -> bool,
+    ) -> bool {
         let found = loop {
             match walk.step(&self.nodes) {
                 Visit::Node => {}
@@ -371,6 +394,11 @@ impl Bvh {
         *t_max = walk.t_max;
         found
     }
+}
+
+thread_local! {
+    /// Storage for traversal stacks, one per thread (tiers use its start).
+    static SCRATCH_STACK: RefCell<[(u32, f32); LARGE_STACK]> = const { RefCell::new([(0, 0.0); LARGE_STACK]) };
 }
 
 /// Work generic over the traversal stack size, run by [`Bvh::with_stack`].
@@ -393,10 +421,11 @@ enum Visit {
 
 /// The state of one ray's near-first walk through a [`Bvh`], advanced one node at a time, so
 /// a caller can interleave the walks of several rays (see [`TriangleBvh::closest_hits`]).
-struct Traversal<const N: usize> {
+struct Traversal<const N: usize, S: BorrowMut<[(u32, f32); N]> = [(u32, f32); N]> {
     ray: RayPre,
-    /// Pending children with their entry distances, nearest on top.
-    stack: [(u32, f32); N],
+    /// Pending children with their entry distances, nearest on top: owned, or borrowed from
+    /// the thread's scratch stack.
+    stack: S,
     sp: usize,
     /// The node or leaf to visit next.
     cur: u32,
@@ -404,21 +433,36 @@ struct Traversal<const N: usize> {
     t_max: f32,
 }
 
-impl<const N: usize> Traversal<N> {
-    /// A walk from the root, or `None` for a non-finite ray (whose slab tests could turn into
-    /// NaN, which min/max would drop).
+impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
+    /// A walk from the root using `stack`, whose contents need not be cleared, or `None` for a
+    /// non-finite ray (whose slab tests could turn into NaN, which min/max would drop).
     #[inline(always)]
-    fn new(ray: &Ray, t_max: f32) -> Option<Traversal<N>> {
+    fn new(ray: &Ray, t_max: f32, stack: S) -> Option<Traversal<N, S>> {
         if !(ray.origin.is_finite() && ray.dir.is_finite()) {
             return None;
         }
         Some(Traversal {
             ray: RayPre::new(ray),
-            stack: [(0, 0.0); N],
+            stack,
             sp: 0,
             cur: 0,
             t_max,
         })
+    }
+
+    /// Starts over from the root with another ray, keeping the stack's storage (entries above
+    /// the top are never read, so they need no clearing); `false`, leaving the walk finished,
+    /// for a non-finite ray.
+    #[inline(always)]
+    fn restart(&mut self, ray: &Ray, t_max: f32) -> bool {
+        self.sp = 0;
+        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+            return false;
+        }
+        self.ray = RayPre::new(ray);
+        self.cur = 0;
+        self.t_max = t_max;
+        true
     }
 
     /// Visits the next inner node, or reports the next leaf or the end of the walk.
@@ -445,7 +489,7 @@ impl<const N: usize> Traversal<N> {
             let (c0, c1) = (node.children[first], node.children[second]);
             let (t0, t1) = (t[first], t[second]);
             let (near, far, far_t) = if t1 < t0 { (c1, c0, t0) } else { (c0, c1, t1) };
-            self.stack[self.sp % N] = (far, far_t);
+            self.stack.borrow_mut()[self.sp % N] = (far, far_t);
             self.sp += 1;
             self.cur = near;
             return Visit::Node;
@@ -469,7 +513,7 @@ impl<const N: usize> Traversal<N> {
         }
         for &key in &keys[..count - 1] {
             let slot = (key as usize) % WIDTH;
-            self.stack[self.sp % N] = (node.children[slot], f32::from_bits(key & !(WIDTH as u32 - 1)));
+            self.stack.borrow_mut()[self.sp % N] = (node.children[slot], f32::from_bits(key & !(WIDTH as u32 - 1)));
             self.sp += 1;
         }
         self.cur = node.children[(keys[(count - 1) % WIDTH] as usize) % WIDTH];
@@ -481,7 +525,7 @@ impl<const N: usize> Traversal<N> {
     fn pop(&mut self) -> bool {
         while self.sp > 0 {
             self.sp -= 1;
-            let (child, t_near) = self.stack[self.sp % N];
+            let (child, t_near) = self.stack.borrow_mut()[self.sp % N];
             if t_near <= self.t_max {
                 self.cur = child;
                 return true;

@@ -564,3 +564,27 @@ fn stream_needs_one_slot_per_ray() {
     let tbvh = TriangleBvh::new(&random_triangles(&mut Rng(1), 10));
     tbvh.closest_hits(&[Ray::new(Vec3::ZERO, Vec3::X)], f32::INFINITY, &mut []);
 }
+
+/// A query made from a callback of another (which holds the thread's scratch stack) walks with
+/// its own stack, and both answer as when made alone.
+#[test]
+fn queries_nested_in_callbacks() {
+    let mut rng = Rng(21);
+    let tris = random_triangles(&mut rng, 3000);
+    let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
+    let bvh = Bvh::build(&bounds);
+    let tbvh = TriangleBvh::new(&tris);
+    let mut inner_queries = 0;
+    for _ in 0..300 {
+        let (outer, inner) = (random_ray(&mut rng, &tris), random_ray(&mut rng, &tris));
+        let alone = tbvh.closest_hit(&inner, f32::INFINITY);
+        let got = bvh.closest_hit(&outer, f32::INFINITY, |p, t| {
+            assert_eq!(tbvh.closest_hit(&inner, f32::INFINITY), alone);
+            inner_queries += 1;
+            tris[p as usize].intersect(&outer, t).map(|h| h.t)
+        });
+        let expect = brute_closest(&tris, &outer, f32::INFINITY);
+        assert!(same_hit(&tris, &outer, got, expect), "{got:?} vs {expect:?}");
+    }
+    assert!(inner_queries > 300, "{inner_queries} nested queries");
+}

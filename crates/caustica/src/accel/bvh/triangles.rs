@@ -195,17 +195,18 @@ impl TriangleBvh {
             best: Option<LeafHit>,
         }
         let mut pending = rays.iter().enumerate();
-        let mut start = || {
-            pending.find_map(|(index, ray)| {
-                Traversal::new(ray, t_max).map(|walk| Lane {
+        let mut lanes: Vec<Lane<N>> = pending
+            .by_ref()
+            .filter_map(|(index, ray)| {
+                Traversal::new(ray, t_max, [(0, 0.0); N]).map(|walk| Lane {
                     index,
                     walk,
                     tri: TriangleRay::new(ray),
                     best: None,
                 })
             })
-        };
-        let mut lanes: Vec<Lane<N>> = std::iter::from_fn(&mut start).take(STREAM).collect();
+            .take(STREAM)
+            .collect();
         while !lanes.is_empty() {
             let mut slot = 0;
             while slot < lanes.len() {
@@ -223,8 +224,14 @@ impl TriangleBvh {
                     continue;
                 }
                 hits[lane.index] = lane.best.map(|b| self.hit(lane.walk.t_max, b));
-                match start() {
-                    Some(next) => *lane = next,
+                // The next ray reuses the lane, stack storage included.
+                let next = pending.by_ref().find(|(_, ray)| lane.walk.restart(ray, t_max));
+                match next {
+                    Some((index, ray)) => {
+                        lane.index = index;
+                        lane.tri = TriangleRay::new(ray);
+                        lane.best = None;
+                    }
                     None => {
                         lanes.swap_remove(slot);
                     }
