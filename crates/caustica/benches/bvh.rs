@@ -1,4 +1,5 @@
-//! BVH build time and single-thread ray throughput, against the `obvhs` crate.
+//! BVH build time and single-thread ray throughput on triangle meshes and on analytic shapes,
+//! against the `obvhs` crate.
 //!
 //! `cargo bench --bench bvh` runs criterion (rays/s as throughput).
 //! `BVH_BENCH_QUICK=1 cargo bench --bench bvh` skips criterion and prints a table of the best
@@ -8,8 +9,10 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use caustica::accel::bvh::{Bvh, TriangleBvh};
+use caustica::geometry::cone::Cone;
 use caustica::geometry::triangle::{Triangle, TriangleRay};
-use caustica::math::{Aabb, Ray, Vec3};
+use caustica::geometry::{Shape, ShapeKind};
+use caustica::math::{Aabb, Mat4, Quat, Ray, Vec3};
 use criterion::{BenchmarkId, Criterion, Throughput};
 
 /// Rays per timed batch (`BVH_BENCH_RAYS` overrides).
@@ -169,6 +172,130 @@ impl Scene {
     }
 }
 
+/// Analytic shapes as `.ray` scenes place them: spheres, boxes, capped cylinders, cones and
+/// squares in equal numbers, each rotated at random, scaled by 0.3–1.3 per axis and scattered
+/// through a cube sized for about one shape per 8 unit cubes. Texture coordinates are off (the
+/// scene of untextured materials).
+struct ShapeScene {
+    name: &'static str,
+    shapes: Vec<Shape>,
+    bvh: Bvh,
+    ob: obvhs::cwbvh::CwBvh,
+}
+
+impl ShapeScene {
+    fn new(name: &'static str, count: usize) -> ShapeScene {
+        let mut rng = Rng(0xa11c_e5ed);
+        let side = (8.0 * count as f32).cbrt();
+        let shapes: Vec<Shape> = (0..count)
+            .map(|i| {
+                let kind = match i % 5 {
+                    0 => ShapeKind::Sphere,
+                    1 => ShapeKind::Cube,
+                    2 => ShapeKind::cylinder(true),
+                    3 => ShapeKind::Cone(Cone::new(1.0, 0.5, 0.1, true, false)),
+                    _ => ShapeKind::Square,
+                };
+                let axis = Vec3::new(rng.f() - 0.5, rng.f() - 0.5, rng.f() - 0.5).normalize_or(Vec3::Z);
+                let rotation = Quat::from_axis_angle(axis, std::f32::consts::TAU * rng.f());
+                let scale = Vec3::new(rng.f(), rng.f(), rng.f()) + Vec3::splat(0.3);
+                let at = Vec3::new(rng.f(), rng.f(), rng.f()) * side;
+                let mut shape = Shape::new(kind, Mat4::from_scale_rotation_translation(scale, rotation, at))
+                    .expect("an invertible transform");
+                shape.needs_uv = false;
+                shape
+            })
+            .collect();
+        let bounds: Vec<Aabb> = shapes.iter().map(|s| s.bounds).collect();
+        let bvh = Bvh::build(&bounds);
+        let ob_bounds: Vec<obvhs::aabb::Aabb> = bounds
+            .iter()
+            .map(|b| obvhs::aabb::Aabb::new(b.min.to_array().into(), b.max.to_array().into()))
+            .collect();
+        let ob = obvhs::cwbvh::builder::build_cwbvh(
+            &ob_bounds,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        ShapeScene { name, shapes, bvh, ob }
+    }
+
+    fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+}
+
+/// A traversal variant over analytic shapes.
+type ShapeTracer = fn(&ShapeScene, &[Ray]) -> (usize, f64);
+
+fn shapes_closest(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        let hit = s.bvh.closest_hit(ray, f32::INFINITY, |p, t| {
+            s.shapes[p as usize].intersect(ray, t).map(|h| h.t)
+        });
+        if let Some((t, _)) = black_box(hit) {
+            acc = (acc.0 + 1, acc.1 + t as f64);
+        }
+    }
+    acc
+}
+
+fn shapes_any(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
+    let n = rays
+        .iter()
+        .filter(|ray| {
+            black_box(s.bvh.any_hit(ray, f32::INFINITY, |p, t| {
+                s.shapes[p as usize].intersect(ray, t).is_some()
+            }))
+        })
+        .count();
+    (n, 0.0)
+}
+
+/// The comparison BVH with the same shape tests.
+fn shapes_obvhs(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
+    let mut acc = (0, 0.0);
+    for ray in rays {
+        let mut hit = obvhs::ray::RayHit::none();
+        let idx = &s.ob.primitive_indices;
+        let found = s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
+            s.shapes[idx[id] as usize]
+                .intersect(ray, r.tmax)
+                .map_or(f32::INFINITY, |h| h.t)
+        });
+        if black_box(found) {
+            acc = (acc.0 + 1, acc.1 + hit.t as f64);
+        }
+    }
+    acc
+}
+
+const SHAPE_TRACERS: [(&str, ShapeTracer); 3] = [
+    ("Bvh", shapes_closest),
+    ("Bvh-any", shapes_any),
+    ("obvhs", shapes_obvhs),
+];
+
+/// The shape scenes whose name matches `filter` (or all).
+fn shape_scenes(filter: &str) -> Vec<ShapeScene> {
+    [("shapes-100", 100), ("shapes-10k", 10_000)]
+        .into_iter()
+        .filter(|(name, _)| {
+            let wanted = filter.split('/').next().unwrap_or_default();
+            name.contains(wanted) || !filter.contains("shapes")
+        })
+        .map(|(name, count)| ShapeScene::new(name, count))
+        .collect()
+}
+
+fn shape_ray_sets(s: &ShapeScene) -> [(&'static str, Vec<Ray>); 2] {
+    [
+        ("primary", primary_rays(s.bounds(), ray_count())),
+        ("incoherent", incoherent_rays(s.bounds(), ray_count(), 7)),
+    ]
+}
+
 /// A traversal variant: hits and the sum of hit distances (as a cross-check).
 type Tracer = fn(&Scene, &[Ray]) -> (usize, f64);
 
@@ -296,6 +423,9 @@ const TRACERS: [(&str, Tracer); 9] = [
 /// The meshes whose name matches `filter` (or all).
 fn scenes(filter: &str) -> Vec<Scene> {
     let mut out = Vec::new();
+    if filter.contains("shapes") {
+        return out;
+    }
     if filter.is_empty() || filter.contains("1M") || !filter.contains("37k") {
         // 2 · 500 · 1000 = 1,000,000 triangles.
         out.push(Scene::new("bumpy-1M", sphere(500, 1000, 1.0)));
@@ -406,6 +536,26 @@ fn quick() {
             }
         }
     }
+    for s in shape_scenes(&filter) {
+        eprintln!("{}: {} nodes, depth {}", s.name, s.bvh.node_count(), s.bvh.depth());
+        for (kind, rays) in shape_ray_sets(&s) {
+            for (name, f) in SHAPE_TRACERS {
+                let label = format!("{}/{kind}/{name}", s.name);
+                if !label.contains(&filter) && !filter.is_empty() {
+                    continue;
+                }
+                let (wall, cpu, (hits, sum)) = best_of(runs, || f(&s, &rays));
+                let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64() / 1e6;
+                println!(
+                    "| {} | {kind} | {name} | {:.2} | {:.2} | {hits} | {:.4} |",
+                    s.name,
+                    rate(wall),
+                    rate(cpu),
+                    sum / hits.max(1) as f64
+                );
+            }
+        }
+    }
 }
 
 fn main() {
@@ -434,6 +584,18 @@ fn main() {
             let mut g = c.benchmark_group(format!("{}/{kind}", s.name));
             g.throughput(Throughput::Elements(rays.len() as u64));
             for (name, f) in TRACERS {
+                g.bench_with_input(BenchmarkId::from_parameter(name), &rays, |b, rays| {
+                    b.iter(|| f(&s, rays))
+                });
+            }
+            g.finish();
+        }
+    }
+    for s in shape_scenes("") {
+        for (kind, rays) in shape_ray_sets(&s) {
+            let mut g = c.benchmark_group(format!("{}/{kind}", s.name));
+            g.throughput(Throughput::Elements(rays.len() as u64));
+            for (name, f) in SHAPE_TRACERS {
                 g.bench_with_input(BenchmarkId::from_parameter(name), &rays, |b, rays| {
                     b.iter(|| f(&s, rays))
                 });
