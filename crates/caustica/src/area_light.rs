@@ -200,6 +200,17 @@ impl AreaLight {
     pub fn sample(&self, scene: &Scene, u_pick: f32, u: Vec2) -> Option<AreaSample> {
         match &self.sampler {
             Sampler::Shape { prim, linear, .. } => {
+                if let Some((center, radius)) = self.sphere {
+                    // A sphere under a similarity is sampled uniformly by area as it stands:
+                    // no transform, normalisation or density to work out per sample.
+                    let normal = sample_uniform_sphere(u);
+                    return Some(AreaSample {
+                        point: center + normal * radius,
+                        normal,
+                        pdf_area: 1.0 / (4.0 * PI * radius * radius),
+                        prim: *prim,
+                    });
+                }
                 let shape = &scene.shapes[*prim as usize];
                 let (p, n) = sample_object(&shape.kind, u_pick, u)?;
                 let point = shape.world_from_object.transform_point3(p);
