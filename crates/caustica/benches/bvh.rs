@@ -518,43 +518,58 @@ fn quick() {
     println!("| mesh | rays | variant | Mrays/s wall | Mrays/s cpu | hits | mean t |\n|---|---|---|---|---|---|---|");
     for s in scenes(&filter) {
         eprintln!("{}: {} nodes, depth {}", s.name, s.bvh.node_count(), s.bvh.depth());
-        for (kind, rays) in ray_sets(&s) {
-            for (name, f) in TRACERS {
-                let label = format!("{}/{kind}/{name}", s.name);
-                if !label.contains(&filter) && !filter.is_empty() {
-                    continue;
-                }
-                let (wall, cpu, (hits, sum)) = best_of(runs, || f(&s, &rays));
-                let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64() / 1e6;
-                println!(
-                    "| {} | {kind} | {name} | {:.2} | {:.2} | {hits} | {:.4} |",
-                    s.name,
-                    rate(wall),
-                    rate(cpu),
-                    sum / hits.max(1) as f64
-                );
-            }
-        }
+        print_rates(s.name, &s, &ray_sets(&s), &TRACERS, &filter, runs);
     }
     for s in shape_scenes(&filter) {
         eprintln!("{}: {} nodes, depth {}", s.name, s.bvh.node_count(), s.bvh.depth());
-        for (kind, rays) in shape_ray_sets(&s) {
-            for (name, f) in SHAPE_TRACERS {
-                let label = format!("{}/{kind}/{name}", s.name);
-                if !label.contains(&filter) && !filter.is_empty() {
-                    continue;
-                }
-                let (wall, cpu, (hits, sum)) = best_of(runs, || f(&s, &rays));
-                let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64() / 1e6;
-                println!(
-                    "| {} | {kind} | {name} | {:.2} | {:.2} | {hits} | {:.4} |",
-                    s.name,
-                    rate(wall),
-                    rate(cpu),
-                    sum / hits.max(1) as f64
-                );
+        print_rates(s.name, &s, &shape_ray_sets(&s), &SHAPE_TRACERS, &filter, runs);
+    }
+}
+
+/// One table row per ray set and variant whose label `scene/rays/variant` matches `filter`.
+fn print_rates<S>(
+    scene_name: &str,
+    scene: &S,
+    ray_sets: &[(&str, Vec<Ray>)],
+    tracers: &[(&str, fn(&S, &[Ray]) -> (usize, f64))],
+    filter: &str,
+    runs: usize,
+) {
+    for (kind, rays) in ray_sets {
+        for (name, f) in tracers {
+            let label = format!("{scene_name}/{kind}/{name}");
+            if !label.contains(filter) && !filter.is_empty() {
+                continue;
             }
+            let (wall, cpu, (hits, sum)) = best_of(runs, || f(scene, rays));
+            let rate = |d: Duration| rays.len() as f64 / d.as_secs_f64() / 1e6;
+            println!(
+                "| {scene_name} | {kind} | {name} | {:.2} | {:.2} | {hits} | {:.4} |",
+                rate(wall),
+                rate(cpu),
+                sum / hits.max(1) as f64
+            );
         }
+    }
+}
+
+/// A criterion group per ray set, with every variant.
+fn bench_rates<S>(
+    c: &mut Criterion,
+    scene_name: &str,
+    scene: &S,
+    ray_sets: &[(&str, Vec<Ray>)],
+    tracers: &[(&str, fn(&S, &[Ray]) -> (usize, f64))],
+) {
+    for (kind, rays) in ray_sets {
+        let mut g = c.benchmark_group(format!("{scene_name}/{kind}"));
+        g.throughput(Throughput::Elements(rays.len() as u64));
+        for (name, f) in tracers {
+            g.bench_with_input(BenchmarkId::from_parameter(name), rays, |b, rays| {
+                b.iter(|| f(scene, rays))
+            });
+        }
+        g.finish();
     }
 }
 
@@ -580,28 +595,10 @@ fn main() {
     drop((tris, bounds, ob_tris));
 
     for s in scenes("") {
-        for (kind, rays) in ray_sets(&s) {
-            let mut g = c.benchmark_group(format!("{}/{kind}", s.name));
-            g.throughput(Throughput::Elements(rays.len() as u64));
-            for (name, f) in TRACERS {
-                g.bench_with_input(BenchmarkId::from_parameter(name), &rays, |b, rays| {
-                    b.iter(|| f(&s, rays))
-                });
-            }
-            g.finish();
-        }
+        bench_rates(&mut c, s.name, &s, &ray_sets(&s), &TRACERS);
     }
     for s in shape_scenes("") {
-        for (kind, rays) in shape_ray_sets(&s) {
-            let mut g = c.benchmark_group(format!("{}/{kind}", s.name));
-            g.throughput(Throughput::Elements(rays.len() as u64));
-            for (name, f) in SHAPE_TRACERS {
-                g.bench_with_input(BenchmarkId::from_parameter(name), &rays, |b, rays| {
-                    b.iter(|| f(&s, rays))
-                });
-            }
-            g.finish();
-        }
+        bench_rates(&mut c, s.name, &s, &shape_ray_sets(&s), &SHAPE_TRACERS);
     }
     c.final_summary();
 }
