@@ -225,9 +225,6 @@ impl ShapeScene {
     }
 }
 
-/// A traversal variant over analytic shapes.
-type ShapeTracer = fn(&ShapeScene, &[Ray]) -> (usize, f64);
-
 fn shapes_closest(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
     let mut acc = (0, 0.0);
     for ray in rays {
@@ -271,7 +268,7 @@ fn shapes_obvhs(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
     acc
 }
 
-const SHAPE_TRACERS: [(&str, ShapeTracer); 3] = [
+const SHAPE_TRACERS: [(&str, Tracer<ShapeScene>); 3] = [
     ("Bvh", shapes_closest),
     ("Bvh-any", shapes_any),
     ("obvhs", shapes_obvhs),
@@ -296,8 +293,8 @@ fn shape_ray_sets(s: &ShapeScene) -> [(&'static str, Vec<Ray>); 2] {
     ]
 }
 
-/// A traversal variant: hits and the sum of hit distances (as a cross-check).
-type Tracer = fn(&Scene, &[Ray]) -> (usize, f64);
+/// A traversal variant over scene type `S`: hits and the sum of hit distances (as a cross-check).
+type Tracer<S> = fn(&S, &[Ray]) -> (usize, f64);
 
 fn generic(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     let mut acc = (0, 0.0);
@@ -408,7 +405,7 @@ fn obvhs_our_triangle(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     acc
 }
 
-const TRACERS: [(&str, Tracer); 9] = [
+const TRACERS: [(&str, Tracer<Scene>); 9] = [
     ("closure", generic),
     ("closure+pre", generic_pre),
     ("TriangleBvh", triangle_bvh),
@@ -531,7 +528,7 @@ fn print_rates<S>(
     scene_name: &str,
     scene: &S,
     ray_sets: &[(&str, Vec<Ray>)],
-    tracers: &[(&str, fn(&S, &[Ray]) -> (usize, f64))],
+    tracers: &[(&str, Tracer<S>)],
     filter: &str,
     runs: usize,
 ) {
@@ -559,7 +556,7 @@ fn bench_rates<S>(
     scene_name: &str,
     scene: &S,
     ray_sets: &[(&str, Vec<Ray>)],
-    tracers: &[(&str, fn(&S, &[Ray]) -> (usize, f64))],
+    tracers: &[(&str, Tracer<S>)],
 ) {
     for (kind, rays) in ray_sets {
         let mut g = c.benchmark_group(format!("{scene_name}/{kind}"));
