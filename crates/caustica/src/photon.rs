@@ -120,14 +120,28 @@ fn encode_rgbe(c: Vec3) -> [u8; 4] {
     if m.is_nan() || m <= 1e-32 || !m.is_finite() {
         return [0; 4];
     }
-    let mut e = m.log2().floor() as i32 + 1;
-    let mut scale = (-e as f32).exp2() * 256.0;
-    if (m * scale).round() >= 256.0 {
+    // m = f · 2^e with f in [0.5, 1), read from its bits (m is a normal float here).
+    let mut e = ((m.to_bits() >> 23) & 0xff) as i32 - 126;
+    let mut scale = power_of_two(8 - e);
+    if round_non_negative(m * scale) >= 256 {
         e += 1;
         scale *= 0.5;
     }
-    let q = |x: f32| (x * scale).round().min(255.0) as u8;
+    let q = |x: f32| round_non_negative(x * scale).min(255) as u8;
     [q(c.x), q(c.y), q(c.z), (e + 128).clamp(0, 255) as u8]
+}
+
+/// 2^k for an exponent of a normal float, built from its bits.
+fn power_of_two(k: i32) -> f32 {
+    f32::from_bits(((k + 127) as u32) << 23)
+}
+
+/// `x.round()` for finite x in [0, 2^23), without the library call that baseline x86-64 makes
+/// for it: the fraction left after truncation is exact, and halves round up as `round` does.
+#[inline]
+fn round_non_negative(x: f32) -> u32 {
+    let whole = x as u32;
+    whole + u32::from(x - whole as f32 >= 0.5)
 }
 
 fn decode_rgbe(c: [u8; 4]) -> Vec3 {
@@ -166,12 +180,18 @@ fn decode_oct(e: Vec2) -> Vec3 {
 
 fn encode_oct16(v: Vec3) -> [u16; 2] {
     let e = encode_oct(v);
-    [(e.x * 65535.0).round() as u16, (e.y * 65535.0).round() as u16]
+    [
+        round_non_negative(e.x * 65535.0) as u16,
+        round_non_negative(e.y * 65535.0) as u16,
+    ]
 }
 
 fn encode_oct8(v: Vec3) -> [u8; 2] {
     let e = encode_oct(v);
-    [(e.x * 255.0).round() as u8, (e.y * 255.0).round() as u8]
+    [
+        round_non_negative(e.x * 255.0) as u8,
+        round_non_negative(e.y * 255.0) as u8,
+    ]
 }
 
 #[cfg(test)]
