@@ -228,6 +228,21 @@ mod tests {
     }
 
     #[test]
+    fn rounding_matches_the_library() {
+        let mut x = 0.0f32;
+        let mut edges = vec![
+            0.0, 0.49999997, 0.5, 0.50000006, 1.5, 2.5, 254.5, 255.49998, 255.5, 65534.5, 8388607.0,
+        ];
+        while x < 70_000.0 {
+            edges.push(x);
+            x = x * 1.01 + 0.013;
+        }
+        for x in edges {
+            assert_eq!(round_non_negative(x), x.round() as u32, "{x}");
+        }
+    }
+
+    #[test]
     fn directions_round_trip() {
         let dirs = [
             Vec3::Z,
