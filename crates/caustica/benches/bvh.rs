@@ -342,6 +342,12 @@ fn triangle_bvh_stream(s: &Scene, rays: &[Ray]) -> (usize, f64) {
         .fold((0, 0.0), |acc, h| (acc.0 + 1, acc.1 + h.t as f64))
 }
 
+fn triangle_bvh_any_stream(s: &Scene, rays: &[Ray]) -> (usize, f64) {
+    let mut occluded = vec![false; rays.len()];
+    s.tri_bvh.any_hits(rays, f32::INFINITY, &mut occluded);
+    (black_box(&occluded).iter().filter(|&&o| o).count(), 0.0)
+}
+
 fn triangle_bvh_any(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     let n = rays
         .iter()
@@ -405,12 +411,13 @@ fn obvhs_our_triangle(s: &Scene, rays: &[Ray]) -> (usize, f64) {
     acc
 }
 
-const TRACERS: [(&str, Tracer<Scene>); 9] = [
+const TRACERS: [(&str, Tracer<Scene>); 10] = [
     ("closure", generic),
     ("closure+pre", generic_pre),
     ("TriangleBvh", triangle_bvh),
     ("TriangleBvh-stream", triangle_bvh_stream),
     ("TriangleBvh-any", triangle_bvh_any),
+    ("TriangleBvh-any-stream", triangle_bvh_any_stream),
     ("any_hit", shadow),
     ("obvhs", obvhs_indexed),
     ("obvhs-ordered", obvhs_ordered),

@@ -511,7 +511,7 @@ fn build_reports_every_primitive_once() {
     }
 }
 
-/// The interleaved stream gives each ray exactly its single-ray answer, whatever the tree's
+/// The interleaved streams give each ray exactly its single-ray answers, whatever the tree's
 /// stack tier, ray order and number of rays (fewer, as many as, or more than the stream's lanes).
 #[test]
 fn stream_matches_single_rays() {
@@ -550,8 +550,11 @@ fn stream_matches_single_rays() {
                 let batch = &rays[..count];
                 let mut hits = vec![None; count];
                 tbvh.closest_hits(batch, t_max, &mut hits);
-                for (ray, hit) in batch.iter().zip(&hits) {
+                let mut occluded = vec![true; count];
+                tbvh.any_hits(batch, t_max, &mut occluded);
+                for ((ray, hit), blocked) in batch.iter().zip(&hits).zip(&occluded) {
                     assert_eq!(*hit, tbvh.closest_hit(ray, t_max), "{ray:?} t_max {t_max}");
+                    assert_eq!(*blocked, tbvh.any_hit(ray, t_max), "{ray:?} t_max {t_max}");
                 }
             }
         }
@@ -559,7 +562,7 @@ fn stream_matches_single_rays() {
 }
 
 #[test]
-#[should_panic(expected = "one hit slot per ray")]
+#[should_panic(expected = "one answer slot per ray")]
 fn stream_needs_one_slot_per_ray() {
     let tbvh = TriangleBvh::new(&random_triangles(&mut Rng(1), 10));
     tbvh.closest_hits(&[Ray::new(Vec3::ZERO, Vec3::X)], f32::INFINITY, &mut []);

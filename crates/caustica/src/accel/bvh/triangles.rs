@@ -159,21 +159,72 @@ impl TriangleBvh {
     /// # Panics
     /// If `hits` and `rays` differ in length.
     pub fn closest_hits(&self, rays: &[Ray], t_max: f32, hits: &mut [Option<TriangleBvhHit>]) {
+        self.stream(
+            rays,
+            t_max,
+            hits,
+            |tri, first, t_max, best: &mut Option<LeafHit>| {
+                self.closest_in_leaf(tri, first, t_max, best);
+                false
+            },
+            |t, best| best.map(|b| self.hit(t, b)),
+        );
+    }
+
+    /// Whether each ray hits any triangle with `0 < t < t_max`, into `occluded` (one per ray):
+    /// [`TriangleBvh::any_hit`] for many rays, with their walks interleaved as in
+    /// [`TriangleBvh::closest_hits`].
+    ///
+    /// # Panics
+    /// If `occluded` and `rays` differ in length.
+    pub fn any_hits(&self, rays: &[Ray], t_max: f32, occluded: &mut [bool]) {
+        self.stream(
+            rays,
+            t_max,
+            occluded,
+            |tri, first, t_max, hit: &mut bool| {
+                *hit = self.any_in_leaf(tri, first, *t_max);
+                *hit
+            },
+            |_, hit| hit,
+        );
+    }
+
+    /// Walks `rays` [`STREAM`] at a time, interleaved. Each ray's lane keeps a `F` (default at
+    /// the start); `leaf(ray, first, t_max, found)` tests the leaf starting at `first` and returns
+    /// whether the ray's answer is settled; `answer(t_max, found)` is what goes to `out`.
+    fn stream<F: Copy + Default, R: Default>(
+        &self,
+        rays: &[Ray],
+        t_max: f32,
+        out: &mut [R],
+        leaf: impl Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
+        answer: impl Fn(f32, F) -> R,
+    ) {
         /// The interleaved walks, generic over their stack size.
-        struct Stream<'a> {
+        struct Stream<'a, 'b, F, R, L, A> {
             bvh: &'a TriangleBvh,
             rays: &'a [Ray],
             t_max: f32,
-            hits: &'a mut [Option<TriangleBvhHit>],
+            out: &'b mut [R],
+            leaf: L,
+            answer: A,
+            found: std::marker::PhantomData<F>,
         }
-        impl StackSized for Stream<'_> {
+        impl<F, R, L, A> StackSized for Stream<'_, '_, F, R, L, A>
+        where
+            F: Copy + Default,
+            L: Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
+            A: Fn(f32, F) -> R,
+        {
             type Output = ();
             fn run<const N: usize>(self) {
-                self.bvh.closest_hits_with::<N>(self.rays, self.t_max, self.hits);
+                self.bvh
+                    .stream_with::<N, F, R>(self.rays, self.t_max, self.out, &self.leaf, &self.answer);
             }
         }
-        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        hits.fill(None);
+        assert_eq!(rays.len(), out.len(), "one answer slot per ray");
+        out.iter_mut().for_each(|o| *o = R::default());
         if self.packets.is_empty() {
             return;
         }
@@ -181,28 +232,38 @@ impl TriangleBvh {
             bvh: self,
             rays,
             t_max,
-            hits,
+            out,
+            leaf,
+            answer,
+            found: std::marker::PhantomData,
         });
     }
 
-    /// [`TriangleBvh::closest_hits`] with a traversal stack of `N` entries.
-    fn closest_hits_with<const N: usize>(&self, rays: &[Ray], t_max: f32, hits: &mut [Option<TriangleBvhHit>]) {
+    /// [`TriangleBvh::stream`] with traversal stacks of `N` entries.
+    fn stream_with<const N: usize, F: Copy + Default, R>(
+        &self,
+        rays: &[Ray],
+        t_max: f32,
+        out: &mut [R],
+        leaf: &impl Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
+        answer: &impl Fn(f32, F) -> R,
+    ) {
         /// One ray of the stream.
-        struct Lane<const N: usize> {
+        struct Lane<const N: usize, F> {
             index: usize,
             walk: Traversal<N>,
             tri: TriangleRay,
-            best: Option<LeafHit>,
+            found: F,
         }
         let mut pending = rays.iter().enumerate();
-        let mut lanes: Vec<Lane<N>> = pending
+        let mut lanes: Vec<Lane<N, F>> = pending
             .by_ref()
             .filter_map(|(index, ray)| {
                 Traversal::new(ray, t_max, [(0, 0.0); N]).map(|walk| Lane {
                     index,
                     walk,
                     tri: TriangleRay::new(ray),
-                    best: None,
+                    found: F::default(),
                 })
             })
             .take(STREAM)
@@ -214,8 +275,7 @@ impl TriangleBvh {
                 let done = match lane.walk.step(&self.bvh.nodes) {
                     Visit::Node => false,
                     Visit::Leaf(first) => {
-                        self.closest_in_leaf(&lane.tri, first, &mut lane.walk.t_max, &mut lane.best);
-                        !lane.walk.pop()
+                        leaf(&lane.tri, first, &mut lane.walk.t_max, &mut lane.found) || !lane.walk.pop()
                     }
                     Visit::Done => true,
                 };
@@ -223,14 +283,14 @@ impl TriangleBvh {
                     slot += 1;
                     continue;
                 }
-                hits[lane.index] = lane.best.map(|b| self.hit(lane.walk.t_max, b));
+                out[lane.index] = answer(lane.walk.t_max, lane.found);
                 // The next ray reuses the lane, stack storage included.
                 let next = pending.by_ref().find(|(_, ray)| lane.walk.restart(ray, t_max));
                 match next {
                     Some((index, ray)) => {
                         lane.index = index;
                         lane.tri = TriangleRay::new(ray);
-                        lane.best = None;
+                        lane.found = F::default();
                     }
                     None => {
                         lanes.swap_remove(slot);
@@ -257,6 +317,21 @@ impl TriangleBvh {
             }
             if self.bvh.order[i] & END != 0 {
                 return;
+            }
+            i += 1;
+        }
+    }
+
+    /// Whether a triangle of the leaf starting at `first` is hit with `0 < t < t_max`.
+    #[inline(always)]
+    fn any_in_leaf(&self, tr: &TriangleRay, first: usize, t_max: f32) -> bool {
+        let mut i = first;
+        loop {
+            if self.packets[i].each_hit(tr, t_max, |_, _| true) {
+                return true;
+            }
+            if self.bvh.order[i] & END != 0 {
+                return false;
             }
             i += 1;
         }
