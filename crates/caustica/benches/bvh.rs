@@ -225,47 +225,58 @@ impl ShapeScene {
     }
 }
 
+/// Hits and the sum of their distances, from each ray's closest-hit distance.
+fn sum_closest(rays: &[Ray], mut closest: impl FnMut(&Ray) -> Option<f32>) -> (usize, f64) {
+    rays.iter().fold((0, 0.0), |acc, ray| match black_box(closest(ray)) {
+        Some(t) => (acc.0 + 1, acc.1 + t as f64),
+        None => acc,
+    })
+}
+
+/// The number of rays `blocked` says are occluded (and no distance sum).
+fn count_occluded(rays: &[Ray], mut blocked: impl FnMut(&Ray) -> bool) -> (usize, f64) {
+    (rays.iter().filter(|ray| black_box(blocked(ray))).count(), 0.0)
+}
+
+/// The closest-hit distance of `ray` in the comparison BVH, whose closure gets its ray and a
+/// primitive's leaf position and returns the hit distance (infinity for a miss).
+fn obvhs_closest(
+    ob: &obvhs::cwbvh::CwBvh,
+    ray: &Ray,
+    hit_t: impl FnMut(&obvhs::ray::Ray, usize) -> f32,
+) -> Option<f32> {
+    let mut hit = obvhs::ray::RayHit::none();
+    ob.ray_traverse(to_ob_ray(ray), &mut hit, hit_t).then_some(hit.t)
+}
+
 fn shapes_closest(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
-        let hit = s.bvh.closest_hit(ray, f32::INFINITY, |p, t| {
-            s.shapes[p as usize].intersect(ray, t).map(|h| h.t)
-        });
-        if let Some((t, _)) = black_box(hit) {
-            acc = (acc.0 + 1, acc.1 + t as f64);
-        }
-    }
-    acc
+    sum_closest(rays, |ray| {
+        s.bvh
+            .closest_hit(ray, f32::INFINITY, |p, t| {
+                s.shapes[p as usize].intersect(ray, t).map(|h| h.t)
+            })
+            .map(|(t, _)| t)
+    })
 }
 
 fn shapes_any(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
-    let n = rays
-        .iter()
-        .filter(|ray| {
-            black_box(s.bvh.any_hit(ray, f32::INFINITY, |p, t| {
-                s.shapes[p as usize].intersect(ray, t).is_some()
-            }))
+    count_occluded(rays, |ray| {
+        s.bvh.any_hit(ray, f32::INFINITY, |p, t| {
+            s.shapes[p as usize].intersect(ray, t).is_some()
         })
-        .count();
-    (n, 0.0)
+    })
 }
 
 /// The comparison BVH with the same shape tests.
 fn shapes_obvhs(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
-        let mut hit = obvhs::ray::RayHit::none();
-        let idx = &s.ob.primitive_indices;
-        let found = s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
+    let idx = &s.ob.primitive_indices;
+    sum_closest(rays, |ray| {
+        obvhs_closest(&s.ob, ray, |r, id| {
             s.shapes[idx[id] as usize]
                 .intersect(ray, r.tmax)
                 .map_or(f32::INFINITY, |h| h.t)
-        });
-        if black_box(found) {
-            acc = (acc.0 + 1, acc.1 + hit.t as f64);
-        }
-    }
-    acc
+        })
+    })
 }
 
 const SHAPE_TRACERS: [(&str, Tracer<ShapeScene>); 3] = [
@@ -297,40 +308,28 @@ fn shape_ray_sets(s: &ShapeScene) -> [(&'static str, Vec<Ray>); 2] {
 type Tracer<S> = fn(&S, &[Ray]) -> (usize, f64);
 
 fn generic(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
-        let hit = s.bvh.closest_hit(ray, f32::INFINITY, |p, t| {
-            s.tris[p as usize].intersect(ray, t).map(|h| h.t)
-        });
-        if let Some((t, _)) = black_box(hit) {
-            acc = (acc.0 + 1, acc.1 + t as f64);
-        }
-    }
-    acc
+    sum_closest(rays, |ray| {
+        s.bvh
+            .closest_hit(ray, f32::INFINITY, |p, t| {
+                s.tris[p as usize].intersect(ray, t).map(|h| h.t)
+            })
+            .map(|(t, _)| t)
+    })
 }
 
 fn generic_pre(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
+    sum_closest(rays, |ray| {
         let tr = TriangleRay::new(ray);
-        let hit = s.bvh.closest_hit(ray, f32::INFINITY, |p, t| {
-            s.tris[p as usize].intersect_pre(&tr, t).map(|h| h.t)
-        });
-        if let Some((t, _)) = black_box(hit) {
-            acc = (acc.0 + 1, acc.1 + t as f64);
-        }
-    }
-    acc
+        s.bvh
+            .closest_hit(ray, f32::INFINITY, |p, t| {
+                s.tris[p as usize].intersect_pre(&tr, t).map(|h| h.t)
+            })
+            .map(|(t, _)| t)
+    })
 }
 
 fn triangle_bvh(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
-        if let Some(h) = black_box(s.tri_bvh.closest_hit(ray, f32::INFINITY)) {
-            acc = (acc.0 + 1, acc.1 + h.t as f64);
-        }
-    }
-    acc
+    sum_closest(rays, |ray| s.tri_bvh.closest_hit(ray, f32::INFINITY).map(|h| h.t))
 }
 
 fn triangle_bvh_stream(s: &Scene, rays: &[Ray]) -> (usize, f64) {
@@ -349,66 +348,42 @@ fn triangle_bvh_any_stream(s: &Scene, rays: &[Ray]) -> (usize, f64) {
 }
 
 fn triangle_bvh_any(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let n = rays
-        .iter()
-        .filter(|ray| black_box(s.tri_bvh.any_hit(ray, f32::INFINITY)))
-        .count();
-    (n, 0.0)
+    count_occluded(rays, |ray| s.tri_bvh.any_hit(ray, f32::INFINITY))
 }
 
 fn shadow(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let mut n = 0;
-    for ray in rays {
+    count_occluded(rays, |ray| {
         let tr = TriangleRay::new(ray);
-        n += usize::from(black_box(s.bvh.any_hit(ray, f32::INFINITY, |p, t| {
+        s.bvh.any_hit(ray, f32::INFINITY, |p, t| {
             s.tris[p as usize].intersect_pre(&tr, t).is_some()
-        })));
-    }
-    (n, 0.0)
+        })
+    })
 }
 
 fn obvhs_indexed(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
-        let mut hit = obvhs::ray::RayHit::none();
-        let idx = &s.ob.primitive_indices;
-        if black_box(s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
-            s.ob_tris[idx[id] as usize].intersect(r)
-        })) {
-            acc = (acc.0 + 1, acc.1 + hit.t as f64);
-        }
-    }
-    acc
+    let idx = &s.ob.primitive_indices;
+    sum_closest(rays, |ray| {
+        obvhs_closest(&s.ob, ray, |r, id| s.ob_tris[idx[id] as usize].intersect(r))
+    })
 }
 
 fn obvhs_ordered(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
-        let mut hit = obvhs::ray::RayHit::none();
-        if black_box(s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| s.ob_tris_ordered[id].intersect(r))) {
-            acc = (acc.0 + 1, acc.1 + hit.t as f64);
-        }
-    }
-    acc
+    sum_closest(rays, |ray| {
+        obvhs_closest(&s.ob, ray, |r, id| s.ob_tris_ordered[id].intersect(r))
+    })
 }
 
 /// The comparison BVH with our (watertight) triangle test, to separate BVH from triangle cost.
 fn obvhs_our_triangle(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    let mut acc = (0, 0.0);
-    for ray in rays {
-        let mut hit = obvhs::ray::RayHit::none();
+    let idx = &s.ob.primitive_indices;
+    sum_closest(rays, |ray| {
         let tr = TriangleRay::new(ray);
-        let idx = &s.ob.primitive_indices;
-        let found = s.ob.ray_traverse(to_ob_ray(ray), &mut hit, |r, id| {
+        obvhs_closest(&s.ob, ray, |r, id| {
             s.tris[idx[id] as usize]
                 .intersect_pre(&tr, r.tmax)
                 .map_or(f32::INFINITY, |h| h.t)
-        });
-        if black_box(found) {
-            acc = (acc.0 + 1, acc.1 + hit.t as f64);
-        }
-    }
-    acc
+        })
+    })
 }
 
 const TRACERS: [(&str, Tracer<Scene>); 10] = [
