@@ -249,13 +249,17 @@ fn obvhs_closest(
     ob.ray_traverse(to_ob_ray(ray), &mut hit, hit_t).then_some(hit.t)
 }
 
-fn shapes_closest(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
+/// [`sum_closest`] over the generic BVH, `hit(prim, ray, t_max)` testing one primitive.
+fn bvh_closest(bvh: &Bvh, rays: &[Ray], hit: impl Fn(u32, &Ray, f32) -> Option<f32>) -> (usize, f64) {
     sum_closest(rays, |ray| {
-        s.bvh
-            .closest_hit(ray, f32::INFINITY, |p, t| {
-                s.shapes[p as usize].intersect(ray, t).map(|h| h.t)
-            })
+        bvh.closest_hit(ray, f32::INFINITY, |p, t| hit(p, ray, t))
             .map(|(t, _)| t)
+    })
+}
+
+fn shapes_closest(s: &ShapeScene, rays: &[Ray]) -> (usize, f64) {
+    bvh_closest(&s.bvh, rays, |p, ray, t| {
+        s.shapes[p as usize].intersect(ray, t).map(|h| h.t)
     })
 }
 
@@ -308,12 +312,8 @@ fn shape_ray_sets(s: &ShapeScene) -> [(&'static str, Vec<Ray>); 2] {
 type Tracer<S> = fn(&S, &[Ray]) -> (usize, f64);
 
 fn generic(s: &Scene, rays: &[Ray]) -> (usize, f64) {
-    sum_closest(rays, |ray| {
-        s.bvh
-            .closest_hit(ray, f32::INFINITY, |p, t| {
-                s.tris[p as usize].intersect(ray, t).map(|h| h.t)
-            })
-            .map(|(t, _)| t)
+    bvh_closest(&s.bvh, rays, |p, ray, t| {
+        s.tris[p as usize].intersect(ray, t).map(|h| h.t)
     })
 }
 

@@ -171,17 +171,23 @@ fn all_identical_boxes() {
     assert!(bvh.depth() <= 12, "depth {}", bvh.depth());
 }
 
+/// 300 parallel triangles at exponentially growing spacing: SAH peels them one at a time, so
+/// the tree is as deep as the depth cap allows.
+fn exponential_steps() -> Vec<Triangle> {
+    (0..300)
+        .map(|i| {
+            let x = 1.07f32.powi(i) - 1.0;
+            Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0))
+        })
+        .collect()
+}
+
 /// Exponentially spaced primitives make SAH peel one at a time; the depth cap must keep the
 /// traversal stack bounded.
 #[test]
 fn pathological_depth_is_capped() {
     let mut rng = Rng(99);
-    let tris: Vec<Triangle> = (0..300)
-        .map(|i| {
-            let x = 1.07f32.powi(i) - 1.0;
-            Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0))
-        })
-        .collect();
+    let tris = exponential_steps();
     let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
     let bvh = Bvh::build(&bounds);
     assert!(bvh.depth() < 80, "depth {}", bvh.depth());
@@ -516,19 +522,13 @@ fn build_reports_every_primitive_once() {
 #[test]
 fn stream_matches_single_rays() {
     let mut rng = Rng(0x5eed);
-    let steps: Vec<Triangle> = (0..300)
-        .map(|i| {
-            let x = 1.07f32.powi(i) - 1.0;
-            Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0), Vec3::new(x, 0.0, 1.0))
-        })
-        .collect();
     let meshes = [
         Vec::new(),
         random_triangles(&mut rng, 1),
         random_triangles(&mut rng, 40),
         random_triangles(&mut rng, 3000),
         sphere(40, 80),
-        steps,
+        exponential_steps(),
     ];
     let nasty = [0.0, f32::NAN, f32::INFINITY, 1e-40, 5.0];
     for tris in &meshes {
