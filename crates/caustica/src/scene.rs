@@ -254,12 +254,12 @@ impl Scene {
             self.intersect_shape(prim, ray, t_max)
         } else {
             let hit = self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max)?;
-            Some(Intersection {
+            Some(self.triangle_intersection(TriangleBvhHit {
                 t: hit.t,
-                prim,
-                normal_or_bary: Vec3::new(hit.u, hit.v, 0.0),
-                uv: Vec2::ZERO,
-            })
+                prim: prim - n_shapes,
+                u: hit.u,
+                v: hit.v,
+            }))
         }
     }
 

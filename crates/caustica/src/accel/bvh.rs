@@ -407,6 +407,13 @@ trait StackSized {
     fn run<const N: usize>(self) -> Self::Output;
 }
 
+/// Whether a ray can be walked: a non-finite one could turn slab tests into NaN, which min/max
+/// would drop.
+#[inline(always)]
+fn walkable(ray: &Ray) -> bool {
+    ray.origin.is_finite() && ray.dir.is_finite()
+}
+
 /// What one [`Traversal::step`] reached.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Visit {
@@ -435,13 +442,10 @@ struct Traversal<const N: usize, S: BorrowMut<[(u32, f32); N]> = [(u32, f32); N]
 
 impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
     /// A walk from the root using `stack`, whose contents need not be cleared, or `None` for a
-    /// non-finite ray (whose slab tests could turn into NaN, which min/max would drop).
+    /// ray that is not [`walkable`].
     #[inline(always)]
     fn new(ray: &Ray, t_max: f32, stack: S) -> Option<Traversal<N, S>> {
-        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
-            return None;
-        }
-        Some(Traversal {
+        walkable(ray).then(|| Traversal {
             ray: RayPre::new(ray),
             stack,
             sp: 0,
@@ -456,7 +460,7 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
     #[inline(always)]
     fn restart(&mut self, ray: &Ray, t_max: f32) -> bool {
         self.sp = 0;
-        if !(ray.origin.is_finite() && ray.dir.is_finite()) {
+        if !walkable(ray) {
             return false;
         }
         self.ray = RayPre::new(ray);

@@ -427,15 +427,20 @@ fn bounds_contain_children() {
     assert!(leaves > 5000 / build::LeafCost::SINGLE.max_leaf);
 }
 
+/// A cube of half-side up to 2 centred in [0, 10]³.
+fn random_cube(rng: &mut Rng) -> Aabb {
+    let c = rng.v() * 10.0;
+    let h = Vec3::splat(rng.f() * 2.0);
+    Aabb::new(c - h, c + h)
+}
+
 #[test]
 fn triangle_overlap_query_finds_every_triangle_touching_the_box() {
     let mut rng = Rng(21);
     let tris = random_triangles(&mut rng, 2000);
     let tbvh = TriangleBvh::new(&tris);
     for _ in 0..200 {
-        let c = rng.v() * 10.0;
-        let h = Vec3::splat(rng.f() * 2.0);
-        let query = Aabb::new(c - h, c + h);
+        let query = random_cube(&mut rng);
         let mut found = HashSet::new();
         assert!(!tbvh.any_overlap(&query, |p| {
             assert!(found.insert(p), "visited twice");
@@ -459,9 +464,7 @@ fn box_overlap_query_matches_brute_force() {
     let bounds: Vec<Aabb> = tris.iter().map(|t| t.bounds()).collect();
     let bvh = Bvh::build(&bounds);
     for _ in 0..300 {
-        let c = rng.v() * 10.0;
-        let h = Vec3::splat(rng.f() * 2.0);
-        let query = Aabb::new(c - h, c + h);
+        let query = random_cube(&mut rng);
         let mut found = HashSet::new();
         let stopped = bvh.any_overlap(&query, |p| {
             assert!(found.insert(p), "visited twice");
