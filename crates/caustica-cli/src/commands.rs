@@ -10,10 +10,13 @@ pub mod render;
 
 use crate::cli::{PhotonOptions, SceneArgs};
 use crate::progress::Bars;
+use caustica::format::ray_file::ast::Dialect;
+use caustica::format::ray_file::ParseOptions;
+use caustica::format::{self, ReadOptions};
+use caustica::loader::{build_source, LoadSettings};
 use caustica::photon::PhotonSettings;
-use caustica::scene::ray_file::ast::Dialect;
-use caustica::scene::ray_file::ParseOptions;
-use caustica::scene::{self, presets, BuildSettings, Scene};
+use caustica::presets;
+use caustica::scene::Scene;
 use caustica::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
@@ -25,15 +28,17 @@ const MAX_PIXELS: usize = 1 << 26;
 /// Largest photon count accepted (24 bytes each: 2.4 GB).
 const MAX_PHOTONS: usize = 100_000_000;
 
-/// Build settings from the command line.
-pub fn build_settings(args: &SceneArgs) -> BuildSettings {
-    let mut settings = BuildSettings::default();
-    settings.shapes.cone_quirks = args.cone_quirks;
-    settings.parse = ParseOptions {
-        dialect: match args.dialect.as_deref() {
-            Some("tokenizer") => Some(Dialect::Tokenizer),
-            Some("dictionary") => Some(Dialect::Dictionary),
-            _ => None,
+/// Load settings from the command line.
+pub fn load_settings(args: &SceneArgs) -> LoadSettings {
+    let mut settings = LoadSettings::default();
+    settings.build.shapes.cone_quirks = args.cone_quirks;
+    settings.read = ReadOptions {
+        ray: ParseOptions {
+            dialect: match args.dialect.as_deref() {
+                Some("tokenizer") => Some(Dialect::Tokenizer),
+                Some("dictionary") => Some(Dialect::Dictionary),
+                _ => None,
+            },
         },
     };
     settings
@@ -52,21 +57,21 @@ pub struct Loaded {
 /// Reads and parses the scene file, or the built-in ring scene when no path is given, then
 /// builds it: two phases, each with its bar.
 pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<Loaded> {
-    let settings = build_settings(args);
+    let settings = load_settings(args);
     let start = Instant::now();
-    let parsed = match path {
-        Some(path) => scene::parse_file(path, &settings, bars),
-        None => scene::parse_text(
+    let source = match path {
+        Some(path) => format::read_file(path, &settings.read, bars),
+        None => format::read_text(
             Path::new("<built-in ring scene>"),
             presets::RING.to_string(),
             Path::new("."),
-            &settings,
+            &settings.read,
             bars,
         ),
     };
     let parse_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    let scene = parsed?.build(&settings, bars)?;
+    let scene = build_source(source?, &settings.build, bars)?;
     Ok(Loaded {
         scene,
         parse_seconds,

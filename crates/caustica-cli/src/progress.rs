@@ -1,6 +1,6 @@
 //! Progress bars on stderr for the phases (parse, build, photons, render).
 
-use caustica::integrator::Progress;
+use caustica::progress::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;

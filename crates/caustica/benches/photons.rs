@@ -14,18 +14,19 @@ use std::path::Path;
 use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
-use caustica::integrator::{Control, NoProgress};
+use caustica::loader::{load, LoadSettings};
 use caustica::math::Vec3;
 use caustica::photon::{Photon, PhotonMap, PhotonSettings, PhotonStats};
+use caustica::progress::{Control, NoProgress};
 use caustica::sampling::Rng;
-use caustica::scene::{load, BuildSettings, Scene};
+use caustica::scene::Scene;
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
 
 const STORED: usize = 100_000;
 
 fn scene(name: &str) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(name);
-    load(&path, &BuildSettings::default()).expect("bench scene loads")
+    load(&path, &LoadSettings::default()).expect("bench scene loads")
 }
 
 fn trace(c: &mut Criterion) {

@@ -15,9 +15,11 @@ use std::sync::atomic::AtomicBool;
 use std::time::Duration;
 
 use caustica::integrator::whitted::{self, WhittedSettings};
-use caustica::integrator::{image_size, Control, ImageSettings, NoProgress};
+use caustica::integrator::{image_size, ImageSettings};
+use caustica::loader::{load, LoadSettings};
 use caustica::photon::{EstimateSettings, PhotonMap, PhotonSettings};
-use caustica::scene::{load, BuildSettings, Scene};
+use caustica::progress::{Control, NoProgress};
+use caustica::scene::Scene;
 use criterion::{criterion_group, criterion_main, Criterion};
 
 const WIDTH: usize = 128;
@@ -61,7 +63,7 @@ fn renders(c: &mut Criterion) {
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(2));
     for name in &names {
-        let scene = load(&dir.join(name), &BuildSettings::default()).expect("scene loads");
+        let scene = load(&dir.join(name), &LoadSettings::default()).expect("scene loads");
         let label = name.trim_end_matches(".ray");
         group.bench_function(label, |b| b.iter(|| black_box(render_once(&scene, 1, control))));
         if label == "ring" {

@@ -1,6 +1,7 @@
 //! Errors of the library: scene-file errors carry a source span; everything else a plain message.
 
-use crate::scene::ray_file::ast::Span;
+/// A byte range into a scene file's text.
+pub type Span = std::ops::Range<usize>;
 use std::path::PathBuf;
 
 /// A syntax or content error in a scene file, located by a byte span.

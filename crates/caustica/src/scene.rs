@@ -1,20 +1,18 @@
 //! The renderable scene: world-space shapes and triangles in their BVHs, materials, textures,
-//! lights and the camera. Built from a parsed `.ray` description by [`build`].
+//! lights and the camera. Built from a scene description by [`build`].
 
 pub mod build;
-pub mod presets;
-pub mod ray_file;
 
-pub use build::{build, load, parse_file, parse_text, BuildSettings, ParsedScene};
+pub use build::{build, BuildSettings};
 
 use crate::accel::bvh::{Bvh, TriangleBvh, TriangleBvhHit};
 use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::Shape;
-use crate::integrator::Progress;
 use crate::light::Light;
 use crate::material::{Material, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
+use crate::progress::Progress;
 use crate::texture::Texture;
 
 /// A triangle mesh's shading data in world space; its triangles live in [`Scene::triangles`].
@@ -539,7 +537,7 @@ mod tests {
                                       material = { specular = map(\"halves.png\"); } })
             translate(0, -2, 0, cone { height = 1; bottom_radius = 0.5; top_radius = 0.5; capped = false;
                                        material = { diffuse = (1, 1, 1); } })";
-        let scene = build::from_text(text, &dir, &build::BuildSettings::default());
+        let scene = crate::loader::from_text(text, &dir, &Default::default());
         std::fs::remove_dir_all(&dir).unwrap();
         let scene = scene.unwrap();
         assert_eq!(

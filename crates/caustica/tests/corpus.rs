@@ -1,7 +1,7 @@
 //! Every scene of the shared corpus either parses or fails with the error this table expects.
 
 use caustica::error::line_col;
-use caustica::scene::ray_file::{self, ast::Dialect, ParseOptions};
+use caustica::format::ray_file::{self, ast::Dialect, ParseOptions};
 use std::path::{Path, PathBuf};
 
 fn corpus_dir() -> PathBuf {

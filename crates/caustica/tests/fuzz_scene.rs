@@ -8,14 +8,14 @@
 
 mod common;
 
+use caustica::format::ray_file::{self, ast::Dialect, ParseOptions};
 use caustica::integrator::path::{PathSettings, PathTracer};
 use caustica::integrator::ppm::{Ppm, PpmSettings};
 use caustica::integrator::progressive::Progressive;
 use caustica::integrator::whitted::{render, WhittedSettings};
 use caustica::integrator::ImageSettings;
+use caustica::loader::{from_text, LoadSettings};
 use caustica::photon::{PhotonMap, PhotonSettings};
-use caustica::scene::build::{from_text, BuildSettings};
-use caustica::scene::ray_file::{self, ast::Dialect, ParseOptions};
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::{Path, PathBuf};
@@ -440,7 +440,7 @@ fn exercise(text: &str, dir: &Path) -> (bool, bool) {
     for dialect in [Dialect::Tokenizer, Dialect::Dictionary] {
         let _ = ray_file::parse(text, dir, &ParseOptions { dialect: Some(dialect) });
     }
-    if let Ok(scene) = from_text(text, dir, &BuildSettings::default()) {
+    if let Ok(scene) = from_text(text, dir, &LoadSettings::default()) {
         let image = ImageSettings {
             width: 8,
             height: 8,

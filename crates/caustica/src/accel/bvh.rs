@@ -15,8 +15,8 @@ use std::cell::RefCell;
 
 use glam::Vec4;
 
-use crate::integrator::{NoProgress, Progress};
 use crate::math::{Aabb, Ray, Vec3};
+use crate::progress::{NoProgress, Progress};
 
 pub use triangles::{TriangleBvh, TriangleBvhHit};
 

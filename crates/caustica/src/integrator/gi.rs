@@ -18,11 +18,11 @@
 use super::physical::{camera_chain, direct_light, Lights};
 use super::ppm::{pixel_angle, InitialRadius, PHOTON_SEED};
 use super::progressive::{radius_factor, sample_pass, Progressive};
-use super::Control;
 use crate::bsdf::{Bsdf, Transport};
 use crate::math::{offset_origin, Ray, Vec3};
 use crate::photon::estimate::DensityMap;
 use crate::photon::physical::{is_caustic, trace};
+use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
 

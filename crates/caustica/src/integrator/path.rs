@@ -117,7 +117,7 @@ impl<'a> PathTracer<'a> {
 }
 
 impl super::progressive::Progressive for PathTracer<'_> {
-    fn render_pass(&self, pass: u64, control: super::Control) -> Option<Vec<Vec3>> {
+    fn render_pass(&self, pass: u64, control: crate::progress::Control) -> Option<Vec<Vec3>> {
         let camera = &self.scene.camera;
         super::progressive::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             radiance(

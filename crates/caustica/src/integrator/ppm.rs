@@ -11,10 +11,10 @@
 
 use super::physical::{camera_chain, direct_light, Lights};
 use super::progressive::{radius_factor, sample_pass, Progressive};
-use super::Control;
 use crate::math::{Ray, Vec3};
 use crate::photon::estimate::DensityMap;
 use crate::photon::physical::{is_direct, trace};
+use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
 

@@ -10,10 +10,11 @@
 //! size, the run's settings fingerprint, the passes it holds) and then the sums as little-endian
 //! f64 triples, rows from the top.
 
-use super::{shade_tiles, Control};
+use super::shade_tiles;
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::math::Vec3;
+use crate::progress::Control;
 use crate::sampling::Rng;
 use std::path::Path;
 

@@ -192,7 +192,7 @@ pub fn render(
     caustics: Option<(&crate::photon::PhotonMap, &crate::photon::EstimateSettings)>,
     settings: &WhittedSettings,
     image: &super::ImageSettings,
-    control: super::Control,
+    control: crate::progress::Control,
 ) -> (crate::film::Film, bool) {
     let camera = &scene.camera;
     let reuse = settings.reuse_caustic_estimates;

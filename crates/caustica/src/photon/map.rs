@@ -9,9 +9,9 @@
 use super::kd_tree::{KdTree, Neighbor};
 use super::trace::{trace_photons, PhotonSettings, PhotonStats};
 use super::Photon;
-use crate::integrator::Control;
 use crate::material::SurfaceParams;
 use crate::math::Vec3;
+use crate::progress::Control;
 use crate::scene::{Scene, SurfaceHit};
 use std::cell::RefCell;
 use std::f32::consts::PI;

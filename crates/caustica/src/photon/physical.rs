@@ -11,8 +11,8 @@
 use super::{Photon, REFLECTED, REFRACTED};
 use crate::bsdf::{Bsdf, Transport};
 use crate::integrator::physical::Lights;
-use crate::integrator::Control;
 use crate::math::{offset_origin, Ray};
+use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
 use rayon::prelude::*;

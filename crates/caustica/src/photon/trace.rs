@@ -11,9 +11,9 @@
 use super::emit::{Emitter, Target};
 use super::{Photon, REFLECTED, REFRACTED};
 use crate::integrator::whitted::refraction_geometry;
-use crate::integrator::Control;
 use crate::light::{distance_attenuation, Light};
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
+use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{ObjectRef, Scene};
 use rayon::prelude::*;

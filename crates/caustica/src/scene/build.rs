@@ -1,109 +1,28 @@
 //! From a parsed description to a renderable [`Scene`]: textures loaded once per path, shapes
 //! placed, meshes moved to world space, and the BVH built.
 
-use super::ray_file::ast::{LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span};
-use super::ray_file::{self, ParseOptions};
 use super::{Mesh, Scene, TriangleRef};
 use crate::camera::Camera;
-use crate::error::{Error, ParseError, Result};
+use crate::description::{LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, TrimeshDesc};
+use crate::error::Span;
+use crate::error::{Error, ParseError};
 use crate::geometry::cone::Cone;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Shape, ShapeKind, ShapeSettings};
 use crate::image_io;
-use crate::integrator::{NoProgress, Progress};
 use crate::light::Light;
 use crate::material::{Channel, Material};
 use crate::math::{Aabb, Mat3, Vec3};
+use crate::progress::{NoProgress, Progress};
 use crate::texture::Texture;
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Options for building a scene.
 #[derive(Clone, Debug, Default)]
 pub struct BuildSettings {
     /// How shapes are built.
     pub shapes: ShapeSettings,
-    /// How the file is read.
-    pub parse: ParseOptions,
-}
-
-/// Reads, parses and builds the scene file at `path`.
-pub fn load(path: &Path, settings: &BuildSettings) -> Result<Scene> {
-    parse_file(path, settings, &NoProgress)?.build(settings, &NoProgress)
-}
-
-/// A scene file read and parsed but not yet built; it keeps the text so that errors found while
-/// building can still point into it.
-pub struct ParsedScene {
-    /// The file, as errors name it.
-    pub path: PathBuf,
-    /// The file's text.
-    pub text: String,
-    /// What the file describes.
-    pub description: SceneDescription,
-}
-
-/// Reads and parses the scene file at `path` (the first half of [`load`]), reporting a "parse"
-/// phase to `progress`.
-pub fn parse_file(path: &Path, settings: &BuildSettings, progress: &dyn Progress) -> Result<ParsedScene> {
-    let bytes = std::fs::read(path).map_err(|source| Error::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let text = match String::from_utf8(bytes) {
-        Ok(text) => text,
-        Err(e) => {
-            let offset = e.utf8_error().valid_up_to();
-            let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
-            return Err(Error::Scene {
-                path: path.to_path_buf(),
-                text,
-                error: ParseError::new("the file is not valid UTF-8 text", offset..offset + 1),
-            });
-        }
-    };
-    let dir = path.parent().map_or_else(|| PathBuf::from("."), Path::to_path_buf);
-    parse_text(path, text, &dir, settings, progress)
-}
-
-/// Parses scene text, reporting a "parse" phase; `path` names it in errors and textures resolve
-/// against `scene_dir`.
-pub fn parse_text(
-    path: &Path,
-    text: String,
-    scene_dir: &Path,
-    settings: &BuildSettings,
-    progress: &dyn Progress,
-) -> Result<ParsedScene> {
-    match ray_file::parse_reporting(&text, scene_dir, &settings.parse, progress) {
-        Ok(description) => Ok(ParsedScene {
-            path: path.to_path_buf(),
-            text,
-            description,
-        }),
-        Err(error) => Err(Error::Scene {
-            path: path.to_path_buf(),
-            text,
-            error,
-        }),
-    }
-}
-
-impl ParsedScene {
-    /// Builds the scene (the second half of [`load`]), reporting a "build" phase to `progress`.
-    pub fn build(self, settings: &BuildSettings, progress: &dyn Progress) -> Result<Scene> {
-        build_reporting(&self.description, settings, progress).map_err(|error| Error::Scene {
-            path: self.path,
-            text: self.text,
-            error,
-        })
-    }
-}
-
-/// Parses and builds scene text; textures resolve against `scene_dir`.
-pub fn from_text(text: &str, scene_dir: &Path, settings: &BuildSettings) -> Result<Scene, ParseError> {
-    let desc = ray_file::parse(text, scene_dir, &settings.parse)?;
-    build(&desc, settings)
 }
 
 /// Builds a scene from its description.
@@ -263,7 +182,7 @@ impl Builder {
     fn add_mesh(
         &mut self,
         object: &ObjectDesc,
-        desc: &super::ray_file::ast::TrimeshDesc,
+        desc: &TrimeshDesc,
         material: u32,
         warnings: &mut Vec<String>,
     ) -> Result<(), ParseError> {
@@ -398,103 +317,5 @@ fn singular(span: &Span) -> ParseError {
 pub(crate) fn test_scene(objects: &str) -> Scene {
     let text =
         format!("SBT-raytracer 1.0\ncamera {{ position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); }}\n{objects}");
-    from_text(&text, Path::new("."), &BuildSettings::default()).unwrap()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scene::ray_file::ast::Dialect;
-    use std::sync::Mutex;
-
-    /// Records the phases and the units reported.
-    #[derive(Default)]
-    struct Record(Mutex<Vec<(String, u64, u64, bool)>>);
-
-    impl Progress for Record {
-        fn start(&self, phase: &str, total: u64) {
-            self.0.lock().unwrap().push((phase.into(), total, 0, false));
-        }
-        fn advance(&self, n: u64) {
-            self.0.lock().unwrap().last_mut().unwrap().2 += n;
-        }
-        fn finish(&self) {
-            self.0.lock().unwrap().last_mut().unwrap().3 = true;
-        }
-    }
-
-    const SCENE: &str = "SBT-raytracer 1.0
-camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); }
-point_light { position = (0, 5, 5); color = (1, 1, 1); }
-sphere { material = { diffuse = (1, 0, 0); } }
-polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1,3)); }
-";
-
-    #[test]
-    fn parse_then_build_reports_one_build_phase_that_ends_at_its_total() {
-        let settings = BuildSettings::default();
-        let record = Record::default();
-        let parsed = parse_text(Path::new("t.ray"), SCENE.into(), Path::new("."), &settings, &record).unwrap();
-        let scene = parsed.build(&settings, &record).unwrap();
-        // The collinear face is dropped by the parser; placing and the BVH count 2 units each.
-        assert_eq!(scene.triangles.len(), 1);
-        let phases = record.0.into_inner().unwrap();
-        let bytes = SCENE.len() as u64;
-        assert_eq!(
-            phases,
-            [
-                ("parse".to_string(), bytes, bytes, true),
-                ("build".to_string(), 4, 4, true)
-            ]
-        );
-    }
-
-    #[test]
-    fn a_large_file_reports_each_byte_once() {
-        let points: Vec<String> = (0..20_000).map(|i| format!("({i}, 0, 1)")).collect();
-        let text = format!(
-            "SBT-raytracer 1.0\npolymesh {{ points = ({}); faces = ((0, 1, 2)); }}\n",
-            points.join(", ")
-        );
-        let settings = BuildSettings::default();
-        for dialect in [None, Some(Dialect::Tokenizer), Some(Dialect::Dictionary)] {
-            let settings = BuildSettings {
-                parse: ParseOptions { dialect },
-                ..settings.clone()
-            };
-            let record = Record::default();
-            let parsed = parse_text(Path::new("big.ray"), text.clone(), Path::new("."), &settings, &record);
-            assert!(parsed.is_ok(), "{dialect:?}");
-            let phases = record.0.into_inner().unwrap();
-            let total = text.len() as u64;
-            assert_eq!(phases, [("parse".to_string(), total, total, true)], "{dialect:?}");
-        }
-    }
-
-    #[test]
-    fn errors_of_either_half_name_the_file() {
-        let settings = BuildSettings::default();
-        let bad_syntax = parse_text(
-            Path::new("a.ray"),
-            "SBT-raytracer 1.0\nsphere {".into(),
-            Path::new("."),
-            &settings,
-            &NoProgress,
-        );
-        assert!(matches!(bad_syntax, Err(Error::Scene { path, .. }) if path == Path::new("a.ray")));
-        // Textures are read while building.
-        let no_texture = "SBT-raytracer 1.0\nsphere { material = { diffuse = map(\"missing.png\"); } }\n";
-        let parsed = parse_text(
-            Path::new("b.ray"),
-            no_texture.into(),
-            Path::new("."),
-            &settings,
-            &NoProgress,
-        )
-        .unwrap();
-        let built = parsed.build(&settings, &NoProgress);
-        assert!(
-            matches!(built, Err(Error::Scene { path, text, .. }) if path == Path::new("b.ray") && text == no_texture)
-        );
-    }
+    crate::loader::from_text(&text, std::path::Path::new("."), &Default::default()).unwrap()
 }

@@ -1,14 +1,15 @@
 //! Helpers shared by the integration tests.
 #![allow(dead_code)]
 
-use caustica::integrator::{Control, NoProgress};
-use caustica::scene::{build::from_text, BuildSettings, Scene};
+use caustica::loader::{from_text, LoadSettings};
+use caustica::progress::{Control, NoProgress};
+use caustica::scene::Scene;
 use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 /// Builds a scene from `.ray` text, panicking with the parse error if it is malformed.
 pub fn scene(text: &str) -> Scene {
-    from_text(text, Path::new("."), &BuildSettings::default()).unwrap_or_else(|e| panic!("scene does not build: {e:?}"))
+    from_text(text, Path::new("."), &LoadSettings::default()).unwrap_or_else(|e| panic!("scene does not build: {e:?}"))
 }
 
 static NEVER: AtomicBool = AtomicBool::new(false);

@@ -5,8 +5,8 @@ use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
 use super::{Node, END, LEAF, WIDTH};
-use crate::integrator::Progress;
 use crate::math::Aabb;
+use crate::progress::Progress;
 
 /// SAH bins per axis.
 const BINS: usize = 32;

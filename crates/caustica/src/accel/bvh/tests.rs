@@ -495,7 +495,7 @@ fn box_overlap_query_matches_brute_force() {
 #[derive(Default)]
 struct Count(std::sync::atomic::AtomicU64);
 
-impl crate::integrator::Progress for Count {
+impl crate::progress::Progress for Count {
     fn start(&self, _: &str, _: u64) {}
     fn advance(&self, n: u64) {
         self.0.fetch_add(n, std::sync::atomic::Ordering::Relaxed);

@@ -6,8 +6,8 @@ use super::build::LeafCost;
 use super::{Bvh, StackSized, Traversal, Visit, END, LEAF};
 use crate::geometry::triangle::{Triangle, TriangleRay};
 use crate::geometry::triangle_packet::{TrianglePacket, LANES};
-use crate::integrator::{NoProgress, Progress};
 use crate::math::{Aabb, Ray};
+use crate::progress::{NoProgress, Progress};
 
 /// Packet leaves: a packet test costs about one binary node visit (measured with the `bvh`
 /// bench: 1.0 to 2.0 change incoherent throughput by under 5%), and a leaf holds at most two.

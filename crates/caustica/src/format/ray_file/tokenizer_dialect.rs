@@ -4,7 +4,7 @@
 //! turns into call-stack depth.
 
 use super::ast::{
-    CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
+    CameraBasis, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, RayCamera, RayScene, ShapeDesc, Span,
 };
 use super::cursor::{Cursor, Reach};
 use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS, TOP_LEVEL};
@@ -71,7 +71,7 @@ const MESH_FIELDS: &[&str] = &[
 ];
 
 /// Parses a whole dialect-T file.
-pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<SceneDescription, ParseError> {
+pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<RayScene, ParseError> {
     let tokens = lexer::lex(text, Dialect::Tokenizer)?;
     let mut parser = Parser {
         cur: Cursor::new(text, tokens, reach),
@@ -79,7 +79,7 @@ pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<S
         default_material: MaterialDesc::default(),
         named: NamedMaterials::default(),
         transforms: TransformStack::new(),
-        scene: SceneDescription {
+        scene: RayScene {
             dialect: Dialect::Tokenizer,
             camera: None,
             lights: Vec::new(),
@@ -107,7 +107,7 @@ struct Parser<'a> {
     default_material: MaterialDesc,
     named: NamedMaterials,
     transforms: TransformStack,
-    scene: SceneDescription,
+    scene: RayScene,
 }
 
 impl<'a> Parser<'a> {
@@ -373,7 +373,7 @@ impl<'a> Parser<'a> {
     fn camera(&mut self) -> Result<(), ParseError> {
         let keyword = self.cur.next();
         // Later camera blocks modify the same camera, as in the skeleton.
-        let mut camera = self.scene.camera.take().unwrap_or(CameraDesc {
+        let mut camera = self.scene.camera.take().unwrap_or(RayCamera {
             position: Vec3::ZERO,
             viewdir: None,
             updir: None,

@@ -1,6 +1,6 @@
-//! The SBT-raytracer `.ray` format: lexer, both dialects' parsers, and the plain description.
+//! The SBT-raytracer `.ray` format: lexer, both dialects' parsers, and the syntax tree, lowered to the format-neutral description.
 //!
-//! [`parse`] reads a whole file into an [`ast::SceneDescription`]; see `docs/scene-format.md`
+//! [`parse`] reads a whole file into an [`ast::RayScene`]; see `docs/scene-format.md`
 //! for what is accepted.
 
 pub mod ast;
@@ -18,7 +18,7 @@ mod trimesh;
 #[cfg(test)]
 mod tests;
 
-use crate::integrator::{NoProgress, Progress};
+use crate::progress::{NoProgress, Progress};
 use crate::ParseError;
 use std::path::Path;
 
@@ -30,7 +30,7 @@ pub struct ParseOptions {
 }
 
 /// Parses a whole `.ray` file; `scene_dir` resolves `map("file")` paths (images are not loaded).
-pub fn parse(text: &str, scene_dir: &Path, options: &ParseOptions) -> Result<ast::SceneDescription, ParseError> {
+pub fn parse(text: &str, scene_dir: &Path, options: &ParseOptions) -> Result<ast::RayScene, ParseError> {
     parse_reporting(text, scene_dir, options, &NoProgress)
 }
 
@@ -41,7 +41,7 @@ pub fn parse_reporting(
     scene_dir: &Path,
     options: &ParseOptions,
     progress: &dyn Progress,
-) -> Result<ast::SceneDescription, ParseError> {
+) -> Result<ast::RayScene, ParseError> {
     progress.start("parse", text.len() as u64);
     let reach = cursor::Reach::new(progress);
     let result = match options.dialect {

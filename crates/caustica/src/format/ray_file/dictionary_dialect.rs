@@ -5,7 +5,7 @@
 //! walked in a loop, so neither step recurses with the input's nesting.
 
 use super::ast::{
-    CameraBasis, CameraDesc, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, Span,
+    CameraBasis, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, RayCamera, RayScene, ShapeDesc, Span,
 };
 use super::cursor::{Cursor, Reach};
 use super::keywords::{extension_error, COLOUR_FIELDS, TOP_LEVEL};
@@ -23,7 +23,7 @@ use std::path::Path;
 pub(crate) const IGNORED_KEY: &str = "ignored unknown key";
 
 /// Parses a whole dialect-O file.
-pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<SceneDescription, ParseError> {
+pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<RayScene, ParseError> {
     let tokens = lexer::lex(text, Dialect::Dictionary)?;
     let mut cur = Cursor::new(text, tokens, reach);
     if !cur.at_word("SBT-raytracer") {
@@ -44,7 +44,7 @@ pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<S
         tree: Vec::new(),
         scene_dir,
         named: NamedMaterials::default(),
-        scene: SceneDescription {
+        scene: RayScene {
             dialect: Dialect::Dictionary,
             camera: None,
             lights: Vec::new(),
@@ -224,7 +224,7 @@ struct Reader<'a> {
     tree: Vec<Node>,
     scene_dir: &'a Path,
     named: NamedMaterials,
-    scene: SceneDescription,
+    scene: RayScene,
 }
 
 impl<'a> Reader<'a> {
@@ -343,7 +343,7 @@ impl<'a> Reader<'a> {
     }
 
     fn camera(&mut self, id: usize, head: Span) -> Result<(), ParseError> {
-        let mut camera = self.scene.camera.take().unwrap_or(CameraDesc {
+        let mut camera = self.scene.camera.take().unwrap_or(RayCamera {
             position: Vec3::ZERO,
             viewdir: None,
             updir: None,

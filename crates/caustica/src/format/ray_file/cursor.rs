@@ -2,7 +2,7 @@
 
 use super::ast::Span;
 use super::lexer::{Tok, Token};
-use crate::integrator::Progress;
+use crate::progress::Progress;
 use crate::ParseError;
 use std::cell::Cell;
 

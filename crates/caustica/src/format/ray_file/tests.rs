@@ -2,6 +2,7 @@
 
 use super::ast::*;
 use super::{parse, ParseOptions};
+use crate::camera::Camera;
 use crate::error::line_col;
 use crate::ParseError;
 use glam::{Mat4, Vec2, Vec3};
@@ -9,7 +10,7 @@ use std::path::{Path, PathBuf};
 
 const HEADER: &str = "SBT-raytracer 1.0\n";
 
-fn read(body: &str) -> SceneDescription {
+fn read(body: &str) -> RayScene {
     let text = format!("{HEADER}{body}");
     match parse(&text, Path::new("scenes"), &ParseOptions::default()) {
         Ok(scene) => scene,
@@ -17,7 +18,7 @@ fn read(body: &str) -> SceneDescription {
     }
 }
 
-fn read_as(body: &str, dialect: Dialect) -> Result<SceneDescription, ParseError> {
+fn read_as(body: &str, dialect: Dialect) -> Result<RayScene, ParseError> {
     let text = format!("{HEADER}{body}");
     let options = ParseOptions { dialect: Some(dialect) };
     parse(&text, Path::new("scenes"), &options)
@@ -689,4 +690,62 @@ fn markers_are_counted() {
             tokenizer: 4
         }
     );
+}
+
+// ---------------------------------------------------------------- the camera block lowered to a pinhole
+
+fn camera_block() -> RayCamera {
+    RayCamera {
+        position: Vec3::new(0.0, 0.0, 5.0),
+        viewdir: Some(-Vec3::Z),
+        updir: Some(Vec3::Y),
+        look_at: None,
+        quaternion: None,
+        fov_degrees: Some(90.0),
+        aspect_ratio: Some(2.0),
+        basis: CameraBasis::AsGiven,
+        span: 0..0,
+    }
+}
+
+#[test]
+fn fov_and_aspect_set_the_image_plane() {
+    let cam = Camera::from_desc(&camera_block().lower());
+    // fov 90°: h = 2, so the top edge is at 45°.
+    let top = cam.generate_ray(0.5, 1.0).dir;
+    assert!((top.y.atan2(-top.z).to_degrees() - 45.0).abs() < 1e-3);
+    let right = cam.generate_ray(1.0, 0.5).dir;
+    assert!((right.x / -right.z - 2.0).abs() < 1e-5, "half-width = aspect · h / 2");
+    assert_eq!(cam.height_for_width(512), 256);
+    let (sx, sy) = cam.project(Vec3::new(1.0, -0.5, 0.0)).unwrap();
+    let back = cam.generate_ray(sx, sy).dir;
+    assert!((back - Vec3::new(1.0, -0.5, -5.0).normalize()).length() < 1e-5);
+}
+
+#[test]
+fn unnormalised_viewdir_narrows_the_view_as_in_the_course() {
+    let mut d = camera_block();
+    d.viewdir = Some(-Vec3::Z * 2.0);
+    let cam = Camera::from_desc(&d.lower());
+    let top = cam.generate_ray(0.5, 1.0).dir;
+    // look has length 2, v still spans h = 2: the top edge is at atan(1/2).
+    assert!((top.y.atan2(-top.z) - 0.5f32.atan()).abs() < 1e-5);
+    d.basis = CameraBasis::Orthonormal;
+    let ortho = Camera::from_desc(&d.lower());
+    let top = ortho.generate_ray(0.5, 1.0).dir;
+    assert!((top.y.atan2(-top.z).to_degrees() - 45.0).abs() < 1e-3);
+}
+
+#[test]
+fn default_view_and_look_at() {
+    let mut d = camera_block();
+    d.viewdir = None;
+    d.updir = None;
+    d.fov_degrees = None;
+    d.position = Vec3::ZERO;
+    let cam = Camera::from_desc(&d.lower());
+    assert_eq!(cam.generate_ray(0.5, 0.5).dir, -Vec3::Z);
+    d.look_at = Some(Vec3::new(3.0, 0.0, 0.0));
+    let cam = Camera::from_desc(&d.lower());
+    assert!((cam.generate_ray(0.5, 0.5).dir - Vec3::X).length() < 1e-6);
 }

@@ -1,6 +1,6 @@
 //! Choosing the dialect of a file: decisive markers first, then whichever reader accepts it.
 
-use super::ast::{Dialect, SceneDescription};
+use super::ast::{Dialect, RayScene};
 use super::cursor::Reach;
 use super::dictionary_dialect::{self, IGNORED_KEY};
 use super::keywords::{is_extension_error, COLOUR_FIELDS};
@@ -76,7 +76,7 @@ pub(crate) fn markers(text: &str) -> Markers {
 /// that O ignores and that is no misspelling of a known field (e.g. `focaldistance`). When both
 /// readers fail, a student-extension error wins, then the error of the marked dialect, then the
 /// one found further into the file (dialect T on a tie).
-pub(crate) fn parse_auto(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<SceneDescription, ParseError> {
+pub(crate) fn parse_auto(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<RayScene, ParseError> {
     let found = markers(text);
     let o_first = found.dictionary > 0 && found.tokenizer == 0;
     if o_first {

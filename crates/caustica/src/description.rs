@@ -1,81 +1,52 @@
-//! The plain description a `.ray` file parses into: no rendering types, only data and source spans.
+//! The format-neutral scene description: what every scene reader produces and the scene builder
+//! consumes. Plain data with source spans; no rendering types and no file syntax.
 //!
-//! Transforms are already flattened: every object carries its `world_from_object` matrix (the
-//! product of the enclosing transforms, outermost first). Materials are already resolved: the
-//! current-default inheritance of dialect T and the named materials of both dialects are applied,
-//! so each object holds the finished material it will render with.
+//! Transforms are already flattened: every object carries its `world_from_object` matrix.
+//! Materials are already resolved: each object holds the finished material it renders with.
 
+use crate::error::Span;
 use glam::{Mat4, Vec2, Vec3};
-use std::ops::Range;
 use std::path::PathBuf;
 
-/// A byte range into the scene file's text.
-pub type Span = Range<usize>;
-
-/// Which of the two course readers the file was written for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Dialect {
-    /// The tokenizer-based reader (UT CS 384G 2012–2019, UW CSE 457 2009+), §1–§9.
-    Tokenizer,
-    /// The older object/dictionary reader (UW ≤ 2008, UT ≤ 2010, HKUST), §10.
-    Dictionary,
-}
-
-/// Everything a `.ray` file describes.
-#[derive(Clone, Debug)]
+/// A whole scene.
+#[derive(Clone, Debug, Default)]
 pub struct SceneDescription {
-    /// The dialect that was detected.
-    pub dialect: Dialect,
     /// The camera, if the file has one.
     pub camera: Option<CameraDesc>,
-    /// Point and directional lights, in file order.
+    /// Lights, in file order.
     pub lights: Vec<LightDesc>,
-    /// Sum of all `ambient_light` colours (Ia).
+    /// Ambient light Ia of the course shading (summed).
     pub ambient: Vec3,
     /// Every primitive, in file order, with its world transform and material.
     pub objects: Vec<ObjectDesc>,
-    /// Non-fatal remarks (ignored dictionary keys, etc.), each with a span.
+    /// Non-fatal remarks made while reading, each with a span.
     pub warnings: Vec<(String, Span)>,
 }
 
-/// How the camera basis is formed from `viewdir` and `updir`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum CameraBasis {
-    /// UT skeleton: vectors used as given (not normalised, not orthogonalised).
-    AsGiven,
-    /// Dialect O: each vector normalised separately, not orthogonalised.
-    Normalized,
-    /// UW 2013 and `look_at`: orthonormalised.
-    Orthonormal,
-}
-
-/// The camera block.
-#[derive(Clone, Debug)]
+/// A pinhole camera: the eye and the image plane it looks through. The plane's centre lies at
+/// `eye + view`; it spans `up × height` vertically and `(up × −view) × height × aspect_ratio`
+/// horizontally. The vectors are used as given (not normalised), so readers that want a
+/// conventional camera pass unit, perpendicular vectors.
+#[derive(Clone, Debug, PartialEq)]
 pub struct CameraDesc {
-    /// Eye position (default origin).
+    /// Eye position.
     pub position: Vec3,
-    /// View direction; `None` means the default orientation (−z) or the quaternion.
-    pub viewdir: Option<Vec3>,
-    /// Up direction, given together with `viewdir`.
-    pub updir: Option<Vec3>,
-    /// `look_at` target point (UW), turned into a view direction by the builder.
-    pub look_at: Option<Vec3>,
-    /// Quaternion (x, y, z, w) applied to the default frame, if given.
-    pub quaternion: Option<[f32; 4]>,
-    /// Vertical field of view in degrees; `None` gives the skeleton's normalised height 1.
-    pub fov_degrees: Option<f32>,
-    /// Width / height; `None` means 1.
-    pub aspect_ratio: Option<f32>,
-    /// How to form the basis.
-    pub basis: CameraBasis,
-    /// Where the camera block is.
+    /// From the eye to the image-plane centre.
+    pub view: Vec3,
+    /// The image plane's upward direction.
+    pub up: Vec3,
+    /// Image-plane height per unit of `up` (2·tan(fov/2) for unit vectors).
+    pub height: f32,
+    /// Width / height.
+    pub aspect_ratio: f32,
+    /// Where the camera is described.
     pub span: Span,
 }
 
-/// A light statement.
+/// A light.
 #[derive(Clone, Debug)]
 pub enum LightDesc {
-    /// `point_light`.
+    /// A point light.
     Point {
         /// Position in world space.
         position: Vec3,
@@ -86,7 +57,7 @@ pub enum LightDesc {
         /// Where the block is.
         span: Span,
     },
-    /// `directional_light`.
+    /// A light from infinitely far away.
     Directional {
         /// The direction the light travels, as written (not normalised).
         direction: Vec3,

@@ -1,0 +1,149 @@
+//! From a scene file to a renderable scene: [`format`](crate::format) reads it into a
+//! description, [`scene::build`](crate::scene::build) builds that.
+
+use crate::error::{ParseError, Result};
+use crate::format::{self, ReadOptions, SceneSource};
+use crate::progress::{NoProgress, Progress};
+use crate::scene::{BuildSettings, Scene};
+use std::path::Path;
+
+/// How a scene file is read and built.
+#[derive(Clone, Debug, Default)]
+pub struct LoadSettings {
+    /// How the file is read.
+    pub read: ReadOptions,
+    /// How the scene is built.
+    pub build: BuildSettings,
+}
+
+/// Reads and builds the scene file at `path`.
+pub fn load(path: &Path, settings: &LoadSettings) -> Result<Scene> {
+    let source = format::read_file(path, &settings.read, &NoProgress)?;
+    build_source(source, &settings.build, &NoProgress)
+}
+
+/// Builds a scene read from a file (reporting a "build" phase); errors point into its text.
+pub fn build_source(source: SceneSource, settings: &BuildSettings, progress: &dyn Progress) -> Result<Scene> {
+    crate::scene::build::build_reporting(&source.description, settings, progress).map_err(|e| source.error(e))
+}
+
+/// Reads and builds scene text; files it refers to resolve against `scene_dir`.
+pub fn from_text(text: &str, scene_dir: &Path, settings: &LoadSettings) -> Result<Scene, ParseError> {
+    let scene = format::ray_file::parse(text, scene_dir, &settings.read.ray)?;
+    crate::scene::build::build(&scene.into_description(), &settings.build)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Error;
+    use crate::format::ray_file::{ast::Dialect, ParseOptions};
+    use std::path::Path;
+    use std::sync::Mutex;
+
+    /// Records the phases and the units reported.
+    #[derive(Default)]
+    struct Record(Mutex<Vec<(String, u64, u64, bool)>>);
+
+    impl Progress for Record {
+        fn start(&self, phase: &str, total: u64) {
+            self.0.lock().unwrap().push((phase.into(), total, 0, false));
+        }
+        fn advance(&self, n: u64) {
+            self.0.lock().unwrap().last_mut().unwrap().2 += n;
+        }
+        fn finish(&self) {
+            self.0.lock().unwrap().last_mut().unwrap().3 = true;
+        }
+    }
+
+    const SCENE: &str = "SBT-raytracer 1.0
+camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); }
+point_light { position = (0, 5, 5); color = (1, 1, 1); }
+sphere { material = { diffuse = (1, 0, 0); } }
+polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1,3)); }
+";
+
+    #[test]
+    fn parse_then_build_reports_one_build_phase_that_ends_at_its_total() {
+        let settings = LoadSettings::default();
+        let record = Record::default();
+        let parsed = format::read_text(
+            Path::new("t.ray"),
+            SCENE.into(),
+            Path::new("."),
+            &settings.read,
+            &record,
+        )
+        .unwrap();
+        let scene = build_source(parsed, &settings.build, &record).unwrap();
+        // The collinear face is dropped by the parser; placing and the BVH count 2 units each.
+        assert_eq!(scene.triangles.len(), 1);
+        let phases = record.0.into_inner().unwrap();
+        let bytes = SCENE.len() as u64;
+        assert_eq!(
+            phases,
+            [
+                ("parse".to_string(), bytes, bytes, true),
+                ("build".to_string(), 4, 4, true)
+            ]
+        );
+    }
+
+    #[test]
+    fn a_large_file_reports_each_byte_once() {
+        let points: Vec<String> = (0..20_000).map(|i| format!("({i}, 0, 1)")).collect();
+        let text = format!(
+            "SBT-raytracer 1.0\npolymesh {{ points = ({}); faces = ((0, 1, 2)); }}\n",
+            points.join(", ")
+        );
+        let settings = LoadSettings::default();
+        for dialect in [None, Some(Dialect::Tokenizer), Some(Dialect::Dictionary)] {
+            let settings = LoadSettings {
+                read: ReadOptions {
+                    ray: ParseOptions { dialect },
+                },
+                ..settings.clone()
+            };
+            let record = Record::default();
+            let parsed = format::read_text(
+                Path::new("big.ray"),
+                text.clone(),
+                Path::new("."),
+                &settings.read,
+                &record,
+            );
+            assert!(parsed.is_ok(), "{dialect:?}");
+            let phases = record.0.into_inner().unwrap();
+            let total = text.len() as u64;
+            assert_eq!(phases, [("parse".to_string(), total, total, true)], "{dialect:?}");
+        }
+    }
+
+    #[test]
+    fn errors_of_either_half_name_the_file() {
+        let settings = LoadSettings::default();
+        let bad_syntax = format::read_text(
+            Path::new("a.ray"),
+            "SBT-raytracer 1.0\nsphere {".into(),
+            Path::new("."),
+            &settings.read,
+            &NoProgress,
+        );
+        assert!(matches!(bad_syntax, Err(Error::Scene { path, .. }) if path == Path::new("a.ray")));
+        // Textures are read while building.
+        let no_texture = "SBT-raytracer 1.0\nsphere { material = { diffuse = map(\"missing.png\"); } }\n";
+        let parsed = format::read_text(
+            Path::new("b.ray"),
+            no_texture.into(),
+            Path::new("."),
+            &settings.read,
+            &NoProgress,
+        )
+        .unwrap();
+        let built = build_source(parsed, &settings.build, &NoProgress);
+        assert!(
+            matches!(built, Err(Error::Scene { path, text, .. }) if path == Path::new("b.ray") && text == no_texture)
+        );
+    }
+}
