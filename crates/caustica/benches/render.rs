@@ -32,7 +32,7 @@ fn render_once(scene: &Scene, aa: u32, control: Control) -> f32 {
         ..PhotonSettings::default()
     };
     let map = PhotonMap::trace(scene, &photons, estimate.k, control);
-    let (width, height) = image_size(&scene.camera, WIDTH, None);
+    let (width, height) = image_size(scene.camera(), WIDTH, None);
     let image = ImageSettings {
         width,
         height,

@@ -2,11 +2,12 @@
 //! parallel; each pixel draws from its own random stream (seed, pixel index), so the picture does
 //! not depend on the thread count.
 
+pub mod direct;
 pub mod gi;
 pub mod path;
-pub mod physical;
 pub mod ppm;
 pub mod progressive;
+pub mod specular_chain;
 pub mod whitted;
 
 use crate::camera::Camera;

@@ -8,7 +8,6 @@
 #![warn(missing_docs)]
 
 pub mod accel;
-pub mod area_light;
 pub mod bsdf;
 pub mod camera;
 pub mod description;

@@ -1,11 +1,29 @@
-//! Lights of the `.ray` format: point lights with the course's attenuation, directional lights.
+//! Lights, each with both of its readings: the course's (§5: a colour with the course's distance
+//! falloff, summed by the Whitted shading) and the physical one (radiometric units, sampled for
+//! next-event estimation and for photon emission). Units and conventions: docs/radiometry.md.
+//!
+//! In the physical model a point light's colour is its intensity I (W/sr) and it falls off with
+//! the inverse square (the file's attenuation coefficients are ignored); a directional light's
+//! colour is the irradiance E (W/m²) on a surface facing it; an emissive object emits radiance
+//! ke (W/m²/sr) from both faces. In the course model emissive objects are not light sources:
+//! their `emissive` term only colours themselves.
+//!
+//! Photon emission is in [`emission`]; emissive objects are sampled by [`area`].
 
-use crate::math::Vec3;
+pub mod area;
+pub mod emission;
+
+pub use area::AreaLight;
+
+use crate::math::{luminance, offset_origin, Ray, Vec3};
+use crate::sampling::Rng;
+use crate::scene::{ObjectRef, Scene, SurfaceHit};
+use std::f32::consts::PI;
 
 /// The closed set of lights.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Light {
-    /// A point light with attenuation f(d) = min(1, 1 / (a + b d + c d²)) (§5).
+    /// A point light with the course's attenuation f(d) = min(1, 1 / (a + b d + c d²)) (§5).
     Point {
         /// World position.
         position: Vec3,
@@ -21,10 +39,12 @@ pub enum Light {
         /// Colour (irradiance on a surface facing the light).
         color: Vec3,
     },
+    /// An emissive object (physical model only).
+    Area(AreaLight),
 }
 
-/// What a light sends to a point: the unit direction towards the light, the distance to it
-/// (infinite for a directional light) and the incident colour before shadowing.
+/// What a light sends to a point under the course model: the unit direction towards the light,
+/// the distance to it (infinite for a directional light) and the incident colour before shadowing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightSample {
     /// Unit direction from the point towards the light.
@@ -36,7 +56,8 @@ pub struct LightSample {
 }
 
 impl Light {
-    /// Illumination of point `p`.
+    /// The course reading: illumination of point `p`; `None` for lights the course model does
+    /// not shade with (emissive objects) and at the light itself.
     pub fn sample_li(&self, p: Vec3) -> Option<LightSample> {
         match *self {
             Light::Point {
@@ -60,13 +81,30 @@ impl Light {
                 distance: f32::INFINITY,
                 intensity: color,
             }),
+            Light::Area(_) => None,
         }
     }
 
-    /// The light's colour.
+    /// Whether the course model shades with this light (point and directional lights).
+    pub fn is_course_light(&self) -> bool {
+        !matches!(self, Light::Area(_))
+    }
+
+    /// The light's colour: intensity, irradiance, or an emissive object's radiance.
     pub fn color(&self) -> Vec3 {
         match self {
             Light::Point { color, .. } | Light::Directional { color, .. } => *color,
+            Light::Area(area) => area.radiance,
+        }
+    }
+
+    /// Emitted power (luminance) under the physical model; a directional light's is the power
+    /// through the disc of radius `scene_radius` across its beam.
+    pub fn power(&self, scene_radius: f32) -> f32 {
+        match self {
+            Light::Point { color, .. } => 4.0 * PI * luminance(*color).max(0.0),
+            Light::Directional { color, .. } => PI * scene_radius * scene_radius * luminance(*color).max(0.0),
+            Light::Area(area) => area.power(),
         }
     }
 }
@@ -80,6 +118,205 @@ pub fn distance_attenuation(abc: [f32; 3], d: f32) -> f32 {
     } else {
         (1.0 / denom).min(1.0)
     }
+}
+
+/// A light sample for a shading point under the physical model.
+#[derive(Clone, Copy, Debug)]
+pub struct DirectSample {
+    /// Unit direction towards the light.
+    pub wi: Vec3,
+    /// Incident radiance (area lights) or irradiance (point, directional) divided by the
+    /// probability of the sample: multiplied by f·cos it is the estimate.
+    pub contribution: Vec3,
+    /// Solid-angle pdf including the choice of light, for MIS; 0 for delta lights.
+    pub pdf: f32,
+}
+
+/// Every light of a scene: the file's lights in file order, then its emissive objects. Under
+/// the physical model lights are chosen in proportion to their power.
+#[derive(Clone, Debug, Default)]
+pub struct LightSet {
+    lights: Vec<Light>,
+    /// Probability of choosing each light.
+    probabilities: Vec<f32>,
+    cdf: Vec<f32>,
+    /// Light number of each shape and mesh (`u32::MAX` when it does not emit).
+    shape_light: Vec<u32>,
+    mesh_light: Vec<u32>,
+    /// The sphere around the scene, across which directional light enters.
+    scene_center: Vec3,
+    scene_radius: f32,
+}
+
+impl LightSet {
+    /// The file's `lights` followed by the emissive objects of `scene`.
+    pub fn new(scene: &Scene, mut lights: Vec<Light>) -> LightSet {
+        let bounds = scene.bounds();
+        let scene_center = bounds.center();
+        let scene_radius = (0.5 * bounds.extent().length()).max(1e-3);
+        let file_lights = lights.len();
+        lights.extend(AreaLight::collect(scene).into_iter().map(Light::Area));
+        let powers: Vec<f32> = lights.iter().map(|l| l.power(scene_radius)).collect();
+        let total: f32 = powers.iter().sum();
+        let probabilities: Vec<f32> = if total > 0.0 && total.is_finite() {
+            powers.iter().map(|p| p / total).collect()
+        } else {
+            vec![0.0; powers.len()]
+        };
+        let mut acc = 0.0;
+        let cdf = probabilities
+            .iter()
+            .map(|p| {
+                acc += p;
+                acc
+            })
+            .collect();
+        let mut shape_light = vec![u32::MAX; scene.shapes().len()];
+        let mut mesh_light = vec![u32::MAX; scene.meshes().len()];
+        for (number, light) in lights.iter().enumerate().skip(file_lights) {
+            if let Light::Area(area) = light {
+                match area.object {
+                    ObjectRef::Shape(s) => shape_light[s as usize] = number as u32,
+                    ObjectRef::Mesh(m) => mesh_light[m as usize] = number as u32,
+                }
+            }
+        }
+        LightSet {
+            lights,
+            probabilities,
+            cdf,
+            shape_light,
+            mesh_light,
+            scene_center,
+            scene_radius,
+        }
+    }
+
+    /// All lights: the file's, then the emissive objects.
+    pub fn iter(&self) -> std::slice::Iter<'_, Light> {
+        self.lights.iter()
+    }
+
+    /// Number of lights.
+    pub fn len(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// Light `index`.
+    pub fn get(&self, index: usize) -> Option<&Light> {
+        self.lights.get(index)
+    }
+
+    /// The lights the course model shades with and emits caustic photons from: the file's
+    /// point and directional lights, in file order.
+    pub fn course_lights(&self) -> impl Iterator<Item = &Light> {
+        self.lights.iter().filter(|l| l.is_course_light())
+    }
+
+    /// The emissive objects.
+    pub fn area_lights(&self) -> impl Iterator<Item = &AreaLight> {
+        self.lights.iter().filter_map(|l| match l {
+            Light::Area(area) => Some(area),
+            _ => None,
+        })
+    }
+
+    /// Whether nothing emits light under the physical model.
+    pub fn is_empty(&self) -> bool {
+        self.probabilities.iter().all(|&p| p == 0.0)
+    }
+
+    /// Centre and radius of the sphere around the scene.
+    pub fn scene_sphere(&self) -> (Vec3, f32) {
+        (self.scene_center, self.scene_radius)
+    }
+
+    fn pick(&self, u: f32) -> Option<(usize, f32)> {
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.cdf.len().checked_sub(1)?);
+        let p = self.probabilities[i];
+        (p > 0.0).then_some((i, p))
+    }
+
+    /// Samples one light for the point `hit` (visibility included): `None` when the light
+    /// chosen sends nothing there.
+    pub fn sample_direct(&self, scene: &Scene, hit: &SurfaceHit, rng: &mut Rng) -> Option<DirectSample> {
+        let (index, p_pick) = self.pick(rng.uniform())?;
+        let (u_pick, u) = (rng.uniform(), rng.uniform2());
+        let p = hit.point;
+        let ng = hit.geometric_normal;
+        let (wi, distance, value) = match &self.lights[index] {
+            Light::Point { position, color, .. } => {
+                let to = *position - p;
+                let d2 = to.length_squared();
+                if !(d2 > 0.0 && d2.is_finite()) {
+                    return None;
+                }
+                let d = d2.sqrt();
+                (to / d, d, *color / d2)
+            }
+            Light::Directional { direction, color } => (-*direction, f32::INFINITY, *color),
+            Light::Area(light) => return sample_area_direct(scene, light, p, ng, p_pick, u_pick, u),
+        };
+        if !scene.unoccluded(p, ng, wi, distance) {
+            return None;
+        }
+        Some(DirectSample {
+            wi,
+            contribution: value / p_pick,
+            pdf: 0.0,
+        })
+    }
+
+    /// Solid-angle pdf with which [`LightSet::sample_direct`] from `from` would pick the
+    /// emissive point `hit`; 0 when the object hit is not a light.
+    pub fn pdf_direct(&self, from: Vec3, hit: &SurfaceHit) -> f32 {
+        let number = match hit.object {
+            ObjectRef::Shape(s) => self.shape_light[s as usize],
+            ObjectRef::Mesh(m) => self.mesh_light[m as usize],
+        };
+        let Some(Light::Area(light)) = self.lights.get(number as usize) else {
+            return 0.0;
+        };
+        self.probabilities[number as usize] * light.pdf_towards(from, hit.point, hit.geometric_normal)
+    }
+}
+
+/// A point on an emissive object for lighting `p`, visibility included.
+fn sample_area_direct(
+    scene: &Scene,
+    light: &AreaLight,
+    p: Vec3,
+    ng: Vec3,
+    p_pick: f32,
+    u_pick: f32,
+    u: glam::Vec2,
+) -> Option<DirectSample> {
+    let drawn = light.sample_towards(scene, p, u_pick, u)?;
+    let sample = drawn.point;
+    let to = sample.point - p;
+    let d = to.length();
+    if d.is_nan() || d <= 0.0 {
+        return None;
+    }
+    let wi = to / d;
+    // The closest hit towards the sampled point must be that point: this tests visibility
+    // and reads the emitted radiance there (textures included).
+    let origin = offset_origin(p, ng, wi);
+    let ray = Ray::new(origin, wi);
+    let isect = scene.intersect(&ray, f32::INFINITY)?;
+    if isect.prim != sample.prim || (isect.t - (sample.point - origin).length()).abs() > 1e-3 * (1.0 + d) {
+        return None;
+    }
+    let le = scene.emission(&scene.surface(&ray, &isect));
+    let pdf = p_pick * drawn.pdf_solid;
+    Some(DirectSample {
+        wi,
+        contribution: le / pdf,
+        pdf,
+    })
 }
 
 #[cfg(test)]

@@ -78,7 +78,7 @@ polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1
         .unwrap();
         let scene = build_source(parsed, &settings.build, &record).unwrap();
         // The collinear face is dropped by the parser; placing and the BVH count 2 units each.
-        assert_eq!(scene.triangles.len(), 1);
+        assert_eq!(scene.triangles().len(), 1);
         let phases = record.0.into_inner().unwrap();
         let bytes = SCENE.len() as u64;
         assert_eq!(

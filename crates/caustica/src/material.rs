@@ -159,5 +159,17 @@ impl SurfaceParams {
     }
 }
 
+/// §9's refraction convention: entering, η = 1/index with the outward normal; leaving,
+/// η = index with the inward normal. Returns (η, normal facing the incoming ray).
+#[inline]
+pub fn refraction_geometry(index: f32, entering: bool, outward_normal: Vec3) -> (f32, Vec3) {
+    let index = if index > 0.0 { index } else { 1.0 };
+    if entering {
+        (1.0 / index, outward_normal)
+    } else {
+        (index, -outward_normal)
+    }
+}
+
 /// The smallest cosine divided by, so that grazing light does not blow the specular lobe up.
 const MIN_COSINE: f32 = 1e-2;

@@ -1,15 +1,13 @@
-//! Photons: emission from lights, specular paths, the photon map and the radiance estimate
-//! (Jensen, "Rendering Caustics on Non-Lambertian Surfaces", GI 1996).
+//! Photons: their paths from the lights ([`trace`]), the photon map and its radiance estimates
+//! ([`map`]; Jensen, "Rendering Caustics on Non-Lambertian Surfaces", GI 1996), and pictures of
+//! them. Photons leave the lights by [`crate::light::emission`].
 //!
 //! A photon is stored compactly in 24 bytes: position (3 × f32), power in Ward's shared-exponent
 //! RGBE (4 bytes, as in Jensen's own photon map), the incoming direction in 32-bit octahedral
 //! form, the receiver's normal in 16-bit octahedral form, and path flags.
 
-pub mod emit;
-pub mod estimate;
 pub mod kd_tree;
 pub mod map;
-pub mod physical;
 pub mod picture;
 pub mod trace;
 
@@ -46,6 +44,20 @@ pub(crate) fn typical_knn_distance<T: kd_tree::KdPoint>(tree: &kd_tree::KdTree, 
 pub const REFLECTED: u8 = 1;
 /// The path reached the surface by at least one refraction.
 pub const REFRACTED: u8 = 2;
+/// The path met a smooth (diffuse or glossy) surface before landing (physical model).
+pub const DIFFUSE: u8 = 4;
+
+/// Whether a photon arrived straight from its light.
+#[inline]
+pub fn is_direct(photon: &Photon) -> bool {
+    photon.flags == 0
+}
+
+/// Whether a photon's path was specular only: light, then mirrors and glass (L S+ D).
+#[inline]
+pub fn is_caustic(photon: &Photon) -> bool {
+    photon.flags != 0 && photon.flags & DIFFUSE == 0
+}
 
 /// A stored photon.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -9,7 +9,7 @@ use crate::accel::bvh::{Bvh, TriangleBvh, TriangleBvhHit};
 use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::Shape;
-use crate::light::Light;
+use crate::light::{Light, LightSet};
 use crate::material::{Material, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use crate::progress::Progress;
@@ -82,34 +82,42 @@ impl Occluders {
     }
 }
 
-/// A scene ready to render.
+/// A scene ready to render. Its parts are read through methods: primitives are numbered
+/// shapes first, then triangles, and only the scene relies on that numbering.
 pub struct Scene {
-    /// The camera.
-    pub camera: Camera,
-    /// Lights.
-    pub lights: Vec<Light>,
-    /// Summed ambient light Ia.
-    pub ambient: Vec3,
-    /// Materials, indexed by id.
-    pub materials: Vec<Material>,
-    /// Textures, indexed by id.
-    pub textures: Vec<Texture>,
-    /// Analytic shapes.
-    pub shapes: Vec<Shape>,
+    camera: Camera,
+    lights: LightSet,
+    ambient: Vec3,
+    materials: Vec<Material>,
+    textures: Vec<Texture>,
+    shapes: Vec<Shape>,
     /// Material id of each shape.
-    pub shape_materials: Vec<u32>,
-    /// Meshes.
-    pub meshes: Vec<Mesh>,
+    shape_materials: Vec<u32>,
+    meshes: Vec<Mesh>,
     /// All triangles of all meshes, in world space.
-    pub triangles: Vec<Triangle>,
+    triangles: Vec<Triangle>,
     /// The mesh and index of each triangle.
-    pub triangle_refs: Vec<TriangleRef>,
-    /// Remarks made while reading and building (dropped triangles, ignored keys, …).
-    pub warnings: Vec<String>,
+    triangle_refs: Vec<TriangleRef>,
+    warnings: Vec<String>,
     /// Hierarchy over the analytic shapes (primitive ids `0..shapes.len()`).
     shape_bvh: Bvh,
     /// Hierarchy over the triangles, tested four at a time (primitive id `shapes.len() + i`).
     triangle_bvh: TriangleBvh,
+}
+
+/// What a scene is assembled from (the builder's output).
+pub(crate) struct SceneParts {
+    pub camera: Camera,
+    pub lights: Vec<Light>,
+    pub ambient: Vec3,
+    pub materials: Vec<Material>,
+    pub textures: Vec<Texture>,
+    pub shapes: Vec<Shape>,
+    pub shape_materials: Vec<u32>,
+    pub meshes: Vec<Mesh>,
+    pub triangles: Vec<Triangle>,
+    pub triangle_refs: Vec<TriangleRef>,
+    pub warnings: Vec<String>,
 }
 
 /// The minimal record of a closest hit: enough to build a [`SurfaceHit`] when needed.
@@ -146,31 +154,30 @@ pub struct SurfaceHit {
 }
 
 impl Scene {
-    /// Assembles a scene and builds its BVH.
-    #[allow(clippy::too_many_arguments)]
-    pub(crate) fn assemble(
-        camera: Camera,
-        lights: Vec<Light>,
-        ambient: Vec3,
-        materials: Vec<Material>,
-        textures: Vec<Texture>,
-        mut shapes: Vec<Shape>,
-        shape_materials: Vec<u32>,
-        meshes: Vec<Mesh>,
-        triangles: Vec<Triangle>,
-        triangle_refs: Vec<TriangleRef>,
-        warnings: Vec<String>,
-        progress: &dyn Progress,
-    ) -> Scene {
+    /// Assembles a scene: builds its hierarchies, then finds its emissive objects.
+    pub(crate) fn assemble(parts: SceneParts, progress: &dyn Progress) -> Scene {
+        let SceneParts {
+            camera,
+            lights,
+            ambient,
+            materials,
+            textures,
+            mut shapes,
+            shape_materials,
+            meshes,
+            triangles,
+            triangle_refs,
+            warnings,
+        } = parts;
         for (shape, &material) in shapes.iter_mut().zip(&shape_materials) {
             shape.needs_uv = materials[material as usize].is_textured();
         }
         let shape_bounds: Vec<Aabb> = shapes.iter().map(|s| s.bounds).collect();
         let shape_bvh = Bvh::build_reporting(&shape_bounds, progress);
         let triangle_bvh = TriangleBvh::build_reporting(&triangles, progress);
-        Scene {
+        let mut scene = Scene {
             camera,
-            lights,
+            lights: LightSet::default(),
             ambient,
             materials,
             textures,
@@ -182,7 +189,92 @@ impl Scene {
             warnings,
             shape_bvh,
             triangle_bvh,
-        }
+        };
+        scene.lights = LightSet::new(&scene, lights);
+        scene
+    }
+
+    /// The camera.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Every light: the file's, then the emissive objects.
+    pub fn lights(&self) -> &LightSet {
+        &self.lights
+    }
+
+    /// Ambient light Ia of the course shading.
+    pub fn ambient(&self) -> Vec3 {
+        self.ambient
+    }
+
+    /// Materials, indexed by id.
+    pub fn materials(&self) -> &[Material] {
+        &self.materials
+    }
+
+    /// Textures, indexed by id.
+    pub fn textures(&self) -> &[Texture] {
+        &self.textures
+    }
+
+    /// Analytic shapes.
+    pub fn shapes(&self) -> &[Shape] {
+        &self.shapes
+    }
+
+    /// The material id of shape `i`.
+    pub fn shape_material(&self, i: usize) -> u32 {
+        self.shape_materials[i]
+    }
+
+    /// Meshes.
+    pub fn meshes(&self) -> &[Mesh] {
+        &self.meshes
+    }
+
+    /// All triangles of all meshes, in world space.
+    pub fn triangles(&self) -> &[Triangle] {
+        &self.triangles
+    }
+
+    /// The mesh and index of triangle `t`.
+    pub fn triangle_ref(&self, t: usize) -> TriangleRef {
+        self.triangle_refs[t]
+    }
+
+    /// The primitive number of shape `i`.
+    pub fn shape_prim(&self, i: usize) -> u32 {
+        i as u32
+    }
+
+    /// The primitive number of triangle `t`.
+    pub fn triangle_prim(&self, t: usize) -> u32 {
+        (self.shapes.len() + t) as u32
+    }
+
+    /// Remarks made while reading and building (dropped triangles, ignored keys, …).
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// The emitted radiance (course: `emissive`) at a surface point.
+    pub fn emission(&self, hit: &SurfaceHit) -> Vec3 {
+        hit.params.emissive
+    }
+
+    /// Whether nothing blocks the segment from a surface point towards `wi` for `distance`.
+    /// Every surface blocks, glass included (the physical model's light through glass arrives
+    /// as caustics).
+    pub fn unoccluded(&self, point: Vec3, geometric_normal: Vec3, wi: Vec3, distance: f32) -> bool {
+        let origin = crate::math::offset_origin(point, geometric_normal, wi);
+        let t_max = if distance.is_finite() {
+            (distance - (origin - point).length()) * (1.0 - 1e-5)
+        } else {
+            f32::INFINITY
+        };
+        !self.any_hit(&Ray::new(origin, wi), t_max, |_| true)
     }
 
     /// World bounds of everything.
@@ -479,7 +571,7 @@ mod tests {
                         faces = ((0,1,2), (0,2,3), (0,1,4), (1,2,4), (2,3,4), (3,0,4), (5,4,0), (5,5,1));
                         material = { diffuse = (1,1,1); } }",
         );
-        assert!(!scene.shapes.is_empty() && scene.triangles.len() >= 7);
+        assert!(!scene.shapes().is_empty() && scene.triangles().len() >= 7);
         let mut state = 0x2545_f491_4f6c_dd1du64;
         let mut f = move || {
             state ^= state << 13;
@@ -541,7 +633,7 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
         let scene = scene.unwrap();
         assert_eq!(
-            scene.shapes.iter().map(|s| s.needs_uv).collect::<Vec<_>>(),
+            scene.shapes().iter().map(|s| s.needs_uv).collect::<Vec<_>>(),
             [true, false, true, false]
         );
         // Rays along −y meet each shape at its +y side: a quarter turn around z, so u = 0.25

@@ -129,7 +129,7 @@ scale(30, square { material = { diffuse = (0.7, 0.7, 0.7); } })
 
 fn direct_light_at(scene: &caustica::scene::Scene, p: Vec3) -> f32 {
     scene
-        .lights
+        .lights()
         .iter()
         .map(|l| {
             let s = l.sample_li(p).unwrap();

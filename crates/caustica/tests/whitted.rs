@@ -79,7 +79,7 @@ fn pixels_match_the_phong_formula_with_filtered_shadows() {
         for x in 0..w {
             let sx = (x as f32 + 0.5) / w as f32;
             let sy = 1.0 - (y as f32 + 0.5) / h as f32;
-            let ray = scene.camera.generate_ray(sx, sy);
+            let ray = scene.camera().generate_ray(sx, sy);
             // Skip pixels that see the glass sphere itself.
             let oc = ray.origin - SPHERE_CENTER;
             let b = oc.dot(ray.dir);

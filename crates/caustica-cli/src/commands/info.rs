@@ -15,7 +15,7 @@ pub fn run(args: InfoArgs) -> Result<u8> {
     let loaded = load_scene(Some(&args.scene), &args.scene_args, &Bars::new(false))?;
     let scene = &loaded.scene;
     let bounds = scene.bounds();
-    let cam = &scene.camera;
+    let cam = scene.camera();
     if args.json {
         println!("{}", info_json(&args, &loaded));
         return Ok(0);
@@ -28,8 +28,8 @@ pub fn run(args: InfoArgs) -> Result<u8> {
         cam.aspect_ratio
     );
     println!("           u {:?}  v {:?}", cam.u.to_array(), cam.v.to_array());
-    println!("lights     {}", scene.lights.len());
-    for light in &scene.lights {
+    println!("lights     {}", scene.lights().course_lights().count());
+    for light in scene.lights().course_lights() {
         match light {
             Light::Point {
                 position,
@@ -50,15 +50,16 @@ pub fn run(args: InfoArgs) -> Result<u8> {
                     color.to_array()
                 )
             }
+            Light::Area(_) => {}
         }
     }
-    let area_lights = caustica::area_light::AreaLight::collect(scene);
+    let area_lights: Vec<_> = scene.lights().area_lights().collect();
     if !area_lights.is_empty() {
         println!(
             "area lights {} (emissive objects; lights in the physical model)",
             area_lights.len()
         );
-        for light in &area_lights {
+        for light in area_lights {
             println!(
                 "  {:?}  area {:.4}  radiance {:?}{}",
                 light.object,
@@ -68,17 +69,17 @@ pub fn run(args: InfoArgs) -> Result<u8> {
             );
         }
     }
-    println!("ambient    {:?}", scene.ambient.to_array());
+    println!("ambient    {:?}", scene.ambient().to_array());
     println!(
         "objects    {} shapes, {} meshes ({} triangles)",
-        scene.shapes.len(),
-        scene.meshes.len(),
-        scene.triangles.len()
+        scene.shapes().len(),
+        scene.meshes().len(),
+        scene.triangles().len()
     );
     for (object, b) in scene.objects() {
         let kind = match object {
-            ObjectRef::Shape(i) => format!("{:?}", scene.shapes[i as usize].kind),
-            ObjectRef::Mesh(i) => format!("mesh of {} triangles", scene.meshes[i as usize].indices.len()),
+            ObjectRef::Shape(i) => format!("{:?}", scene.shapes()[i as usize].kind),
+            ObjectRef::Mesh(i) => format!("mesh of {} triangles", scene.meshes()[i as usize].indices.len()),
         };
         let kind: String = kind.chars().take(60).collect();
         println!(
@@ -91,10 +92,10 @@ pub fn run(args: InfoArgs) -> Result<u8> {
     println!("bounds     {:?} .. {:?}", bounds.min.to_array(), bounds.max.to_array());
     println!(
         "materials  {}   textures {}",
-        scene.materials.len(),
-        scene.textures.len()
+        scene.materials().len(),
+        scene.textures().len()
     );
-    for (i, m) in scene.materials.iter().enumerate() {
+    for (i, m) in scene.materials().iter().enumerate() {
         println!(
             "  {i:>3}  kd {}  ks {}  kr {}  kt {}  ke {}  ka {}  ns {}  index {}",
             channel(&m.diffuse),
@@ -107,7 +108,7 @@ pub fn run(args: InfoArgs) -> Result<u8> {
             channel(&m.index)
         );
     }
-    for warning in &scene.warnings {
+    for warning in scene.warnings() {
         println!("warning    {warning}");
     }
     Ok(0)
@@ -124,7 +125,7 @@ fn channel(c: &Channel) -> String {
 /// Everything the text output shows, as one JSON object.
 fn info_json(args: &InfoArgs, loaded: &Loaded) -> String {
     let scene = &loaded.scene;
-    let cam = &scene.camera;
+    let cam = scene.camera();
     let bounds = scene.bounds();
     let mut s = String::new();
     let _ = write!(
@@ -137,17 +138,17 @@ fn info_json(args: &InfoArgs, loaded: &Loaded) -> String {
         json::numbers(&cam.v.to_array()),
         json::number(f64::from(cam.aspect_ratio))
     );
-    let lights: Vec<String> = scene.lights.iter().map(light_json).collect();
+    let lights: Vec<String> = scene.lights().course_lights().filter_map(light_json).collect();
     let objects: Vec<String> = scene
         .objects()
         .map(|(object, b)| {
             let kind = match object {
-                ObjectRef::Shape(i) => format!("{:?}", scene.shapes[i as usize].kind),
+                ObjectRef::Shape(i) => format!("{:?}", scene.shapes()[i as usize].kind),
                 ObjectRef::Mesh(_) => "mesh".to_string(),
             };
             let triangles = match object {
                 ObjectRef::Shape(_) => String::new(),
-                ObjectRef::Mesh(i) => format!(",\"triangles\":{}", scene.meshes[i as usize].indices.len()),
+                ObjectRef::Mesh(i) => format!(",\"triangles\":{}", scene.meshes()[i as usize].indices.len()),
             };
             format!(
                 "{{\"kind\":{}{triangles},\"material\":{},\"bounds\":{}}}",
@@ -158,7 +159,7 @@ fn info_json(args: &InfoArgs, loaded: &Loaded) -> String {
         })
         .collect();
     let materials: Vec<String> = scene
-        .materials
+        .materials()
         .iter()
         .map(|m| {
             format!(
@@ -178,16 +179,16 @@ fn info_json(args: &InfoArgs, loaded: &Loaded) -> String {
         s,
         "\"lights\":[{}],\"area_lights\":{},\"ambient\":{},\"shapes\":{},\"meshes\":{},\"triangles\":{},\"objects\":[{}],\"materials\":[{}],\"textures\":{},\"bounds\":{},\"warnings\":{},\"seconds\":{{\"parse\":{:.4},\"build\":{:.4}}}}}",
         lights.join(","),
-        caustica::area_light::AreaLight::collect(scene).len(),
-        json::numbers(&scene.ambient.to_array()),
-        scene.shapes.len(),
-        scene.meshes.len(),
-        scene.triangles.len(),
+        scene.lights().area_lights().count(),
+        json::numbers(&scene.ambient().to_array()),
+        scene.shapes().len(),
+        scene.meshes().len(),
+        scene.triangles().len(),
         objects.join(","),
         materials.join(","),
-        scene.textures.len(),
+        scene.textures().len(),
         bounds_json(bounds.min.to_array(), bounds.max.to_array()),
-        json::strings(&scene.warnings),
+        json::strings(scene.warnings()),
         loaded.parse_seconds,
         loaded.build_seconds
     );
@@ -206,8 +207,8 @@ fn channel_json(c: &Channel) -> String {
     }
 }
 
-fn light_json(light: &Light) -> String {
-    match light {
+fn light_json(light: &Light) -> Option<String> {
+    Some(match light {
         Light::Point {
             position,
             color,
@@ -223,5 +224,6 @@ fn light_json(light: &Light) -> String {
             json::numbers(&direction.to_array()),
             json::numbers(&color.to_array())
         ),
-    }
+        Light::Area(_) => return None,
+    })
 }

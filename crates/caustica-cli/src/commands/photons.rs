@@ -23,11 +23,11 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let loaded = load_scene(Some(&args.scene), &args.scene_args, &bars)?;
     let scene = loaded.scene;
     if !args.quiet {
-        for warning in &scene.warnings {
+        for warning in scene.warnings() {
             eprintln!("warning: {warning}");
         }
     }
-    let (width, height) = image_size(&scene.camera, args.width, args.height);
+    let (width, height) = image_size(scene.camera(), args.width, args.height);
     check_image_size(width, height)?;
     let control = Control {
         progress: &bars,

@@ -158,7 +158,7 @@ pub fn run(args: RenderArgs, integrator: Integrator, cancel: &'static AtomicBool
     let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
     let (scene, parse_seconds, build_seconds) = (loaded.scene, loaded.parse_seconds, loaded.build_seconds);
     if !quiet {
-        for warning in &scene.warnings {
+        for warning in scene.warnings() {
             eprintln!("warning: {warning}");
         }
         for note in physical_notes(&scene) {
@@ -172,7 +172,7 @@ pub fn run(args: RenderArgs, integrator: Integrator, cancel: &'static AtomicBool
             );
         }
     }
-    let (width, height) = image_size(&scene.camera, args.width, args.height);
+    let (width, height) = image_size(scene.camera(), args.width, args.height);
     check_image_size(width, height)?;
     let depth = args.depth.unwrap_or(64);
     let scene_id = match &args.scene {
@@ -369,7 +369,7 @@ fn ignored_options(args: &RenderArgs) -> Vec<&'static str> {
 fn physical_notes(scene: &caustica::scene::Scene) -> Vec<String> {
     let mut notes = Vec::new();
     let attenuated = scene
-        .lights
+        .lights()
         .iter()
         .filter(|l| matches!(l, Light::Point { attenuation, .. } if *attenuation != [0.0, 0.0, 1.0]))
         .count();
@@ -378,7 +378,7 @@ fn physical_notes(scene: &caustica::scene::Scene) -> Vec<String> {
             "the physical model ignores the attenuation coefficients of {attenuated} point light(s): light falls off with the inverse square"
         ));
     }
-    if scene.ambient != caustica::math::Vec3::ZERO {
+    if scene.ambient() != caustica::math::Vec3::ZERO {
         notes.push("the physical model ignores ambient light: indirect light is computed".into());
     }
     notes

@@ -55,11 +55,11 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
     let (scene, parse_seconds, build_seconds) = (loaded.scene, loaded.parse_seconds, loaded.build_seconds);
     if !args.quiet {
-        for warning in &scene.warnings {
+        for warning in scene.warnings() {
             eprintln!("warning: {warning}");
         }
     }
-    let (width, height) = image_size(&scene.camera, args.width, args.height);
+    let (width, height) = image_size(scene.camera(), args.width, args.height);
     check_image_size(width, height)?;
 
     let estimate = EstimateSettings {

@@ -15,13 +15,15 @@
 //! A gather ray that reaches a light, directly or by a specular chain, adds nothing: next-event
 //! estimation and the caustic map already count those paths.
 
-use super::physical::{camera_chain, direct_light, Lights};
+use super::direct::direct_light;
 use super::ppm::{pixel_angle, InitialRadius, PHOTON_SEED};
 use super::progressive::{radius_factor, sample_pass, Progressive};
+use super::specular_chain::camera_chain;
 use crate::bsdf::{Bsdf, Transport};
 use crate::math::{offset_origin, Ray, Vec3};
-use crate::photon::estimate::DensityMap;
-use crate::photon::physical::{is_caustic, trace};
+use crate::photon::is_caustic;
+use crate::photon::map::PhotonMap;
+use crate::photon::trace::trace_count;
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -61,9 +63,9 @@ impl Default for GiSettings {
 /// One pass's two maps and their largest gather radii.
 pub struct GiMaps {
     /// Every stored photon.
-    pub global: DensityMap,
+    pub global: PhotonMap,
     /// Photons that came by mirrors and glass only.
-    pub caustic: DensityMap,
+    pub caustic: PhotonMap,
     /// Twice the typical distance to the k-th nearest global photon.
     global_radius: f32,
     /// This pass's shrink factor of the gather radii.
@@ -73,7 +75,6 @@ pub struct GiMaps {
 /// The integrator over a whole image.
 pub struct Gi<'a> {
     scene: &'a Scene,
-    lights: Lights,
     settings: GiSettings,
     width: usize,
     height: usize,
@@ -86,20 +87,18 @@ impl<'a> Gi<'a> {
     pub fn new(scene: &'a Scene, settings: GiSettings, width: usize, height: usize, seed: u64) -> Gi<'a> {
         Gi {
             scene,
-            lights: Lights::new(scene),
             settings,
             width,
             height,
             seed,
-            pixel_angle: pixel_angle(&scene.camera, height),
+            pixel_angle: pixel_angle(scene.camera(), height),
         }
     }
 
     /// The maps of pass `pass`.
     pub fn maps(&self, pass: u64, control: Control) -> GiMaps {
-        let photons = trace(
+        let photons = trace_count(
             self.scene,
-            &self.lights,
             self.settings.photons_per_pass,
             self.seed ^ PHOTON_SEED,
             pass,
@@ -107,8 +106,8 @@ impl<'a> Gi<'a> {
             control,
         );
         let caustic: Vec<_> = photons.iter().copied().filter(is_caustic).collect();
-        let global = DensityMap::new(photons);
-        let caustic = DensityMap::new(caustic);
+        let global = PhotonMap::new(photons);
+        let caustic = PhotonMap::new(caustic);
         // Largest radii: past these a k-NN estimate reaches across the scene for nothing.
         let global_radius = global.typical_radius(self.settings.k_global) * 2.0;
         GiMaps {
@@ -129,7 +128,7 @@ impl<'a> Gi<'a> {
             rng,
             |hit, bsdf, wo, path_length, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                direct_light(self.scene, &self.lights, hit, bsdf, wo, false, rng)
+                direct_light(self.scene, hit, bsdf, wo, false, rng)
                     + maps.caustic.radiance_within(hit.point, bsdf, wo, r)
             },
             |hit, sample, path_length, rng| {
@@ -168,7 +167,7 @@ impl<'a> Gi<'a> {
                     return beta * maps.global.radiance_within(hit.point, &bsdf, wo, r);
                 }
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                let mut l = direct_light(scene, &self.lights, &hit, &bsdf, wo, false, rng);
+                let mut l = direct_light(scene, &hit, &bsdf, wo, false, rng);
                 l += maps.caustic.radiance_within(hit.point, &bsdf, wo, r);
                 if let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) {
                     let next = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
@@ -195,7 +194,7 @@ impl Progressive for Gi<'_> {
         if control.cancelled() {
             return None;
         }
-        let camera = &self.scene.camera;
+        let camera = self.scene.camera();
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             self.radiance(&maps, camera.generate_ray(sx, sy), rng)
         })

@@ -4,7 +4,7 @@
 //! It cannot see caustics of point or directional lights (a path can never hit a delta light
 //! after a mirror or through glass); that is what photon mapping is for.
 
-use super::physical::{direct_light, emitted, power_heuristic, Lights};
+use super::direct::{direct_light, emitted, power_heuristic};
 use crate::bsdf::{Bsdf, Transport};
 use crate::math::{offset_origin, Ray, Vec3};
 use crate::sampling::Rng;
@@ -33,7 +33,8 @@ impl Default for PathSettings {
 }
 
 /// Radiance arriving along `ray` (unit direction).
-pub fn radiance(scene: &Scene, lights: &Lights, settings: &PathSettings, ray: Ray, rng: &mut Rng) -> Vec3 {
+pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng) -> Vec3 {
+    let lights = scene.lights();
     let mut ray = ray;
     let mut l = Vec3::ZERO;
     let mut beta = Vec3::ONE;
@@ -47,7 +48,7 @@ pub fn radiance(scene: &Scene, lights: &Lights, settings: &PathSettings, ray: Ra
         };
         let hit = scene.surface(&ray, &isect);
         let wo = -ray.dir;
-        let le = emitted(&hit);
+        let le = emitted(scene, &hit);
         if le != Vec3::ZERO {
             let weight = if specular {
                 1.0
@@ -64,7 +65,7 @@ pub fn radiance(scene: &Scene, lights: &Lights, settings: &PathSettings, ray: Ra
             break;
         }
         if bsdf.is_smooth() {
-            l += beta * direct_light(scene, lights, &hit, &bsdf, wo, true, rng);
+            l += beta * direct_light(scene, &hit, &bsdf, wo, true, rng);
         }
         let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
             break;
@@ -95,7 +96,6 @@ pub fn radiance(scene: &Scene, lights: &Lights, settings: &PathSettings, ray: Ra
 /// The path tracer over a whole image, one sample per pixel per pass.
 pub struct PathTracer<'a> {
     scene: &'a Scene,
-    lights: Lights,
     settings: PathSettings,
     width: usize,
     height: usize,
@@ -107,7 +107,6 @@ impl<'a> PathTracer<'a> {
     pub fn new(scene: &'a Scene, settings: PathSettings, width: usize, height: usize, seed: u64) -> PathTracer<'a> {
         PathTracer {
             scene,
-            lights: Lights::new(scene),
             settings,
             width,
             height,
@@ -118,15 +117,9 @@ impl<'a> PathTracer<'a> {
 
 impl super::progressive::Progressive for PathTracer<'_> {
     fn render_pass(&self, pass: u64, control: crate::progress::Control) -> Option<Vec<Vec3>> {
-        let camera = &self.scene.camera;
+        let camera = self.scene.camera();
         super::progressive::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
-            radiance(
-                self.scene,
-                &self.lights,
-                &self.settings,
-                camera.generate_ray(sx, sy),
-                rng,
-            )
+            radiance(self.scene, &self.settings, camera.generate_ray(sx, sy), rng)
         })
     }
 }

@@ -9,11 +9,13 @@
 //! light comes from next-event estimation and everything else (caustics, indirect diffuse light)
 //! from the photons within the pass's radius.
 
-use super::physical::{camera_chain, direct_light, Lights};
+use super::direct::direct_light;
 use super::progressive::{radius_factor, sample_pass, Progressive};
+use super::specular_chain::camera_chain;
 use crate::math::{Ray, Vec3};
-use crate::photon::estimate::DensityMap;
-use crate::photon::physical::{is_direct, trace};
+use crate::photon::is_direct;
+use crate::photon::map::PhotonMap;
+use crate::photon::trace::trace_count;
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -78,7 +80,6 @@ pub(crate) const PHOTON_SEED: u64 = 0x70_686f_746f_6e73;
 /// The progressive photon mapper over a whole image.
 pub struct Ppm<'a> {
     scene: &'a Scene,
-    lights: Lights,
     settings: PpmSettings,
     width: usize,
     height: usize,
@@ -90,10 +91,9 @@ pub struct Ppm<'a> {
 impl<'a> Ppm<'a> {
     /// A renderer for `scene` at `width`×`height`.
     pub fn new(scene: &'a Scene, settings: PpmSettings, width: usize, height: usize, seed: u64) -> Ppm<'a> {
-        let pixel_angle = pixel_angle(&scene.camera, height);
+        let pixel_angle = pixel_angle(scene.camera(), height);
         Ppm {
             scene,
-            lights: Lights::new(scene),
             settings,
             width,
             height,
@@ -103,10 +103,9 @@ impl<'a> Ppm<'a> {
     }
 
     /// The photons of pass `pass` that the estimate uses (all but direct ones).
-    pub fn photon_map(&self, pass: u64, control: Control) -> DensityMap {
-        let mut photons = trace(
+    pub fn photon_map(&self, pass: u64, control: Control) -> PhotonMap {
+        let mut photons = trace_count(
             self.scene,
-            &self.lights,
             self.settings.photons_per_pass,
             self.seed ^ PHOTON_SEED,
             pass,
@@ -114,13 +113,13 @@ impl<'a> Ppm<'a> {
             control,
         );
         photons.retain(|p| !is_direct(p));
-        DensityMap::new(photons)
+        PhotonMap::new(photons)
     }
 
     /// Radiance along a camera ray with the photons of one pass: smooth lobes are counted in
     /// full at the first smooth surface (next-event estimation and photons), only specular ones
     /// continue the path.
-    fn radiance(&self, map: &DensityMap, ray: Ray, radius_factor: f32, rng: &mut Rng) -> Vec3 {
+    fn radiance(&self, map: &PhotonMap, ray: Ray, radius_factor: f32, rng: &mut Rng) -> Vec3 {
         camera_chain(
             self.scene,
             ray,
@@ -129,8 +128,7 @@ impl<'a> Ppm<'a> {
             rng,
             |hit, bsdf, wo, path_length, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
-                direct_light(self.scene, &self.lights, hit, bsdf, wo, false, rng)
-                    + map.radiance_within(hit.point, bsdf, wo, r)
+                direct_light(self.scene, hit, bsdf, wo, false, rng) + map.radiance_within(hit.point, bsdf, wo, r)
             },
             |_, _, _, _| Vec3::ZERO,
         )
@@ -144,7 +142,7 @@ impl Progressive for Ppm<'_> {
             return None;
         }
         let factor = radius_factor(pass, self.settings.alpha);
-        let camera = &self.scene.camera;
+        let camera = self.scene.camera();
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             self.radiance(&map, camera.generate_ray(sx, sy), factor, rng)
         })

@@ -2,7 +2,7 @@
 //! attenuation and shadows filtered by each occluder's `transmissive`, recursive mirror
 //! reflection and refraction (no Fresnel), plus an optional caustic term from the photon map.
 
-use crate::material::SurfaceParams;
+use crate::material::{refraction_geometry, SurfaceParams};
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
 use crate::scene::{Scene, SurfaceHit};
 
@@ -68,7 +68,7 @@ where
     };
     let inside_transmissive = !entering && p.transmissive != Vec3::ZERO;
 
-    let mut color = p.emissive + p.ambient * scene.ambient;
+    let mut color = p.emissive + p.ambient * scene.ambient();
     let shade_specular = settings.backface_specular || !inside_transmissive;
     let local = SurfaceParams {
         specular: if shade_specular { p.specular } else { Vec3::ZERO },
@@ -103,22 +103,10 @@ where
     color
 }
 
-/// §9's refraction convention: entering, η = 1/index with the outward normal; leaving,
-/// η = index with the inward normal. Returns (η, normal facing the incoming ray).
-#[inline]
-pub fn refraction_geometry(index: f32, entering: bool, outward_normal: Vec3) -> (f32, Vec3) {
-    let index = if index > 0.0 { index } else { 1.0 };
-    if entering {
-        (1.0 / index, outward_normal)
-    } else {
-        (index, -outward_normal)
-    }
-}
-
 /// Σ over lights of f(d)·S·I ⊙ [kd (N·L) + ks (V·R)^ns].
 fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3, wo: Vec3) -> Vec3 {
     let mut sum = Vec3::ZERO;
-    for light in &scene.lights {
+    for light in scene.lights().course_lights() {
         let Some(ls) = light.sample_li(hit.point) else { continue };
         let cos = n.dot(ls.wi);
         if cos <= 0.0 {
@@ -194,7 +182,7 @@ pub fn render(
     image: &super::ImageSettings,
     control: crate::progress::Control,
 ) -> (crate::film::Film, bool) {
-    let camera = &scene.camera;
+    let camera = scene.camera();
     let reuse = settings.reuse_caustic_estimates;
     super::render_tiles(image, control, "render", |sx, sy, _rng, pixel: &mut PixelCaustic| {
         let ray = camera.generate_ray(sx, sy);

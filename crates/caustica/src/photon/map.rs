@@ -1,14 +1,26 @@
-//! The photon map: photons in kd-tree order and Jensen's radiance estimate.
+//! The photon map: photons in kd-tree order, and the radiance estimates both shading models make
+//! from it:
 //!
-//! L(x, ωo) ≈ Σ_p f(x, ωo, ωp) Φp / (π r²) over the k nearest photons within r (Jensen 1996,
-//! eq. 6), with the reflectance evaluated for each photon's own incoming direction, an optional
-//! cone filter (eq. 7) and a disc-shaped gather: photons whose stored normal disagrees with the
-//! receiver's, or that lie off its tangent plane, do not count — light cannot bleed through a
-//! thin wall or round a corner.
+//! ```text
+//! L(x, ωo) ≈ Σ_p f(x, ωo, ωp) Φp / (π r²)
+//! ```
+//!
+//! (Jensen 1996, eq. 6), with the reflectance evaluated for each photon's own incoming direction
+//! and a disc-shaped gather: photons whose stored normal disagrees with the receiver's, or that
+//! lie off its tangent plane, do not count — light cannot bleed through a thin wall or round a
+//! corner.
+//!
+//! - The course model ([`PhotonMap::radiance`]): the k nearest photons within a largest radius,
+//!   an optional cone filter (eq. 7), the course's Phong reflectance, and photons that other
+//!   geometry hides from the point left out.
+//! - The physical model: the photons within a fixed radius (progressive photon mapping,
+//!   [`PhotonMap::radiance_within`]) or the k nearest (Jensen's global and caustic maps,
+//!   [`PhotonMap::radiance_nearest`]), with the BSDF the camera paths use.
 
 use super::kd_tree::{KdTree, Neighbor};
 use super::trace::{trace_photons, PhotonSettings, PhotonStats};
 use super::Photon;
+use crate::bsdf::Bsdf;
 use crate::material::SurfaceParams;
 use crate::math::Vec3;
 use crate::progress::Control;
@@ -37,11 +49,16 @@ impl Default for EstimateSettings {
             k: 100,
             max_radius: None,
             cone_filter: Some(1.1),
-            min_normal_cosine: 0.7,
-            max_plane_distance: 0.25,
+            min_normal_cosine: MIN_NORMAL_COSINE,
+            max_plane_distance: MAX_PLANE_DISTANCE,
         }
     }
 }
+
+/// Least cosine between a photon's stored normal and the receiver's normal.
+const MIN_NORMAL_COSINE: f32 = 0.7;
+/// Largest distance off the receiver's tangent plane, as a fraction of the gather radius.
+const MAX_PLANE_DISTANCE: f32 = 0.25;
 
 /// Stored photons and the tree over them.
 pub struct PhotonMap {
@@ -65,6 +82,17 @@ impl PhotonMap {
     pub fn trace(scene: &Scene, settings: &PhotonSettings, estimate_k: usize, control: Control) -> PhotonMap {
         let (photons, stats) = trace_photons(scene, settings, control);
         PhotonMap::from_photons(photons, stats, estimate_k)
+    }
+
+    /// Builds the map over `photons` (reordering them), without an automatic radius.
+    pub fn new(mut photons: Vec<Photon>) -> PhotonMap {
+        let tree = KdTree::build(&mut photons);
+        PhotonMap {
+            photons,
+            tree,
+            auto_radius: 0.0,
+            stats: PhotonStats::default(),
+        }
     }
 
     /// Builds the map over photons (reordering them); the automatic radius is chosen for `k`.
@@ -242,4 +270,61 @@ impl PhotonMap {
         };
         self.radiance(scene, &hit, n, n, settings)
     }
+
+    /// Reflected radiance at `point` towards `wo` from the photons within radius `r`.
+    pub fn radiance_within(&self, point: Vec3, bsdf: &Bsdf, wo: Vec3, r: f32) -> Vec3 {
+        if self.photons.is_empty() || r.is_nan() || r <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let n = bsdf.normal();
+        let mut sum = Vec3::ZERO;
+        self.tree.for_each_within(&self.photons, point, r * r, |slot, _| {
+            let photon = &self.photons[slot as usize];
+            if accepts(photon, point, n, r) {
+                sum += bsdf.eval(wo, -photon.direction()) * photon.power();
+            }
+        });
+        sum / (PI * r * r)
+    }
+
+    /// Reflected radiance at `point` towards `wo` from the `k` nearest photons within
+    /// `max_radius`, the radius being the distance to the k-th.
+    pub fn radiance_nearest(&self, point: Vec3, bsdf: &Bsdf, wo: Vec3, k: usize, max_radius: f32) -> Vec3 {
+        if self.photons.is_empty() || k == 0 || max_radius.is_nan() || max_radius <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let n = bsdf.normal();
+        NEIGHBORS.with(|cell| {
+            let mut neighbors = cell.borrow_mut();
+            let r2 = self
+                .tree
+                .k_nearest(&self.photons, point, k, max_radius * max_radius, &mut neighbors);
+            if neighbors.is_empty() || r2.is_nan() || r2 <= 0.0 {
+                return Vec3::ZERO;
+            }
+            let r = r2.sqrt();
+            let mut sum = Vec3::ZERO;
+            // The k-th photon only marks the radius: counting it too would bias the density by
+            // k / (k − 1) (the k-th nearest lies on the disc's rim, not inside it).
+            let skip = usize::from(neighbors.len() == k && k > 1);
+            for nb in neighbors.iter().skip(skip) {
+                let photon = &self.photons[nb.slot as usize];
+                if accepts(photon, point, n, r) {
+                    sum += bsdf.eval(wo, -photon.direction()) * photon.power();
+                }
+            }
+            sum / (PI * r2)
+        })
+    }
+
+    /// Twice the median distance to the k-th nearest photon around up to 256 photons spread
+    /// through the map: a gather radius that holds about k photons where they are typical.
+    pub fn typical_radius(&self, k: usize) -> f32 {
+        2.0 * super::typical_knn_distance(&self.tree, &self.photons, k)
+    }
+}
+
+#[inline]
+fn accepts(photon: &Photon, point: Vec3, n: Vec3, r: f32) -> bool {
+    (photon.position - point).dot(n).abs() <= MAX_PLANE_DISTANCE * r && photon.normal().dot(n) >= MIN_NORMAL_COSINE
 }

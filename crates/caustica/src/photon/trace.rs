@@ -1,21 +1,33 @@
-//! Photon paths: lights emit, photons follow mirrors (`reflective`) and glass (`transmissive`,
-//! `index`, total internal reflection), pick up the colour of what they meet, and are stored
-//! where they land on a diffuse or glossy surface after at least one specular bounce (L S+ D).
+//! Photon paths for both shading models, traced by one loop: a photon leaves a light, meets
+//! surfaces, and at each one its [`PhotonModel`] decides what is stored there and where the
+//! photon goes next.
 //!
-//! Russian roulette chooses reflection, refraction or absorption with probabilities from the
-//! surface's colours and divides the power by the probability taken, so the estimate stays
-//! unbiased. Photons from a point light are scaled by d²·f(d) for their path length d (the
-//! course's falloff f, §5), which is exactly 1 when f = 1/d²: caustics then fall off the same way
-//! as the course's direct light (docs/radiometry.md).
+//! - [`CourseModel`] (the course's caustics, Jensen 1996): photons follow mirrors
+//!   (`reflective`) and glass (`transmissive`, `index`, total internal reflection), pick up the
+//!   colour of what they meet, and are stored where they land on a diffuse or glossy surface
+//!   after at least one specular bounce (L S+ D). Russian roulette chooses reflection,
+//!   refraction or absorption with probabilities from the surface's colours and divides the
+//!   power by the probability taken. Photons from a point light are scaled by d²·f(d) for their
+//!   path length d (the course's falloff f, §5), which is exactly 1 when f = 1/d²: caustics then
+//!   fall off the same way as the course's direct light (docs/radiometry.md).
+//! - [`PhysicalModel`]: photons scatter by the same BSDF the camera paths use and are stored
+//!   wherever they meet a smooth (diffuse or glossy) surface, their history in their flags;
+//!   Russian roulette keeps each photon's flux nearly constant.
+//!
+//! Two drivers emit: [`trace_photons`] stores a budget of caustic photons per light (course),
+//! [`trace_count`] emits a fixed number from lights chosen by power (physical). Both are
+//! deterministic whatever the thread count: photon `i` draws from its own random stream and
+//! batches are concatenated in order.
 
-use super::emit::{Emitter, Target};
-use super::{Photon, REFLECTED, REFRACTED};
-use crate::integrator::whitted::refraction_geometry;
+use super::{Photon, DIFFUSE, REFLECTED, REFRACTED};
+use crate::bsdf::{Bsdf, Transport};
+use crate::light::emission::{caustic_targets, Emitter};
 use crate::light::{distance_attenuation, Light};
+use crate::material::refraction_geometry;
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::{ObjectRef, Scene};
+use crate::scene::{Scene, SurfaceHit};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -89,43 +101,17 @@ impl PhotonStats {
     }
 }
 
-/// The bounding spheres photons are aimed at: one per reflective or transmissive object. For a
-/// shape, the smaller of the sphere around its world bounds and its own bounding sphere: a
-/// rotated ring's world box is much larger than the ring, and every photon aimed past the ring
-/// is traced for nothing.
-pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
-    scene
-        .objects()
-        .filter(|(object, bounds)| scene.object_is_specular(*object) && !bounds.is_empty())
-        .map(|(object, bounds)| {
-            let around = Target::around(&bounds);
-            let ObjectRef::Shape(i) = object else {
-                return around;
-            };
-            let (center, radius) = scene.shapes[i as usize].bounding_sphere();
-            let own = Target {
-                center,
-                radius: radius * 1.001 + 1e-4,
-            };
-            if own.radius < around.radius && own.radius.is_finite() && center.is_finite() {
-                own
-            } else {
-                around
-            }
-        })
-        .collect()
-}
-
 const BATCH: u64 = 4096;
 
-/// Traces photons from every light until the budget is stored or the cap is reached.
+/// Traces caustic photons from every course light until the budget is stored or the cap is
+/// reached.
 pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control) -> (Vec<Photon>, PhotonStats) {
     let start = Instant::now();
     let targets = caustic_targets(scene);
     let aim = settings.aim && !settings.first_hit;
     let bounds = scene.bounds();
-    let emitters: Vec<Option<Emitter>> = scene
-        .lights
+    let lights: Vec<&Light> = scene.lights().course_lights().collect();
+    let emitters: Vec<Option<Emitter>> = lights
         .iter()
         .map(|light| {
             if !settings.first_hit && targets.is_empty() {
@@ -136,9 +122,7 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
         .collect();
     let total_power: f32 = emitters.iter().flatten().map(Emitter::power).sum();
     let shares: Vec<usize> = match &settings.per_light {
-        Some(counts) => (0..scene.lights.len())
-            .map(|i| counts.get(i).copied().unwrap_or(0))
-            .collect(),
+        Some(counts) => (0..lights.len()).map(|i| counts.get(i).copied().unwrap_or(0)).collect(),
         None => emitters
             .iter()
             .map(|e| match e {
@@ -160,16 +144,11 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
             continue;
         };
         let light_cap = ((cap as f64) * share as f64 / total_share as f64).ceil().max(1.0) as u64;
-        let run = trace_light(
-            scene,
-            &scene.lights[index],
-            emitter,
-            index,
-            share,
-            light_cap,
-            settings,
-            control,
-        );
+        let model = CourseModel {
+            light: lights[index],
+            first_hit: settings.first_hit,
+        };
+        let run = trace_light(scene, &model, emitter, index, share, light_cap, settings, control);
         stats.emitted += run.emitted;
         stats.stored += run.photons.len() as u64;
         stats.cap_reached |= run.cap_reached;
@@ -192,7 +171,7 @@ struct LightRun {
 #[allow(clippy::too_many_arguments)]
 fn trace_light(
     scene: &Scene,
-    light: &Light,
+    model: &CourseModel,
     emitter: &Emitter,
     light_index: usize,
     share: usize,
@@ -225,16 +204,13 @@ fn trace_light(
             .map(|b| {
                 let first = emitted + b * BATCH;
                 let count = BATCH.min(cap - first.min(cap));
-                let mut out = Vec::new();
-                let mut ends = Vec::with_capacity(count as usize);
-                for i in first..first + count {
+                trace_batch(first..first + count, |i, out| {
                     let mut rng = Rng::new(settings.seed, stream | i);
                     if let Some((ray, power)) = emitter.sample(&mut rng) {
-                        trace_path(scene, light, ray, power, light_index, settings, &mut rng, &mut out);
+                        let light = light_index.min(255) as u8;
+                        trace_path(scene, model, ray, power, light, settings.max_bounces, &mut rng, out);
                     }
-                    ends.push(out.len() as u32);
-                }
-                (out, ends)
+                })
             })
             .collect();
         for (batch, ends) in results {
@@ -267,26 +243,131 @@ fn trace_light(
     }
 }
 
-/// Follows one photon; pushes what it stores to `out`.
-#[allow(clippy::too_many_arguments)]
-pub fn trace_path(
+/// Emits `count` photons from lights chosen by power, under the physical model, from stream
+/// `stream` of `seed`, and returns those stored, their flux already divided by `count`.
+pub fn trace_count(
     scene: &Scene,
-    light: &Light,
+    count: u64,
+    seed: u64,
+    stream: u64,
+    max_bounces: u32,
+    control: Control,
+) -> Vec<Photon> {
+    let lights = scene.lights();
+    if lights.is_empty() || count == 0 {
+        return Vec::new();
+    }
+    let scale = 1.0 / count as f32;
+    let parts: Vec<Vec<Photon>> = (0..count.div_ceil(BATCH))
+        .into_par_iter()
+        .map(|b| {
+            if control.cancelled() {
+                return Vec::new();
+            }
+            let first = b * BATCH;
+            let (photons, _) = trace_batch(first..(first + BATCH).min(count), |i, out| {
+                let mut rng = Rng::new(seed, (stream << 40) ^ i);
+                if let Some(emitted) = lights.emit(scene, &mut rng) {
+                    let flux = emitted.flux * scale;
+                    trace_path(scene, &PhysicalModel, emitted.ray, flux, 0, max_bounces, &mut rng, out);
+                }
+            });
+            photons
+        })
+        .collect();
+    parts.concat()
+}
+
+/// Runs `photon(i, out)` for each photon index of a batch; returns what they stored and, for
+/// each photon, the number stored up to and including it.
+fn trace_batch(
+    indices: std::ops::Range<u64>,
+    mut photon: impl FnMut(u64, &mut Vec<Photon>),
+) -> (Vec<Photon>, Vec<u32>) {
+    let mut out = Vec::new();
+    let mut ends = Vec::with_capacity((indices.end - indices.start) as usize);
+    for i in indices {
+        photon(i, &mut out);
+        ends.push(out.len() as u32);
+    }
+    (out, ends)
+}
+
+/// A photon on its way: what it carries and what it has met.
+#[derive(Clone, Copy, Debug)]
+pub struct PhotonState {
+    /// Power (flux).
+    pub power: Vec3,
+    /// [`REFLECTED`], [`REFRACTED`] and [`DIFFUSE`] bounces so far.
+    pub flags: u8,
+    /// Length of the path so far.
+    pub length: f32,
+    /// The light that emitted it.
+    pub light: u8,
+}
+
+/// What a shading model does with a photon at a surface.
+pub trait PhotonModel: Sync {
+    /// At `hit`, reached along `ray`: pushes what is stored there to `out`, updates the photon's
+    /// power and flags, and returns the unit direction it leaves in (`None`: absorbed).
+    fn interact(
+        &self,
+        hit: &SurfaceHit,
+        ray: &Ray,
+        photon: &mut PhotonState,
+        rng: &mut Rng,
+        out: &mut Vec<Photon>,
+    ) -> Option<Vec3>;
+}
+
+/// Follows one photon from `ray` carrying `power`; pushes what it stores to `out`.
+#[allow(clippy::too_many_arguments)]
+pub fn trace_path<M: PhotonModel>(
+    scene: &Scene,
+    model: &M,
     mut ray: Ray,
-    mut power: Vec3,
-    light_index: usize,
-    settings: &PhotonSettings,
+    power: Vec3,
+    light: u8,
+    max_bounces: u32,
     rng: &mut Rng,
     out: &mut Vec<Photon>,
 ) {
-    let mut flags = 0u8;
-    let mut length = 0.0f32;
-    for _ in 0..=settings.max_bounces {
+    let mut photon = PhotonState {
+        power,
+        flags: 0,
+        length: 0.0,
+        light,
+    };
+    for _ in 0..=max_bounces {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
             return;
         };
         let hit = scene.surface(&ray, &isect);
-        length += isect.t * ray.dir.length();
+        photon.length += isect.t * ray.dir.length();
+        let Some(dir) = model.interact(&hit, &ray, &mut photon, rng, out) else {
+            return;
+        };
+        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, dir), dir);
+    }
+}
+
+/// The course's caustic photons from one light.
+pub struct CourseModel<'a> {
+    /// The light the photons come from (its falloff scales what is stored).
+    pub light: &'a Light,
+    /// Store every photon at its first surface instead (a map of direct light, for checks).
+    pub first_hit: bool,
+}
+
+impl PhotonModel for CourseModel<'_> {
+    fn interact(
+        &self,
+        hit: &SurfaceHit,
+        ray: &Ray,
+        photon: &mut PhotonState,
+        rng: &mut Rng,
+        out: &mut Vec<Photon>,
+    ) -> Option<Vec3> {
         let p = &hit.params;
         let d = ray.dir;
         let entering = d.dot(hit.geometric_normal) < 0.0;
@@ -296,46 +377,80 @@ pub fn trace_path(
             hit.shading_normal
         };
         let receives = p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO;
-        if receives && (flags != 0 || settings.first_hit) {
-            let stored = power * falloff_scale(light, length);
-            out.push(Photon::new(
-                hit.point,
-                stored,
-                d,
-                facing,
-                flags,
-                light_index.min(255) as u8,
-            ));
+        if receives && (photon.flags != 0 || self.first_hit) {
+            let stored = photon.power * falloff_scale(self.light, photon.length);
+            out.push(Photon::new(hit.point, stored, d, facing, photon.flags, photon.light));
         }
-        if settings.first_hit {
-            return;
+        if self.first_hit {
+            return None;
         }
         let pr = p.reflective.max_element().max(0.0);
         let pt = p.transmissive.max_element().max(0.0);
         let norm = (pr + pt).max(1.0);
         let (pr, pt) = (pr / norm, pt / norm);
         let u = rng.uniform();
-        let dir = if u < pr {
-            power *= p.reflective / pr;
-            flags |= REFLECTED;
-            reflect(d, facing)
+        if u < pr {
+            photon.power *= p.reflective / pr;
+            photon.flags |= REFLECTED;
+            Some(reflect(d, facing))
         } else if u < pr + pt {
-            power *= p.transmissive / pt;
-            flags |= REFRACTED;
+            photon.power *= p.transmissive / pt;
+            photon.flags |= REFRACTED;
             let (eta, n_in) = refraction_geometry(p.index, entering, hit.shading_normal);
-            refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in))
+            Some(refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in)))
         } else {
-            return;
-        };
-        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, dir), dir);
+            None
+        }
     }
 }
 
-/// d²·f(d) for a point light's course falloff f; 1 for directional lights.
+/// d²·f(d) for a point light's course falloff f; 1 for other lights.
 #[inline]
 pub fn falloff_scale(light: &Light, path_length: f32) -> f32 {
     match light {
         Light::Point { attenuation, .. } => path_length * path_length * distance_attenuation(*attenuation, path_length),
-        Light::Directional { .. } => 1.0,
+        _ => 1.0,
+    }
+}
+
+/// Photons under the physical model: every smooth surface stores them.
+pub struct PhysicalModel;
+
+impl PhotonModel for PhysicalModel {
+    fn interact(
+        &self,
+        hit: &SurfaceHit,
+        ray: &Ray,
+        photon: &mut PhotonState,
+        rng: &mut Rng,
+        out: &mut Vec<Photon>,
+    ) -> Option<Vec3> {
+        let wo = -ray.dir;
+        let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+        if bsdf.is_smooth() {
+            out.push(Photon::new(
+                hit.point,
+                photon.power,
+                ray.dir,
+                bsdf.normal(),
+                photon.flags,
+                photon.light,
+            ));
+        }
+        let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)?;
+        // Survive with the probability of the throughput kept, so flux stays nearly constant.
+        let q = sample.weight.max_element().min(1.0);
+        if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+            return None;
+        }
+        photon.power *= sample.weight / q;
+        photon.flags |= if !sample.specular {
+            DIFFUSE
+        } else if sample.transmitted {
+            REFRACTED
+        } else {
+            REFLECTED
+        };
+        Some(sample.wi)
     }
 }

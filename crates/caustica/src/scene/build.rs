@@ -1,7 +1,7 @@
 //! From a parsed description to a renderable [`Scene`]: textures loaded once per path, shapes
 //! placed, meshes moved to world space, and the BVH built.
 
-use super::{Mesh, Scene, TriangleRef};
+use super::{Mesh, Scene, SceneParts, TriangleRef};
 use crate::camera::Camera;
 use crate::description::{LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, TrimeshDesc};
 use crate::error::Span;
@@ -71,17 +71,19 @@ fn build_objects(
     // Dropped triangles never reach the BVH: count them now so the phase ends at its total.
     progress.advance(placed.saturating_sub((builder.shapes.len() + builder.triangles.len()) as u64));
     Ok(Scene::assemble(
-        camera,
-        lights,
-        desc.ambient,
-        builder.materials,
-        builder.textures,
-        builder.shapes,
-        builder.shape_materials,
-        builder.meshes,
-        builder.triangles,
-        builder.triangle_refs,
-        warnings,
+        SceneParts {
+            camera,
+            lights,
+            ambient: desc.ambient,
+            materials: builder.materials,
+            textures: builder.textures,
+            shapes: builder.shapes,
+            shape_materials: builder.shape_materials,
+            meshes: builder.meshes,
+            triangles: builder.triangles,
+            triangle_refs: builder.triangle_refs,
+            warnings,
+        },
         progress,
     ))
 }

@@ -79,8 +79,8 @@ impl AreaLight {
     /// The area lights of a scene: every object whose material can emit.
     pub fn collect(scene: &Scene) -> Vec<AreaLight> {
         let mut lights = Vec::new();
-        for (i, shape) in scene.shapes.iter().enumerate() {
-            let material = &scene.materials[scene.shape_materials[i] as usize];
+        for (i, shape) in scene.shapes().iter().enumerate() {
+            let material = &scene.materials()[scene.shape_material(i) as usize];
             if !material.is_emissive() {
                 continue;
             }
@@ -95,7 +95,7 @@ impl AreaLight {
                 crate::material::Channel::Texture(_) => (Vec3::splat(0.5), false),
             };
             let sampler = Sampler::Shape {
-                prim: i as u32,
+                prim: scene.shape_prim(i),
                 object_area,
                 det,
                 linear,
@@ -141,19 +141,19 @@ impl AreaLight {
         }
         // Triangles by mesh, gathered in one pass over the scene's triangles.
         let mut by_mesh: Vec<Vec<u32>> = Vec::new();
-        for (m, mesh) in scene.meshes.iter().enumerate() {
-            let emissive_base = scene.materials[mesh.material as usize].is_emissive();
+        for (m, mesh) in scene.meshes().iter().enumerate() {
+            let emissive_base = scene.materials()[mesh.material as usize].is_emissive();
             let per_vertex = mesh
                 .vertex_materials
                 .as_ref()
-                .is_some_and(|ids| ids.iter().any(|&id| scene.materials[id as usize].is_emissive()));
+                .is_some_and(|ids| ids.iter().any(|&id| scene.materials()[id as usize].is_emissive()));
             if !emissive_base && !per_vertex {
                 continue;
             }
             if by_mesh.is_empty() {
-                by_mesh = vec![Vec::new(); scene.meshes.len()];
-                for (t, r) in scene.triangle_refs.iter().enumerate() {
-                    by_mesh[r.mesh as usize].push(t as u32);
+                by_mesh = vec![Vec::new(); scene.meshes().len()];
+                for t in 0..scene.triangles().len() {
+                    by_mesh[scene.triangle_ref(t).mesh as usize].push(t as u32);
                 }
             }
             let mut triangles = Vec::new();
@@ -161,7 +161,7 @@ impl AreaLight {
             let mut area = 0.0f32;
             for &t in &by_mesh[m] {
                 let t = t as usize;
-                let [a, b, c] = scene.triangles[t].vertices();
+                let [a, b, c] = scene.triangles()[t].vertices();
                 let tri_area = 0.5 * (b - a).cross(c - a).length();
                 if tri_area > 0.0 && tri_area.is_finite() {
                     area += tri_area;
@@ -172,7 +172,10 @@ impl AreaLight {
             if triangles.is_empty() {
                 continue;
             }
-            let (radiance, uniform) = match (&mesh.vertex_materials, scene.materials[mesh.material as usize].emissive) {
+            let (radiance, uniform) = match (
+                &mesh.vertex_materials,
+                scene.materials()[mesh.material as usize].emissive,
+            ) {
                 (None, crate::material::Channel::Constant(c)) => (c, true),
                 _ => (Vec3::splat(0.5), false),
             };
@@ -211,7 +214,7 @@ impl AreaLight {
                         prim: *prim,
                     });
                 }
-                let shape = &scene.shapes[*prim as usize];
+                let shape = &scene.shapes()[*prim as usize];
                 let (p, n) = sample_object(&shape.kind, u_pick, u)?;
                 let point = shape.world_from_object.transform_point3(p);
                 let normal = (shape.normal_to_world * n).normalize_or_zero();
@@ -230,7 +233,7 @@ impl AreaLight {
                 let target = u_pick * area;
                 let i = cdf.partition_point(|&c| c <= target).min(triangles.len() - 1);
                 let t = triangles[i] as usize;
-                let [a, b, c] = scene.triangles[t].vertices();
+                let [a, b, c] = scene.triangles()[t].vertices();
                 let su = u.x.sqrt();
                 let (b1, b2) = (1.0 - su, u.y * su);
                 let point = a * (1.0 - b1 - b2) + b * b1 + c * b2;
@@ -239,7 +242,7 @@ impl AreaLight {
                     point,
                     normal,
                     pdf_area: 1.0 / area,
-                    prim: scene.shapes.len() as u32 + t as u32,
+                    prim: scene.triangle_prim(t),
                 })
             }
         }

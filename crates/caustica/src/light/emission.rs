@@ -1,14 +1,21 @@
-//! Photon emission from point and directional lights, aimed or uniform.
+//! Photon emission: photons leaving the lights, with their flux.
 //!
-//! Aimed emission sends photons only towards the bounding spheres of objects that can make
+//! The physical model chooses a light in proportion to its power ([`LightSet::emit`]): point
+//! lights emit uniformly over the sphere, directional lights across a disc covering the scene,
+//! emissive objects from a point uniform by area in a cosine-weighted direction.
+//!
+//! The course model's caustic photons leave each point or directional light by an [`Emitter`],
+//! aimed or uniform. Aimed emission sends photons only towards the bounding spheres of objects that can make
 //! caustics. Point lights sample a mixture of cones (one per target, weighted by solid angle);
 //! directional lights sample a mixture of discs on a plane across the beam (one per target,
 //! weighted by area). Each photon carries the light's intensity (or irradiance) divided by the
 //! mixture pdf actually used, so aiming changes the noise, never the expected power.
 
-use crate::light::Light;
-use crate::math::{luminance, Aabb, Frame, Ray, Vec2, Vec3};
-use crate::sampling::{sample_uniform_cone, sample_uniform_disc, Rng};
+use super::area::AreaSample;
+use super::{Light, LightSet};
+use crate::math::{luminance, offset_origin, Aabb, Frame, Ray, Vec2, Vec3};
+use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, sample_uniform_sphere, Rng};
+use crate::scene::{ObjectRef, Scene};
 use std::f32::consts::PI;
 
 /// A bounding sphere that photons are aimed at.
@@ -89,6 +96,7 @@ impl Emitter {
                     4.0 * PI * luminance(color).max(0.0),
                 )
             }
+            Light::Area(_) => None,
             Light::Directional { direction, color } => {
                 let frame = Frame::from_normal(direction);
                 let plane_origin = scene.center - direction * (scene.radius * 2.0 + 1.0);
@@ -215,9 +223,107 @@ fn cone_towards(position: Vec3, target: &Target) -> ConeLobe {
     }
 }
 
+/// The bounding spheres photons are aimed at: one per reflective or transmissive object. For a
+/// shape, the smaller of the sphere around its world bounds and its own bounding sphere: a
+/// rotated ring's world box is much larger than the ring, and every photon aimed past the ring
+/// is traced for nothing.
+pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
+    scene
+        .objects()
+        .filter(|(object, bounds)| scene.object_is_specular(*object) && !bounds.is_empty())
+        .map(|(object, bounds)| {
+            let around = Target::around(&bounds);
+            let ObjectRef::Shape(i) = object else {
+                return around;
+            };
+            let (center, radius) = scene.shapes()[i as usize].bounding_sphere();
+            let own = Target {
+                center,
+                radius: radius * 1.001 + 1e-4,
+            };
+            if own.radius < around.radius && own.radius.is_finite() && center.is_finite() {
+                own
+            } else {
+                around
+            }
+        })
+        .collect()
+}
+
+/// A photon leaving a light: its ray and its flux before division by the photon count.
+#[derive(Clone, Copy, Debug)]
+pub struct EmittedPhoton {
+    /// Origin and unit direction.
+    pub ray: Ray,
+    /// Flux.
+    pub flux: Vec3,
+}
+
+impl LightSet {
+    /// One photon from a light chosen by power; `None` if the sample carries nothing.
+    pub fn emit(&self, scene: &Scene, rng: &mut Rng) -> Option<EmittedPhoton> {
+        let (index, p_pick) = self.pick(rng.uniform())?;
+        let (u_pick, u, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
+        let (scene_center, scene_radius) = self.scene_sphere();
+        match &self.lights[index] {
+            Light::Point { position, color, .. } => Some(EmittedPhoton {
+                ray: Ray::new(*position, sample_uniform_sphere(u_dir)),
+                flux: *color * (4.0 * PI / p_pick),
+            }),
+            Light::Directional { direction, color } => {
+                let frame = Frame::from_normal(*direction);
+                let d = sample_uniform_disc(u) * scene_radius;
+                let origin = scene_center - *direction * (2.0 * scene_radius + 1.0) + frame.x * d.x + frame.y * d.y;
+                let area = PI * scene_radius * scene_radius;
+                Some(EmittedPhoton {
+                    ray: Ray::new(origin, *direction),
+                    flux: *color * (area / p_pick),
+                })
+            }
+            Light::Area(light) => {
+                let sample = light.sample(scene, u_pick, u)?;
+                let le = if light.uniform {
+                    light.radiance
+                } else {
+                    emission_at(scene, &sample)
+                };
+                // A face at random (the outer one of a closed lamp that absorbs its own inward
+                // light), then a cosine-weighted direction: pdf ½·cos/π, or cos/π.
+                let (side, u2, faces) = if light.outward_only {
+                    (1.0, u_dir, 1.0)
+                } else if u_dir.x < 0.5 {
+                    (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y), 2.0)
+                } else {
+                    (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y), 2.0)
+                };
+                let normal = sample.normal * side;
+                let dir = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2));
+                if dir.dot(normal) <= 0.0 {
+                    return None;
+                }
+                Some(EmittedPhoton {
+                    ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
+                    flux: le * (faces * PI / (sample.pdf_area * p_pick)),
+                })
+            }
+        }
+    }
+}
+
+/// The emitted radiance at a sampled light point, read from its material by a short ray.
+fn emission_at(scene: &Scene, sample: &AreaSample) -> Vec3 {
+    let eps = 1e-3 * (1.0 + sample.point.abs().max_element());
+    let ray = Ray::new(sample.point + sample.normal * eps, -sample.normal);
+    match scene.intersect(&ray, 2.0 * eps) {
+        Some(isect) => scene.emission(&scene.surface(&ray, &isect)),
+        None => Vec3::ZERO,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::build::test_scene as scene;
 
     fn bounds() -> Aabb {
         Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0))
@@ -303,6 +409,46 @@ mod tests {
             assert!(
                 (estimate / exact as f64 - 1.0).abs() < 0.02,
                 "aimed {aimed}: {estimate} vs {exact}"
+            );
+        }
+    }
+
+    /// Photons carry the lamp's whole useful power: π·A·Le from each face that lights anything,
+    /// the outer face only for a closed lamp that absorbs its own inward light.
+    #[test]
+    fn emitted_flux_is_the_lamps_power() {
+        let lamp = "scale(0.5, sphere { material = { emissive = (2, 2, 2); } })";
+        for (objects, faces, outward) in [
+            (lamp.to_string(), 1.0, true),
+            (
+                format!("{lamp} scale(0.1, sphere {{ material = {{ diffuse = (1,1,1); }} }})"),
+                2.0,
+                false,
+            ),
+            (
+                "scale(0.5, sphere { material = { emissive = (2, 2, 2); diffuse = (0.5, 0.5, 0.5); } })".to_string(),
+                2.0,
+                false,
+            ),
+        ] {
+            let s = scene(&objects);
+            let lights = s.lights();
+            assert_eq!(lights.area_lights().next().unwrap().outward_only, outward, "{objects}");
+            let mut rng = Rng::new(3, 0);
+            let n = 100_000;
+            let mut sum = 0.0f64;
+            for _ in 0..n {
+                if let Some(p) = lights.emit(&s, &mut rng) {
+                    sum += p.flux.x as f64;
+                    let outside = (p.ray.origin - Vec3::ZERO).dot(p.ray.dir) > 0.0;
+                    assert!(outside || !outward, "an outward-only lamp emitted inwards");
+                }
+            }
+            let exact = faces * std::f64::consts::PI * (4.0 * std::f64::consts::PI * 0.25) * 2.0;
+            assert!(
+                (sum / n as f64 / exact - 1.0).abs() < 0.01,
+                "{objects}: {} vs {exact}",
+                sum / n as f64
             );
         }
     }
