@@ -191,7 +191,7 @@ impl ShapeScene {
             .map(|i| {
                 let kind = match i % 5 {
                     0 => ShapeKind::Sphere,
-                    1 => ShapeKind::Cube,
+                    1 => ShapeKind::Box,
                     2 => ShapeKind::cylinder(true),
                     3 => ShapeKind::Cone(Cone::new(1.0, 0.5, 0.1, true, false)),
                     _ => ShapeKind::Square,

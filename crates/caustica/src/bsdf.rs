@@ -15,6 +15,7 @@
 use crate::material::SurfaceParams;
 use crate::math::{reflect, Frame, Vec3};
 use crate::sampling::sample_cosine_hemisphere;
+use crate::scene::{Scene, SurfaceHit};
 use std::f32::consts::PI;
 
 /// Whether a path carries radiance (from the camera) or importance (from a light): refraction
@@ -63,6 +64,11 @@ pub struct BsdfSample {
 }
 
 impl Bsdf {
+    /// The lobes at a surface point of `scene`, seen from direction `wo` (unit, away from it).
+    pub fn at(scene: &Scene, hit: &SurfaceHit, wo: Vec3) -> Bsdf {
+        Bsdf::new(&scene.phong(hit), hit.shading_normal, hit.geometric_normal, wo)
+    }
+
     /// The lobes of `params` at a point with outward shading normal `ns` and geometric normal
     /// `ng`, seen from direction `wo` (unit, away from the surface).
     pub fn new(params: &SurfaceParams, ns: Vec3, ng: Vec3, wo: Vec3) -> Bsdf {

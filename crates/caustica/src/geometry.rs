@@ -1,12 +1,11 @@
 //! Shapes and their ray intersections.
 //!
-//! Analytic shapes (sphere, box, square, cylinder, cone) are intersected in their own object
+//! Analytic shapes (sphere, box, square, cylinder and cone in `cone.rs`) are intersected in their own object
 //! space: the world ray is mapped by `object_from_world` without renormalising its direction, so
 //! the ray parameter `t` is the same in both spaces. Triangles are stored in world space.
 
+pub mod box_shape;
 pub mod cone;
-pub mod cube;
-pub mod cylinder;
 pub mod shape;
 pub mod sphere;
 pub mod square;

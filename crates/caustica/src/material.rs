@@ -13,8 +13,9 @@ pub enum Channel {
 }
 
 impl Channel {
+    /// The value at texture coordinates `uv`.
     #[inline]
-    fn eval(&self, textures: &[Texture], uv: Vec2) -> Vec3 {
+    pub fn eval(&self, textures: &[Texture], uv: Vec2) -> Vec3 {
         match *self {
             Channel::Constant(c) => c,
             Channel::Texture(i) => textures[i as usize].lookup(uv),
@@ -28,6 +29,21 @@ impl Channel {
             Channel::Texture(_) => true,
         }
     }
+}
+
+/// Which material a surface point has: one, or (per-vertex materials of a mesh) three blended
+/// by barycentric weights.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MaterialRef {
+    /// One material id.
+    One(u32),
+    /// The materials of a triangle's three vertices and their weights at the point.
+    Blend {
+        /// Material ids.
+        ids: [u32; 3],
+        /// Barycentric weights (sum 1).
+        weights: [f32; 3],
+    },
 }
 
 /// A material: the eight `.ray` parameters.

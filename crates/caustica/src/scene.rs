@@ -10,7 +10,7 @@ use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::Shape;
 use crate::light::{Light, LightSet};
-use crate::material::{Material, SurfaceParams};
+use crate::material::{Material, MaterialRef, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use crate::progress::Progress;
 use crate::texture::Texture;
@@ -145,8 +145,8 @@ pub struct SurfaceHit {
     pub shading_normal: Vec3,
     /// Texture coordinates.
     pub uv: Vec2,
-    /// Material values here.
-    pub params: SurfaceParams,
+    /// The material here (one, or three blended across a mesh triangle).
+    pub material: MaterialRef,
     /// The object hit.
     pub object: ObjectRef,
     /// The primitive hit (shapes first, then triangles).
@@ -259,9 +259,23 @@ impl Scene {
         &self.warnings
     }
 
-    /// The emitted radiance (course: `emissive`) at a surface point.
+    /// The course's eight material values at a surface point.
+    pub fn phong(&self, hit: &SurfaceHit) -> SurfaceParams {
+        match hit.material {
+            MaterialRef::One(id) => self.materials[id as usize].eval(&self.textures, hit.uv),
+            MaterialRef::Blend { ids, weights } => {
+                let p = ids.map(|id| self.materials[id as usize].eval(&self.textures, hit.uv));
+                SurfaceParams::blend([&p[0], &p[1], &p[2]], weights)
+            }
+        }
+    }
+
+    /// The emitted radiance (`emissive`) at a surface point.
     pub fn emission(&self, hit: &SurfaceHit) -> Vec3 {
-        hit.params.emissive
+        match hit.material {
+            MaterialRef::One(id) => self.materials[id as usize].emissive.eval(&self.textures, hit.uv),
+            MaterialRef::Blend { .. } => self.phong(hit).emissive,
+        }
     }
 
     /// Whether nothing blocks the segment from a surface point towards `wi` for `distance`.
@@ -401,14 +415,13 @@ impl Scene {
         let point = ray.at(hit.t);
         let n_shapes = self.shapes.len() as u32;
         if hit.prim < n_shapes {
-            let material = &self.materials[self.shape_materials[hit.prim as usize] as usize];
             return SurfaceHit {
                 t: hit.t,
                 point,
                 geometric_normal: hit.normal_or_bary,
                 shading_normal: hit.normal_or_bary,
                 uv: hit.uv,
-                params: material.eval(&self.textures, hit.uv),
+                material: MaterialRef::One(self.shape_materials[hit.prim as usize]),
                 object: ObjectRef::Shape(hit.prim),
                 prim: hit.prim,
             };
@@ -438,12 +451,12 @@ impl Scene {
             }
             None => geometric_normal,
         };
-        let params = match &mesh.vertex_materials {
-            Some(ids) => {
-                let p = [ids[i0], ids[i1], ids[i2]].map(|id| self.materials[id as usize].eval(&self.textures, uv));
-                SurfaceParams::blend([&p[0], &p[1], &p[2]], w)
-            }
-            None => self.materials[mesh.material as usize].eval(&self.textures, uv),
+        let material = match &mesh.vertex_materials {
+            Some(ids) => MaterialRef::Blend {
+                ids: [ids[i0], ids[i1], ids[i2]],
+                weights: w,
+            },
+            None => MaterialRef::One(mesh.material),
         };
         SurfaceHit {
             t: hit.t,
@@ -451,7 +464,7 @@ impl Scene {
             geometric_normal,
             shading_normal,
             uv,
-            params,
+            material,
             object: ObjectRef::Mesh(tri_ref.mesh),
             prim: hit.prim,
         }
@@ -649,10 +662,10 @@ mod tests {
             "{:?}",
             textured.uv
         );
-        assert_eq!(textured.params.diffuse, Vec3::X);
+        assert_eq!(scene.phong(&textured).diffuse, Vec3::X);
         let plain = hit(Vec3::new(1.5, 0.0, 0.0), Vec3::new(0.0, -1.0, 0.0));
         assert_eq!(plain.uv, Vec2::ZERO);
-        assert_eq!(plain.params.diffuse, Vec3::splat(0.5));
+        assert_eq!(scene.phong(&plain).diffuse, Vec3::splat(0.5));
         let cone = hit(Vec3::new(0.0, 2.0, 0.5), Vec3::new(0.0, -1.0, 0.0));
         assert!(
             (cone.uv - Vec2::new(0.25, 0.5)).abs().max_element() < 1e-5,

@@ -21,6 +21,18 @@ pub struct Cone {
 }
 
 impl Cone {
+    /// The `.ray` cylinder: radius 1 about +z, z ∈ [0, 1] — a cone with equal radii, built
+    /// exactly (no course slope clamp: that quirk belongs to `cone`).
+    pub fn cylinder(capped: bool) -> Cone {
+        Cone {
+            bottom_radius: 1.0,
+            top_radius: 1.0,
+            height: 1.0,
+            capped,
+            doubled_normal_z: false,
+        }
+    }
+
     /// A cone as the file describes it. With `course_quirks`, radii are clamped to ≥ 1e-4 and
     /// the slope to magnitude ≥ 0.001, and the side normal has the skeleton's doubled z (§7).
     pub fn new(height: f32, bottom_radius: f32, top_radius: f32, capped: bool, course_quirks: bool) -> Cone {

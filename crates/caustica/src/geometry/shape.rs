@@ -1,6 +1,6 @@
 //! An analytic shape placed in the world by a transform.
 
-use super::{cone::Cone, cube, cylinder, sphere, square, LocalHit};
+use super::{box_shape, cone::Cone, sphere, square, LocalHit};
 use crate::math::{Aabb, Mat3, Mat4, Ray, Vec2, Vec3};
 
 /// The closed set of analytic shapes.
@@ -8,8 +8,8 @@ use crate::math::{Aabb, Mat3, Mat4, Ray, Vec2, Vec3};
 pub enum ShapeKind {
     /// Unit sphere.
     Sphere,
-    /// Cube [-0.5, 0.5]³.
-    Cube,
+    /// The `.ray` box: the cube [-0.5, 0.5]³.
+    Box,
     /// Square [-0.5, 0.5]² at z = 0.
     Square,
     /// Cone or cylinder about +z.
@@ -81,7 +81,7 @@ impl Shape {
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
         let (center, radius) = match &self.kind {
             ShapeKind::Sphere => (Vec3::ZERO, 1.0),
-            ShapeKind::Cube => (Vec3::ZERO, 0.75f32.sqrt()),
+            ShapeKind::Box => (Vec3::ZERO, 0.75f32.sqrt()),
             ShapeKind::Square => (Vec3::ZERO, 0.5f32.sqrt()),
             ShapeKind::Cone(cone) => {
                 let h = 0.5 * cone.height;
@@ -100,7 +100,7 @@ impl Shape {
         let p = self.object_from_world.transform_point3(point);
         let d = match &self.kind {
             ShapeKind::Sphere => (p.length() - 1.0).abs(),
-            ShapeKind::Cube => {
+            ShapeKind::Box => {
                 let q = p.abs() - Vec3::splat(0.5);
                 if q.max_element() > 0.0 {
                     q.max(Vec3::ZERO).length()
@@ -124,7 +124,7 @@ impl Shape {
         );
         let hit: LocalHit = match &self.kind {
             ShapeKind::Sphere => sphere::intersect(&local, t_max, self.needs_uv),
-            ShapeKind::Cube => cube::intersect(&local, t_max),
+            ShapeKind::Box => box_shape::intersect(&local, t_max),
             ShapeKind::Square => square::intersect(&local, t_max),
             ShapeKind::Cone(cone) => cone.intersect(&local, t_max, self.needs_uv),
         }?;
@@ -157,14 +157,14 @@ fn max_stretch(m: Mat3) -> f32 {
 impl ShapeKind {
     /// A cylinder of the file (radius 1, height 1).
     pub fn cylinder(capped: bool) -> ShapeKind {
-        ShapeKind::Cone(cylinder::cylinder(capped))
+        ShapeKind::Cone(Cone::cylinder(capped))
     }
 
     /// Object-space bounds.
     pub fn object_bounds(&self) -> Aabb {
         match self {
             ShapeKind::Sphere => sphere::bounds(),
-            ShapeKind::Cube => cube::bounds(),
+            ShapeKind::Box => box_shape::bounds(),
             ShapeKind::Square => square::bounds(),
             ShapeKind::Cone(cone) => cone.bounds(),
         }
@@ -215,7 +215,7 @@ mod tests {
 
     #[test]
     fn box_faces_normals_and_uv() {
-        let b = Shape::new(ShapeKind::Cube, Mat4::IDENTITY).unwrap();
+        let b = Shape::new(ShapeKind::Box, Mat4::IDENTITY).unwrap();
         let hit = b
             .intersect(&Ray::new(Vec3::new(0.2, 0.1, 3.0), -Vec3::Z), f32::INFINITY)
             .unwrap();
@@ -309,7 +309,7 @@ mod tests {
     fn proximity_bound_is_conservative() {
         let kinds = [
             ShapeKind::Sphere,
-            ShapeKind::Cube,
+            ShapeKind::Box,
             ShapeKind::Square,
             ShapeKind::cylinder(false),
             ShapeKind::cylinder(true),
@@ -356,7 +356,7 @@ mod tests {
     fn bounding_sphere_holds_the_shape() {
         let kinds = [
             ShapeKind::Sphere,
-            ShapeKind::Cube,
+            ShapeKind::Box,
             ShapeKind::Square,
             ShapeKind::cylinder(true),
             ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),

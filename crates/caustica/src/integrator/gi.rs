@@ -157,7 +157,7 @@ impl<'a> Gi<'a> {
             path_length += isect.t;
             segment += isect.t;
             let wo = -ray.dir;
-            let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+            let bsdf = Bsdf::at(scene, &hit, wo);
             if bsdf.is_black() {
                 break;
             }

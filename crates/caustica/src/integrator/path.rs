@@ -60,7 +60,7 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng)
         if depth == settings.max_depth {
             break;
         }
-        let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+        let bsdf = Bsdf::at(scene, &hit, wo);
         if bsdf.is_black() {
             break;
         }

@@ -38,7 +38,7 @@ where
         let wo = -ray.dir;
         // Only the camera and specular chains reach here: emission counts in full.
         l += beta * super::direct::emitted(scene, &hit);
-        let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+        let bsdf = Bsdf::at(scene, &hit, wo);
         if bsdf.is_black() {
             break;
         }

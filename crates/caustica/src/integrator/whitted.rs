@@ -38,25 +38,25 @@ const MAX_CROSSINGS_PER_SHAPE: usize = 4;
 /// Recursion stops once a path's weight falls below this: it could not change an 8-bit pixel.
 const MIN_PATH_WEIGHT: f32 = 1.0 / 1024.0;
 
-/// Radiance along `ray` (unit direction). `caustic(hit, wo, n, depth)` adds light estimated from
-/// photons at a surface point, given the direction to the viewer, the normal facing it and the
-/// recursion depth (0 for the camera ray's own hit).
+/// Radiance along `ray` (unit direction). `caustic(hit, params, wo, n, depth)` adds light
+/// estimated from photons at a surface point, given its material values, the direction to the
+/// viewer, the normal facing it and the recursion depth (0 for the camera ray's own hit).
 pub fn radiance<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, caustic: &C) -> Vec3
 where
-    C: Fn(&SurfaceHit, Vec3, Vec3, u32) -> Vec3,
+    C: Fn(&SurfaceHit, &SurfaceParams, Vec3, Vec3, u32) -> Vec3,
 {
     trace(scene, settings, ray, 0, Vec3::ONE, caustic)
 }
 
 fn trace<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, depth: u32, weight: Vec3, caustic: &C) -> Vec3
 where
-    C: Fn(&SurfaceHit, Vec3, Vec3, u32) -> Vec3,
+    C: Fn(&SurfaceHit, &SurfaceParams, Vec3, Vec3, u32) -> Vec3,
 {
     let Some(isect) = scene.intersect(ray, f32::INFINITY) else {
         return Vec3::ZERO;
     };
     let hit = scene.surface(ray, &isect);
-    let p = &hit.params;
+    let p = &scene.phong(&hit);
     let d = ray.dir;
     let wo = -d;
     // Rays meeting the outward normal from behind are inside the object.
@@ -76,7 +76,7 @@ where
     };
     if local.diffuse != Vec3::ZERO || local.specular != Vec3::ZERO {
         color += direct_light(scene, &hit, &local, n, wo);
-        color += caustic(&hit, wo, n, depth);
+        color += caustic(&hit, p, wo, n, depth);
     }
 
     if depth >= settings.max_depth {
@@ -139,7 +139,7 @@ pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec
             let Some(hit) = crossing else { break };
             filter *= match scene.uniform_transmissive(hit.prim) {
                 Some(kt) => kt,
-                None => scene.surface(&ray, &hit).params.transmissive,
+                None => scene.phong(&scene.surface(&ray, &hit)).transmissive,
             };
             if filter == Vec3::ZERO {
                 return true;
@@ -187,23 +187,25 @@ pub fn render(
     super::render_tiles(image, control, "render", |sx, sy, _rng, pixel: &mut PixelCaustic| {
         let ray = camera.generate_ray(sx, sy);
         let Some((map, estimate)) = caustics else {
-            return radiance(scene, settings, &ray, &|_: &SurfaceHit, _: Vec3, _: Vec3, _: u32| {
-                Vec3::ZERO
-            });
+            return radiance(
+                scene,
+                settings,
+                &ray,
+                &|_: &SurfaceHit, _: &SurfaceParams, _: Vec3, _: Vec3, _: u32| Vec3::ZERO,
+            );
         };
         let cache = std::cell::Cell::new(*pixel);
         let color = radiance(
             scene,
             settings,
             &ray,
-            &|hit: &SurfaceHit, wo: Vec3, n: Vec3, depth: u32| {
-                let p = &hit.params;
+            &|hit: &SurfaceHit, p: &SurfaceParams, wo: Vec3, n: Vec3, depth: u32| {
                 if p.diffuse == Vec3::ZERO && p.specular == Vec3::ZERO {
                     return Vec3::ZERO;
                 }
                 let slot = depth as usize;
                 if !reuse || slot >= CACHED_DEPTHS || p.specular != Vec3::ZERO {
-                    return map.radiance(scene, hit, n, wo, estimate);
+                    return map.radiance(scene, hit, p, n, wo, estimate);
                 }
                 let mut entries = cache.get();
                 let mut nearby = None;

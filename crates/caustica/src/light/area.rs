@@ -108,7 +108,7 @@ impl AreaLight {
                 _ => None,
             };
             let closed = match shape.kind {
-                ShapeKind::Sphere | ShapeKind::Cube => true,
+                ShapeKind::Sphere | ShapeKind::Box => true,
                 ShapeKind::Cone(cone) => cone.capped,
                 ShapeKind::Square => false,
             };
@@ -356,7 +356,7 @@ fn similarity_scale(m: &Mat3) -> Option<f32> {
 fn object_area(kind: &ShapeKind) -> f32 {
     match kind {
         ShapeKind::Sphere => 4.0 * PI,
-        ShapeKind::Cube => 6.0,
+        ShapeKind::Box => 6.0,
         ShapeKind::Square => 1.0,
         ShapeKind::Cone(cone) => {
             let (side, bottom, top) = cone_areas(cone);
@@ -409,7 +409,7 @@ fn sample_object(kind: &ShapeKind, u_pick: f32, u: Vec2) -> Option<(Vec3, Vec3)>
             let p = sample_uniform_sphere(u);
             Some((p, p))
         }
-        ShapeKind::Cube => {
+        ShapeKind::Box => {
             let face = ((u_pick * 6.0) as usize).min(5);
             let axis = face % 3;
             let sign = if face < 3 { 1.0 } else { -1.0 };

@@ -140,11 +140,18 @@ impl PhotonMap {
         2.0 * super::typical_knn_distance(&self.tree, &self.photons, k.max(1))
     }
 
-    /// Reflected radiance at a surface point towards `wo` from the photons nearby; `n` is the
-    /// unit normal facing `wo`. Where other geometry comes within the gather radius, photons the
+    /// Reflected radiance at a surface point with material values `params` towards `wo` from
+    /// the photons nearby; `n` is the unit normal facing `wo`. Where other geometry comes within the gather radius, photons the
     /// point cannot see in a straight line (behind a wall, across a ring's rim) are left out.
-    pub fn radiance(&self, scene: &Scene, hit: &SurfaceHit, n: Vec3, wo: Vec3, settings: &EstimateSettings) -> Vec3 {
-        let params = &hit.params;
+    pub fn radiance(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        params: &SurfaceParams,
+        n: Vec3,
+        wo: Vec3,
+        settings: &EstimateSettings,
+    ) -> Vec3 {
         self.gather(scene, hit, n, settings, None, |wi| params.phong_reflectance(n, wo, wi))
             .0
     }
@@ -263,12 +270,12 @@ impl PhotonMap {
         let Some(isect) = scene.intersect(&ray, 2e-3) else {
             return Vec3::ZERO;
         };
-        let mut hit = scene.surface(&ray, &isect);
-        hit.params = SurfaceParams {
+        let hit = scene.surface(&ray, &isect);
+        let white = SurfaceParams {
             diffuse: Vec3::ONE,
             ..SurfaceParams::default()
         };
-        self.radiance(scene, &hit, n, n, settings)
+        self.radiance(scene, &hit, &white, n, n, settings)
     }
 
     /// Reflected radiance at `point` towards `wo` from the photons within radius `r`.

@@ -308,10 +308,11 @@ pub struct PhotonState {
 
 /// What a shading model does with a photon at a surface.
 pub trait PhotonModel: Sync {
-    /// At `hit`, reached along `ray`: pushes what is stored there to `out`, updates the photon's
+    /// At `hit` in `scene`, reached along `ray`: pushes what is stored there to `out`, updates the photon's
     /// power and flags, and returns the unit direction it leaves in (`None`: absorbed).
     fn interact(
         &self,
+        scene: &Scene,
         hit: &SurfaceHit,
         ray: &Ray,
         photon: &mut PhotonState,
@@ -344,7 +345,7 @@ pub fn trace_path<M: PhotonModel>(
         };
         let hit = scene.surface(&ray, &isect);
         photon.length += isect.t * ray.dir.length();
-        let Some(dir) = model.interact(&hit, &ray, &mut photon, rng, out) else {
+        let Some(dir) = model.interact(scene, &hit, &ray, &mut photon, rng, out) else {
             return;
         };
         ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, dir), dir);
@@ -362,13 +363,14 @@ pub struct CourseModel<'a> {
 impl PhotonModel for CourseModel<'_> {
     fn interact(
         &self,
+        scene: &Scene,
         hit: &SurfaceHit,
         ray: &Ray,
         photon: &mut PhotonState,
         rng: &mut Rng,
         out: &mut Vec<Photon>,
     ) -> Option<Vec3> {
-        let p = &hit.params;
+        let p = &scene.phong(hit);
         let d = ray.dir;
         let entering = d.dot(hit.geometric_normal) < 0.0;
         let facing = if d.dot(hit.shading_normal) > 0.0 {
@@ -419,6 +421,7 @@ pub struct PhysicalModel;
 impl PhotonModel for PhysicalModel {
     fn interact(
         &self,
+        scene: &Scene,
         hit: &SurfaceHit,
         ray: &Ray,
         photon: &mut PhotonState,
@@ -426,7 +429,7 @@ impl PhotonModel for PhysicalModel {
         out: &mut Vec<Photon>,
     ) -> Option<Vec3> {
         let wo = -ray.dir;
-        let bsdf = Bsdf::new(&hit.params, hit.shading_normal, hit.geometric_normal, wo);
+        let bsdf = Bsdf::at(scene, hit, wo);
         if bsdf.is_smooth() {
             out.push(Photon::new(
                 hit.point,

@@ -150,7 +150,7 @@ impl Builder {
         let m = object.world_from_object;
         let kind = match &object.shape {
             ShapeDesc::Sphere => ShapeKind::Sphere,
-            ShapeDesc::Box => ShapeKind::Cube,
+            ShapeDesc::Box => ShapeKind::Box,
             ShapeDesc::Square => ShapeKind::Square,
             ShapeDesc::Cylinder { capped } => ShapeKind::cylinder(*capped),
             ShapeDesc::Cone {

@@ -1,4 +1,4 @@
-//! The `box` primitive: the cube [-0.5, 0.5]³.
+//! The `.ray` `box` primitive: the cube [-0.5, 0.5]³.
 
 use super::LocalHit;
 use crate::math::{Aabb, Ray, Vec2, Vec3};
