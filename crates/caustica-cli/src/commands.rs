@@ -5,7 +5,6 @@ pub mod compare;
 pub mod info;
 pub mod merge;
 pub mod photons;
-pub mod progressive;
 pub mod render;
 
 use crate::cli::{PhotonOptions, SceneArgs};
@@ -13,20 +12,14 @@ use crate::progress::Bars;
 use caustica::format::ray_file::ast::Dialect;
 use caustica::format::ray_file::ParseOptions;
 use caustica::format::{self, ReadOptions};
-use caustica::loader::{build_source, LoadSettings};
+use caustica::integrator::RenderConfig;
+use caustica::loader::{build_source, scene_id, LoadSettings};
 use caustica::photon::PhotonSettings;
 use caustica::presets;
 use caustica::scene::Scene;
 use caustica::{Error, Result};
 use std::path::Path;
 use std::time::Instant;
-
-/// Largest image side accepted: beyond it the film alone would not fit in memory.
-const MAX_SIDE: usize = 32_768;
-/// Largest pixel count (1 GiB of float RGB film).
-const MAX_PIXELS: usize = 1 << 26;
-/// Largest photon count accepted (24 bytes each: 2.4 GB).
-const MAX_PHOTONS: usize = 100_000_000;
 
 /// Load settings from the command line.
 pub fn load_settings(args: &SceneArgs) -> LoadSettings {
@@ -48,6 +41,8 @@ pub fn load_settings(args: &SceneArgs) -> LoadSettings {
 pub struct Loaded {
     /// The scene.
     pub scene: Scene,
+    /// What identifies it in a render's fingerprint.
+    pub scene_id: String,
     /// Reading and parsing the file.
     pub parse_seconds: f64,
     /// Building shapes, meshes, textures and the BVH.
@@ -71,9 +66,12 @@ pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<
     };
     let parse_seconds = start.elapsed().as_secs_f64();
     let start = Instant::now();
-    let scene = build_source(source?, &settings.build, bars)?;
+    let source = source?;
+    let scene_id = scene_id(&source, &settings);
+    let scene = build_source(source, &settings.build, bars)?;
     Ok(Loaded {
         scene,
+        scene_id,
         parse_seconds,
         build_seconds: start.elapsed().as_secs_f64(),
     })
@@ -90,16 +88,13 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::InvalidSettings(format!("cannot start worker threads: {e}")))
 }
 
-/// Refuses image sizes that cannot be rendered, before any memory is committed.
-pub fn check_image_size(width: usize, height: usize) -> Result<()> {
-    if width == 0 || height == 0 {
-        return Err(Error::InvalidSettings(
-            "the image needs a width and height of at least 1 pixel".into(),
-        ));
-    }
-    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
+/// Refuses photon counts whose map would exceed `--max-memory` MB, before any work.
+pub fn check_photon_memory(total: usize, max_memory: u64) -> Result<()> {
+    // 24 bytes a photon plus the tree's node per 8–16 photons; stored counts overshoot by a few.
+    let needed_mb = (total as u64).saturating_mul(25) / 1_000_000;
+    if needed_mb > max_memory {
         return Err(Error::InvalidSettings(format!(
-            "{width}×{height} is too large: at most {MAX_SIDE} pixels a side and {MAX_PIXELS} pixels in all"
+            "{total} photons need about {needed_mb} MB, more than --max-memory {max_memory} MB: store fewer photons or raise the cap"
         )));
     }
     Ok(())
@@ -107,32 +102,22 @@ pub fn check_image_size(width: usize, height: usize) -> Result<()> {
 
 /// Photon settings from the command line, checked.
 pub fn photon_settings(options: &PhotonOptions, seed: u64) -> Result<PhotonSettings> {
-    let total = match &options.photons_per_light {
-        Some(counts) => counts.iter().fold(0usize, |a, b| a.saturating_add(*b)),
-        None => options.photons,
-    };
-    // 24 bytes a photon plus the tree's node per 8–16 photons; stored counts overshoot by a few.
-    let needed_mb = (total as u64).saturating_mul(25) / 1_000_000;
-    if needed_mb > options.max_memory {
-        return Err(Error::InvalidSettings(format!(
-            "{total} photons need about {needed_mb} MB, more than --max-memory {} MB: store fewer photons or raise the cap",
-            options.max_memory
-        )));
-    }
-    if total > MAX_PHOTONS {
-        return Err(Error::InvalidSettings(format!(
-            "{total} photons would need {} MB; at most {MAX_PHOTONS} photons are accepted",
-            total.saturating_mul(24) / 1_000_000
-        )));
-    }
-    Ok(PhotonSettings {
-        target_stored: total,
-        max_emitted: options.max_emitted.unwrap_or(0),
-        aim: !options.no_aim,
+    let config = RenderConfig {
+        photons: options.photons,
+        max_emitted: options.max_emitted,
+        photons_per_light: options.photons_per_light.clone(),
+        no_aim: options.no_aim,
         seed,
-        per_light: options.photons_per_light.clone(),
-        ..PhotonSettings::default()
-    })
+        ..RenderConfig::default()
+    };
+    check_photon_memory(config.photon_total(), options.max_memory)?;
+    config.integrator()?;
+    Ok(config.photon_settings())
+}
+
+/// A path as JSON shows it (`null` for none); any path prints, UTF-8 or not.
+pub fn shown(path: &Option<std::path::PathBuf>) -> Option<String> {
+    path.as_ref().map(|p| p.display().to_string())
 }
 
 /// Peak resident memory of this process in bytes (Linux), if known.

@@ -6,7 +6,6 @@ mod cli;
 mod commands;
 mod diagnostics;
 mod interrupt;
-mod json;
 mod progress;
 
 use clap::Parser;

@@ -1,7 +1,7 @@
 //! The real binary under the physical model: split runs merged, progressive output, refusals.
 
 use assert_cmd::Command;
-use caustica::integrator::progressive::Accumulator;
+use caustica::integrator::partial::Accumulator;
 use std::path::{Path, PathBuf};
 
 fn caustica() -> Command {

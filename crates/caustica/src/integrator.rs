@@ -1,125 +1,192 @@
-//! Integrators turn camera rays into pixel values. The image is cut into tiles rendered in
-//! parallel; each pixel draws from its own random stream (seed, pixel index), so the picture does
-//! not depend on the thread count.
+//! Integrators turn camera rays into pixel values: [`Integrator`] names one with its settings,
+//! [`RenderSession`] runs it over a scene, pass by pass, and [`RenderConfig`] is every render
+//! option as a front end (the command line, Python) gives it.
+//!
+//! - [`whitted`]: the course model: the course's Whitted ray tracer plus caustics from a photon
+//!   map, rendered in one go.
+//! - [`path`], [`ppm`], [`gi`]: the physical model, rendered in independent passes that
+//!   converge: a path tracer, progressive photon mapping, Jensen's photon mapping with final
+//!   gathering.
 
+pub mod config;
 pub mod direct;
 pub mod gi;
+pub mod partial;
 pub mod path;
 pub mod ppm;
-pub mod progressive;
+pub mod radius;
+pub mod session;
 pub mod specular_chain;
+pub mod tiles;
 pub mod whitted;
 
-use crate::camera::Camera;
-use crate::film::Film;
+pub use config::RenderConfig;
+pub use session::{PassPlan, RenderOptions, RenderSession, RunSummary};
+pub use tiles::{image_size, ImageSettings};
+
+use crate::error::{Error, Result};
+use crate::math::Vec3;
+use crate::photon::{EstimateSettings, PhotonSettings};
 use crate::progress::Control;
-use crate::sampling::Rng;
-use rayon::prelude::*;
+use gi::GiSettings;
+use path::PathSettings;
+use ppm::PpmSettings;
+use radius::InitialRadius;
+use whitted::WhittedSettings;
 
-/// Image size and sampling.
+/// An integrator and its settings.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ImageSettings {
-    /// Width in pixels.
-    pub width: usize,
-    /// Height in pixels.
-    pub height: usize,
-    /// N for N×N stratified, jittered samples per pixel (1 samples the pixel centre).
+pub enum Integrator {
+    /// The course's Whitted ray tracer with caustics from a photon map.
+    Whitted(WhittedOptions),
+    /// Unidirectional path tracing (the physical model's reference).
+    Path(PathSettings),
+    /// Progressive photon mapping.
+    Ppm(PpmSettings),
+    /// Jensen's photon mapping with final gathering.
+    Gi(GiSettings),
+}
+
+/// Everything the course model's render uses.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WhittedOptions {
+    /// The ray tracer.
+    pub whitted: WhittedSettings,
+    /// The caustic photons (none stored when `target_stored` is 0).
+    pub photons: PhotonSettings,
+    /// How caustic radiance is estimated from them.
+    pub estimate: EstimateSettings,
+    /// N for N×N stratified, jittered samples per pixel.
     pub aa: u32,
-    /// Seed of all random streams.
-    pub seed: u64,
 }
 
-const TILE: usize = 16;
-
-/// Renders every pixel with `sample(screen point, rng, pixel state)`, averaging N×N stratified
-/// samples; the state starts as `S::default()` for each pixel and is shared by its samples.
-/// Returns the film and whether it is complete (false when cancelled).
-pub fn render_tiles<S, F>(settings: &ImageSettings, control: Control, phase: &str, sample: F) -> (Film, bool)
-where
-    S: Default,
-    F: Fn(f32, f32, &mut Rng, &mut S) -> crate::math::Vec3 + Sync,
-{
-    let (w, h) = (settings.width, settings.height);
-    control.progress.start(phase, (w * h) as u64);
-    let aa = settings.aa.max(1);
-    let inv_samples = 1.0 / (aa * aa) as f32;
-    let (pixels, complete) = shade_tiles(w, h, control, true, |x, y| {
-        let mut rng = Rng::new(settings.seed, (y * w + x) as u64);
-        let mut state = S::default();
-        let mut sum = crate::math::Vec3::ZERO;
-        for sy in 0..aa {
-            for sx in 0..aa {
-                let (jx, jy) = if aa == 1 {
-                    (0.5, 0.5)
-                } else {
-                    (rng.uniform(), rng.uniform())
-                };
-                let px = x as f32 + (sx as f32 + jx) / aa as f32;
-                let py = y as f32 + (sy as f32 + jy) / aa as f32;
-                // Screen y runs upwards; film rows run downwards.
-                sum += sample(px / w as f32, 1.0 - py / h as f32, &mut rng, &mut state);
-            }
-        }
-        sum * inv_samples
-    });
-    control.progress.finish();
-    let mut film = Film::new(w, h);
-    film.pixels = pixels;
-    (film, complete)
-}
-
-/// Computes `pixel(x, y)` for every pixel, 16×16 tiles in parallel, into rows from the top;
-/// tiles not begun before cancellation stay black. With `report`, each finished tile advances
-/// the progress by its pixel count. Returns the pixels and whether every tile was done.
-pub(crate) fn shade_tiles<F>(
-    width: usize,
-    height: usize,
-    control: Control,
-    report: bool,
-    pixel: F,
-) -> (Vec<crate::math::Vec3>, bool)
-where
-    F: Fn(usize, usize) -> crate::math::Vec3 + Sync,
-{
-    let tiles_x = width.div_ceil(TILE);
-    let tiles_y = height.div_ceil(TILE);
-    let tiles: Vec<Option<Vec<crate::math::Vec3>>> = (0..tiles_x * tiles_y)
-        .into_par_iter()
-        .map(|tile| {
-            if control.cancelled() {
-                return None;
-            }
-            let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-            let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
-            let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    out.push(pixel(x, y));
-                }
-            }
-            if report {
-                control.progress.advance(out.len() as u64);
-            }
-            Some(out)
-        })
-        .collect();
-    let mut pixels = vec![crate::math::Vec3::ZERO; width * height];
-    let mut complete = true;
-    for (tile, values) in tiles.into_iter().enumerate() {
-        let Some(values) = values else {
-            complete = false;
-            continue;
-        };
-        let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
-        let tw = (x0 + TILE).min(width) - x0;
-        for (i, v) in values.into_iter().enumerate() {
-            pixels[(y0 + i / tw) * width + x0 + i % tw] = v;
+impl Default for WhittedOptions {
+    fn default() -> Self {
+        WhittedOptions {
+            whitted: WhittedSettings::default(),
+            photons: PhotonSettings::default(),
+            estimate: EstimateSettings::default(),
+            aa: 1,
         }
     }
-    (pixels, complete)
 }
 
-/// The image size for a camera: `width` as given, height from the aspect ratio unless given.
-pub fn image_size(camera: &Camera, width: usize, height: Option<usize>) -> (usize, usize) {
-    (width, height.unwrap_or_else(|| camera.height_for_width(width)))
+/// Largest photon count accepted (24 bytes each: 2.4 GB).
+pub const MAX_PHOTONS: usize = 100_000_000;
+
+impl Integrator {
+    /// The integrator's name on the command line.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Integrator::Whitted(_) => "whitted",
+            Integrator::Path(_) => "path",
+            Integrator::Ppm(_) => "ppm",
+            Integrator::Gi(_) => "gi",
+        }
+    }
+
+    /// Whether it renders the physical model in independent passes (every integrator but
+    /// Whitted's).
+    pub fn is_progressive(&self) -> bool {
+        !matches!(self, Integrator::Whitted(_))
+    }
+
+    /// Refuses settings out of their ranges, with the option that is wrong.
+    pub fn validate(&self) -> Result<()> {
+        let invalid = |m: &str| Err(Error::InvalidSettings(m.into()));
+        match self {
+            Integrator::Whitted(o) => {
+                if o.aa == 0 || o.aa > 64 {
+                    return invalid("--aa must be between 1 and 64");
+                }
+                if o.whitted.max_depth > 64 {
+                    return invalid("--depth must be at most 64");
+                }
+                if o.estimate.max_radius.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
+                    return invalid("--radius must be a positive number");
+                }
+                if o.estimate.cone_filter.is_some_and(|c| !(c >= 1.0 && c.is_finite())) {
+                    return invalid("--cone-filter must be 0 (off) or at least 1");
+                }
+                check_k(o.estimate.k)?;
+                check_photons(o.photons.target_stored)
+            }
+            Integrator::Path(s) => check_depth(s.max_depth),
+            Integrator::Ppm(s) => {
+                check_depth(s.max_depth)?;
+                check_alpha(s.alpha)?;
+                check_radius(s.initial_radius)?;
+                check_photons_per_pass(self.name(), s.photons_per_pass)
+            }
+            Integrator::Gi(s) => {
+                check_depth(s.max_depth)?;
+                check_alpha(s.alpha)?;
+                check_radius(s.caustic_radius)?;
+                check_k(s.k_global)?;
+                check_photons_per_pass(self.name(), s.photons_per_pass)
+            }
+        }
+    }
+}
+
+fn check_k(k: usize) -> Result<()> {
+    if k == 0 || k > 10_000 {
+        return Err(Error::InvalidSettings("--k must be between 1 and 10000".into()));
+    }
+    Ok(())
+}
+
+fn check_photons(count: usize) -> Result<()> {
+    if count > MAX_PHOTONS {
+        return Err(Error::InvalidSettings(format!(
+            "{count} photons would need {} MB; at most {MAX_PHOTONS} photons are accepted",
+            count.saturating_mul(24) / 1_000_000
+        )));
+    }
+    Ok(())
+}
+
+fn check_photons_per_pass(name: &str, count: u64) -> Result<()> {
+    if count == 0 {
+        return Err(Error::InvalidSettings(format!(
+            "--integrator {name} needs photons: --photons must be at least 1 (photons per pass)"
+        )));
+    }
+    check_photons(usize::try_from(count).unwrap_or(usize::MAX))
+}
+
+fn check_depth(depth: u32) -> Result<()> {
+    if depth == 0 || depth > 1024 {
+        return Err(Error::InvalidSettings(
+            "--depth must be between 1 and 1024 for the physical integrators".into(),
+        ));
+    }
+    Ok(())
+}
+
+fn check_alpha(alpha: f32) -> Result<()> {
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(Error::InvalidSettings(
+            "--alpha must lie strictly between 0 and 1".into(),
+        ));
+    }
+    Ok(())
+}
+
+fn check_radius(radius: InitialRadius) -> Result<()> {
+    match radius {
+        InitialRadius::Pixels(px) if !(px > 0.0 && px <= 10_000.0) => Err(Error::InvalidSettings(
+            "--footprint must be a positive number of pixels (at most 10000)".into(),
+        )),
+        InitialRadius::World(r) if !(r > 0.0 && r.is_finite()) => {
+            Err(Error::InvalidSettings("--radius must be a positive number".into()))
+        }
+        _ => Ok(()),
+    }
+}
+
+/// An integrator that renders the image as a series of independent passes.
+pub trait Progressive: Send + Sync {
+    /// Renders pass `pass` (global index); `None` when cancelled.
+    fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>>;
 }

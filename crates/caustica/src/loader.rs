@@ -27,6 +27,18 @@ pub fn build_source(source: SceneSource, settings: &BuildSettings, progress: &dy
     crate::scene::build::build_reporting(&source.description, settings, progress).map_err(|e| source.error(e))
 }
 
+/// What identifies a scene in a render's fingerprint, so that only parts of one run merge: a
+/// hash of its text (the same on every machine) and how it was read and built.
+pub fn scene_id(source: &SceneSource, settings: &LoadSettings) -> String {
+    let hash = source.text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    });
+    format!(
+        "{hash:016x} cone-quirks {} dialect {:?}",
+        settings.build.shapes.cone_quirks, settings.read.ray.dialect
+    )
+}
+
 /// Reads and builds scene text; files it refers to resolve against `scene_dir`.
 pub fn from_text(text: &str, scene_dir: &Path, settings: &LoadSettings) -> Result<Scene, ParseError> {
     let scene = format::ray_file::parse(text, scene_dir, &settings.read.ray)?;

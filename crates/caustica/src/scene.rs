@@ -2,6 +2,7 @@
 //! lights and the camera. Built from a scene description by [`build`].
 
 pub mod build;
+pub mod summary;
 
 pub use build::{build, BuildSettings};
 

@@ -8,7 +8,7 @@ use caustica::film::Film;
 use caustica::integrator::gi::{Gi, GiSettings};
 use caustica::integrator::path::{PathSettings, PathTracer};
 use caustica::integrator::ppm::{Ppm, PpmSettings};
-use caustica::integrator::progressive::{Accumulator, Progressive};
+use caustica::integrator::{partial::Accumulator, Progressive};
 use caustica::math::Vec3;
 use common::{control, rel, scene};
 use std::path::PathBuf;

@@ -141,19 +141,14 @@ fn run_case(exe: &Path, case: &Case, threads: Option<usize>) -> Result<Summary> 
             String::from_utf8_lossy(&output.stderr)
         )));
     }
-    let json = String::from_utf8_lossy(&output.stdout);
-    let number = |key: &str| -> f64 {
-        json.split(&format!("\"{key}\":"))
-            .nth(1)
-            .and_then(|rest| rest.split([',', '}']).next())
-            .and_then(|v| v.trim().parse().ok())
-            .unwrap_or(f64::NAN)
-    };
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout)
+        .map_err(|e| Error::InvalidSettings(format!("caustica render --json printed no JSON: {e}")))?;
+    let seconds = |key: &str| json["seconds"][key].as_f64().unwrap_or(f64::NAN);
     Ok(Summary {
-        photons: number("photons"),
-        render: number("render"),
-        total: number("total"),
-        stored: number("photons_stored") as u64,
-        peak_memory: number("peak_memory_bytes") as u64,
+        photons: seconds("photons"),
+        render: seconds("render"),
+        total: seconds("total"),
+        stored: json["photons_stored"].as_u64().unwrap_or(0),
+        peak_memory: json["peak_memory_bytes"].as_u64().unwrap_or(0),
     })
 }

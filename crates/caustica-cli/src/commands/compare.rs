@@ -70,23 +70,18 @@ pub fn run(args: CompareArgs) -> Result<u8> {
         rows.push((region, got, want, error));
     }
     if args.json {
-        let items: Vec<String> = rows
+        let items: Vec<serde_json::Value> = rows
             .iter()
             .map(|(r, g, w, e)| {
-                format!(
-                    "{{\"name\":{},\"mean\":[{},{},{}],\"reference\":[{},{},{}],\"relative_error\":{}}}",
-                    crate::json::string(&r.name),
-                    crate::json::number(g.x as f64),
-                    crate::json::number(g.y as f64),
-                    crate::json::number(g.z as f64),
-                    crate::json::number(w.x as f64),
-                    crate::json::number(w.y as f64),
-                    crate::json::number(w.z as f64),
-                    crate::json::number(*e as f64)
-                )
+                serde_json::json!({
+                    "name": r.name,
+                    "mean": g.to_array(),
+                    "reference": w.to_array(),
+                    "relative_error": e,
+                })
             })
             .collect();
-        println!("[{}]", items.join(","));
+        println!("{}", serde_json::Value::Array(items));
     } else {
         println!("| region | mean R, G, B | reference R, G, B | largest relative error |");
         println!("|---|---|---|---:|");

@@ -1,229 +1,108 @@
-//! `caustica info`: what was parsed.
+//! `caustica info`: what was parsed, from the library's scene summary.
 
-use super::{load_scene, Loaded};
+use super::load_scene;
 use crate::cli::InfoArgs;
-use crate::json;
 use crate::progress::Bars;
-use caustica::light::Light;
-use caustica::material::Channel;
-use caustica::scene::ObjectRef;
-use caustica::Result;
-use std::fmt::Write as _;
+use caustica::scene::summary::{LightSummary, SceneSummary};
+use caustica::{Error, Result};
+use serde::Serialize;
+use serde_json::json;
+
+/// `info --json`: the file, the summary, and the time reading and building took.
+#[derive(Serialize)]
+struct InfoJson<'a> {
+    scene: String,
+    #[serde(flatten)]
+    summary: &'a SceneSummary,
+    seconds: serde_json::Value,
+}
 
 /// Runs the command; returns the exit code.
 pub fn run(args: InfoArgs) -> Result<u8> {
     let loaded = load_scene(Some(&args.scene), &args.scene_args, &Bars::new(false))?;
-    let scene = &loaded.scene;
-    let bounds = scene.bounds();
-    let cam = scene.camera();
+    let summary = loaded.scene.summary();
     if args.json {
-        println!("{}", info_json(&args, &loaded));
+        let info = InfoJson {
+            scene: args.scene.display().to_string(),
+            summary: &summary,
+            seconds: json!({ "parse": loaded.parse_seconds, "build": loaded.build_seconds }),
+        };
+        let text = serde_json::to_string(&info).map_err(|e| Error::InvalidSettings(e.to_string()))?;
+        println!("{text}");
         return Ok(0);
     }
-    println!("scene      {}", args.scene.display());
-    println!(
-        "camera     eye {:?}  look {:?}  aspect {}",
-        cam.eye.to_array(),
-        cam.look.to_array(),
-        cam.aspect_ratio
-    );
-    println!("           u {:?}  v {:?}", cam.u.to_array(), cam.v.to_array());
-    println!("lights     {}", scene.lights().course_lights().count());
-    for light in scene.lights().course_lights() {
-        match light {
-            Light::Point {
-                position,
-                color,
-                attenuation,
-            } => {
-                println!(
-                    "  point        at {:?}  colour {:?}  attenuation {:?}",
-                    position.to_array(),
-                    color.to_array(),
-                    attenuation
-                )
-            }
-            Light::Directional { direction, color } => {
-                println!(
-                    "  directional  towards {:?}  colour {:?}",
-                    direction.to_array(),
-                    color.to_array()
-                )
-            }
-            Light::Area(_) => {}
-        }
-    }
-    let area_lights: Vec<_> = scene.lights().area_lights().collect();
-    if !area_lights.is_empty() {
-        println!(
-            "area lights {} (emissive objects; lights in the physical model)",
-            area_lights.len()
-        );
-        for light in area_lights {
-            println!(
-                "  {:?}  area {:.4}  radiance {:?}{}",
-                light.object,
-                light.area,
-                light.radiance.to_array(),
-                if light.uniform { "" } else { " (textured: mean guess)" }
-            );
-        }
-    }
-    println!("ambient    {:?}", scene.ambient().to_array());
-    println!(
-        "objects    {} shapes, {} meshes ({} triangles)",
-        scene.shapes().len(),
-        scene.meshes().len(),
-        scene.triangles().len()
-    );
-    for (object, b) in scene.objects() {
-        let kind = match object {
-            ObjectRef::Shape(i) => format!("{:?}", scene.shapes()[i as usize].kind),
-            ObjectRef::Mesh(i) => format!("mesh of {} triangles", scene.meshes()[i as usize].indices.len()),
-        };
-        let kind: String = kind.chars().take(60).collect();
-        println!(
-            "  {kind:<60}  material {:>3}  bounds {:?} .. {:?}",
-            scene.object_material(object),
-            b.min.to_array(),
-            b.max.to_array()
-        );
-    }
-    println!("bounds     {:?} .. {:?}", bounds.min.to_array(), bounds.max.to_array());
-    println!(
-        "materials  {}   textures {}",
-        scene.materials().len(),
-        scene.textures().len()
-    );
-    for (i, m) in scene.materials().iter().enumerate() {
-        println!(
-            "  {i:>3}  kd {}  ks {}  kr {}  kt {}  ke {}  ka {}  ns {}  index {}",
-            channel(&m.diffuse),
-            channel(&m.specular),
-            channel(&m.reflective),
-            channel(&m.transmissive),
-            channel(&m.emissive),
-            channel(&m.ambient),
-            channel(&m.shininess),
-            channel(&m.index)
-        );
-    }
-    for warning in scene.warnings() {
-        println!("warning    {warning}");
-    }
+    print!("{}", text(&args.scene.display().to_string(), &summary));
     Ok(0)
 }
 
-fn channel(c: &Channel) -> String {
-    match c {
-        Channel::Constant(v) if v.x == v.y && v.y == v.z => format!("{}", v.x),
-        Channel::Constant(v) => format!("({}, {}, {})", v.x, v.y, v.z),
-        Channel::Texture(i) => format!("texture#{i}"),
+/// The summary as aligned text.
+fn text(scene: &str, s: &SceneSummary) -> String {
+    let mut out = String::new();
+    let mut line = |l: String| {
+        out.push_str(&l);
+        out.push('\n');
+    };
+    let c = &s.camera;
+    line(format!("scene      {scene}"));
+    line(format!(
+        "camera     eye {:?}  look {:?}  aspect {}",
+        c.eye, c.look, c.aspect_ratio
+    ));
+    line(format!("           u {:?}  v {:?}", c.u, c.v));
+    line(format!("lights     {}", s.lights.len()));
+    for light in &s.lights {
+        line(match light {
+            LightSummary::Point {
+                position,
+                color,
+                attenuation,
+            } => format!("  point        at {position:?}  colour {color:?}  attenuation {attenuation:?}"),
+            LightSummary::Directional { direction, color } => {
+                format!("  directional  towards {direction:?}  colour {color:?}")
+            }
+        });
     }
-}
-
-/// Everything the text output shows, as one JSON object.
-fn info_json(args: &InfoArgs, loaded: &Loaded) -> String {
-    let scene = &loaded.scene;
-    let cam = scene.camera();
-    let bounds = scene.bounds();
-    let mut s = String::new();
-    let _ = write!(
-        s,
-        "{{\"scene\":{},\"camera\":{{\"eye\":{},\"look\":{},\"u\":{},\"v\":{},\"aspect_ratio\":{}}},",
-        json::string(&args.scene.display().to_string()),
-        json::numbers(&cam.eye.to_array()),
-        json::numbers(&cam.look.to_array()),
-        json::numbers(&cam.u.to_array()),
-        json::numbers(&cam.v.to_array()),
-        json::number(f64::from(cam.aspect_ratio))
-    );
-    let lights: Vec<String> = scene.lights().course_lights().filter_map(light_json).collect();
-    let objects: Vec<String> = scene
-        .objects()
-        .map(|(object, b)| {
-            let kind = match object {
-                ObjectRef::Shape(i) => format!("{:?}", scene.shapes()[i as usize].kind),
-                ObjectRef::Mesh(_) => "mesh".to_string(),
-            };
-            let triangles = match object {
-                ObjectRef::Shape(_) => String::new(),
-                ObjectRef::Mesh(i) => format!(",\"triangles\":{}", scene.meshes()[i as usize].indices.len()),
-            };
-            format!(
-                "{{\"kind\":{}{triangles},\"material\":{},\"bounds\":{}}}",
-                json::string(&kind),
-                scene.object_material(object),
-                bounds_json(b.min.to_array(), b.max.to_array())
-            )
-        })
-        .collect();
-    let materials: Vec<String> = scene
-        .materials()
-        .iter()
-        .map(|m| {
-            format!(
-                "{{\"diffuse\":{},\"specular\":{},\"reflective\":{},\"transmissive\":{},\"emissive\":{},\"ambient\":{},\"shininess\":{},\"index\":{}}}",
-                channel_json(&m.diffuse),
-                channel_json(&m.specular),
-                channel_json(&m.reflective),
-                channel_json(&m.transmissive),
-                channel_json(&m.emissive),
-                channel_json(&m.ambient),
-                channel_json(&m.shininess),
-                channel_json(&m.index)
-            )
-        })
-        .collect();
-    let _ = write!(
-        s,
-        "\"lights\":[{}],\"area_lights\":{},\"ambient\":{},\"shapes\":{},\"meshes\":{},\"triangles\":{},\"objects\":[{}],\"materials\":[{}],\"textures\":{},\"bounds\":{},\"warnings\":{},\"seconds\":{{\"parse\":{:.4},\"build\":{:.4}}}}}",
-        lights.join(","),
-        scene.lights().area_lights().count(),
-        json::numbers(&scene.ambient().to_array()),
-        scene.shapes().len(),
-        scene.meshes().len(),
-        scene.triangles().len(),
-        objects.join(","),
-        materials.join(","),
-        scene.textures().len(),
-        bounds_json(bounds.min.to_array(), bounds.max.to_array()),
-        json::strings(scene.warnings()),
-        loaded.parse_seconds,
-        loaded.build_seconds
-    );
-    s
-}
-
-fn bounds_json(min: [f32; 3], max: [f32; 3]) -> String {
-    format!("{{\"min\":{},\"max\":{}}}", json::numbers(&min), json::numbers(&max))
-}
-
-/// A constant as `[r, g, b]`, a texture as `{"texture": id}`.
-fn channel_json(c: &Channel) -> String {
-    match c {
-        Channel::Constant(v) => json::numbers(&v.to_array()),
-        Channel::Texture(i) => format!("{{\"texture\":{i}}}"),
+    if !s.area_lights.is_empty() {
+        line(format!(
+            "area lights {} (emissive objects; lights in the physical model)",
+            s.area_lights.len()
+        ));
+        for light in &s.area_lights {
+            line(format!(
+                "  object {}  area {:.4}  radiance {:?}{}",
+                light.object,
+                light.area,
+                light.radiance,
+                if light.uniform { "" } else { " (textured: mean guess)" }
+            ));
+        }
     }
-}
-
-fn light_json(light: &Light) -> Option<String> {
-    Some(match light {
-        Light::Point {
-            position,
-            color,
-            attenuation,
-        } => format!(
-            "{{\"type\":\"point\",\"position\":{},\"color\":{},\"attenuation\":{}}}",
-            json::numbers(&position.to_array()),
-            json::numbers(&color.to_array()),
-            json::numbers(attenuation)
-        ),
-        Light::Directional { direction, color } => format!(
-            "{{\"type\":\"directional\",\"direction\":{},\"color\":{}}}",
-            json::numbers(&direction.to_array()),
-            json::numbers(&color.to_array())
-        ),
-        Light::Area(_) => return None,
-    })
+    line(format!("ambient    {:?}", s.ambient));
+    line(format!(
+        "objects    {} shapes, {} meshes ({} triangles)",
+        s.shapes, s.meshes, s.triangles
+    ));
+    for object in &s.objects {
+        let kind = match (object.triangles, object.details.is_empty()) {
+            (Some(n), _) => format!("mesh of {n} triangles"),
+            (None, true) => object.kind.clone(),
+            (None, false) => format!("{} ({})", object.kind, object.details),
+        };
+        line(format!(
+            "  {kind:<44}  material {:>3}  bounds {:?} .. {:?}",
+            object.material, object.bounds.min, object.bounds.max
+        ));
+    }
+    line(format!("bounds     {:?} .. {:?}", s.bounds.min, s.bounds.max));
+    line(format!("materials  {}   textures {}", s.materials.len(), s.textures));
+    for (i, m) in s.materials.iter().enumerate() {
+        line(format!(
+            "  {i:>3}  kd {}  ks {}  kr {}  kt {}  ke {}  ka {}  ns {}  index {}",
+            m.diffuse, m.specular, m.reflective, m.transmissive, m.emissive, m.ambient, m.shininess, m.index
+        ));
+    }
+    for warning in &s.warnings {
+        line(format!("warning    {warning}"));
+    }
+    out
 }

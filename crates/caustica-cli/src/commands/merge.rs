@@ -1,8 +1,9 @@
 //! `caustica merge`: the partial files of a split progressive run, combined into one image.
 
 use crate::cli::MergeArgs;
+use caustica::film::ToneMap;
 use caustica::image_io::ImageFormat;
-use caustica::integrator::progressive::Accumulator;
+use caustica::integrator::partial::Accumulator;
 use caustica::{Error, Result};
 
 /// Runs the command; returns the exit code.
@@ -25,7 +26,15 @@ pub fn run(args: MergeArgs) -> Result<u8> {
             other => other,
         })?;
     }
-    super::progressive::save_merged(&merged, &args.output, args.partial.as_deref(), args.exposure)?;
+    merged.film().save(
+        &args.output,
+        ToneMap::Reinhard {
+            exposure: args.exposure,
+        },
+    )?;
+    if let Some(p) = &args.partial {
+        merged.save(p)?;
+    }
     if !args.quiet {
         let ranges: Vec<String> = merged.passes.iter().map(|(a, b)| format!("{a}..{b}")).collect();
         eprintln!(

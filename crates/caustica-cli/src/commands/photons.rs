@@ -1,15 +1,17 @@
 //! `caustica photons`: the stored caustic photons drawn through the camera, and a PLY dump.
 
-use super::{check_image_size, load_scene, photon_settings, thread_pool};
+use super::shown;
+use super::{load_scene, photon_settings, thread_pool};
 use crate::cli::PhotonArgs;
-use crate::json;
 use crate::progress::Bars;
 use caustica::film::ToneMap;
 use caustica::integrator::image_size;
+use caustica::integrator::session::check_image_size;
 use caustica::photon::picture::{draw_photons, write_ply};
 use caustica::photon::PhotonMap;
 use caustica::progress::Control;
 use caustica::Result;
+use serde_json::json;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
@@ -46,20 +48,25 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let total = start.elapsed().as_secs_f64();
     let s = &map.stats;
     if args.json {
-        println!(
-            "{{\"output\":{},\"ply\":{},\"width\":{width},\"height\":{height},\"photons_stored\":{},\"photons_emitted\":{},\"useful_fraction\":{:.4},\"cap_reached\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{:.4},\"build\":{:.4},\"photons\":{photon_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
-            json::string(&args.output.display().to_string()),
-            args.ply
-                .as_ref()
-                .map_or("null".to_string(), |p| json::string(&p.display().to_string())),
-            s.stored,
-            s.emitted,
-            s.useful_fraction(),
-            s.cap_reached,
-            loaded.parse_seconds,
-            loaded.build_seconds,
-            super::peak_memory_bytes().map_or("null".to_string(), |b| b.to_string()),
-        );
+        let summary = json!({
+            "output": args.output.display().to_string(),
+            "ply": shown(&args.ply),
+            "width": width,
+            "height": height,
+            "photons_stored": s.stored,
+            "photons_emitted": s.emitted,
+            "useful_fraction": s.useful_fraction(),
+            "cap_reached": s.cap_reached,
+            "complete": complete,
+            "seconds": {
+                "parse": loaded.parse_seconds,
+                "build": loaded.build_seconds,
+                "photons": photon_seconds,
+                "total": total,
+            },
+            "peak_memory_bytes": super::peak_memory_bytes(),
+        });
+        println!("{summary}");
     } else if !args.quiet {
         eprintln!(
             "{}{}: {} photons stored of {} emitted ({:.1}% useful){} — parse {:.2} s, build {:.2} s, photons {photon_seconds:.2} s, total {total:.2} s{}",

@@ -1,84 +1,151 @@
-//! `caustica render`: photons (when the scene can make caustics), then the image.
+//! `caustica render`: the options become a render session of the library, which this command
+//! runs with progress bars, saving the image (and the partial sums) as it goes.
 
-use super::{check_image_size, load_scene, photon_settings, thread_pool};
+use super::shown;
+use super::{check_photon_memory, load_scene, thread_pool};
 use crate::cli::RenderArgs;
 use crate::progress::Bars;
 use caustica::film::ToneMap;
 use caustica::image_io::ImageFormat;
-use caustica::integrator::whitted::{self, WhittedSettings};
-use caustica::integrator::{image_size, ImageSettings};
-use caustica::photon::{EstimateSettings, PhotonMap};
+use caustica::integrator::config::{IntegratorKind, Model};
+use caustica::integrator::{Integrator, RenderConfig, RenderSession};
+use caustica::light::Light;
 use caustica::progress::Control;
+use caustica::scene::Scene;
 use caustica::{Error, Result};
+use serde_json::json;
+use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
+/// The library's render options from the command line.
+pub fn config(args: &RenderArgs) -> Result<RenderConfig> {
+    let p = &args.progressive;
+    Ok(RenderConfig {
+        model: p.model.as_deref().map(str::parse::<Model>).transpose()?,
+        integrator: p.integrator.as_deref().map(str::parse).transpose()?,
+        width: args.width,
+        height: args.height,
+        aa: args.aa,
+        depth: args.depth,
+        seed: args.seed,
+        photons: args.photon.photons,
+        max_emitted: args.photon.max_emitted,
+        photons_per_light: args.photon.photons_per_light.clone(),
+        no_aim: args.photon.no_aim,
+        k: args.k,
+        radius: args.radius,
+        cone_filter: args.cone_filter,
+        no_estimate_reuse: args.no_estimate_reuse,
+        passes: p.passes.clone(),
+        time: p.time,
+        footprint: p.footprint,
+        alpha: p.alpha,
+        no_camera_specular: p.no_camera_specular,
+    })
+}
+
 /// Runs the command; returns the exit code.
 pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
-    if let Some(integrator) = super::progressive::integrator_for(&args.progressive)? {
-        return super::progressive::run(args, integrator, cancel);
-    }
     let start = Instant::now();
-    if args.progressive.partial.is_some() || args.progressive.passes.is_some() || args.progressive.time.is_some() {
+    let config = config(&args)?;
+    let options = &args.progressive;
+    if config.integrator_kind()? != IntegratorKind::Path {
+        check_photon_memory(config.photon_total(), args.photon.max_memory)?;
+    }
+    let integrator = config.integrator()?;
+    let progressive = integrator.is_progressive();
+    let plan = config.plan()?;
+    if !progressive && options.partial.is_some() {
         return Err(Error::InvalidSettings(
             "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
         ));
     }
-    let output = args.output.clone().unwrap_or_else(|| "caustica.png".into());
-    let depth = args.depth.unwrap_or(5);
-    ImageFormat::from_path(&output)?;
-    if args.aa == 0 || args.aa > 64 {
-        return Err(Error::InvalidSettings("--aa must be between 1 and 64".into()));
-    }
-    if depth > 64 {
-        return Err(Error::InvalidSettings("--depth must be at most 64".into()));
-    }
-    if args.radius.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
-        return Err(Error::InvalidSettings("--radius must be a positive number".into()));
-    }
-    if !(args.cone_filter == 0.0 || args.cone_filter >= 1.0) {
+    if !options.exposure.is_finite() || options.exposure.abs() > 64.0 {
         return Err(Error::InvalidSettings(
-            "--cone-filter must be 0 (off) or at least 1".into(),
+            "--exposure must be a number of stops between -64 and 64".into(),
         ));
     }
-    if args.k == 0 || args.k > 10_000 {
-        return Err(Error::InvalidSettings("--k must be between 1 and 10000".into()));
+    if !(options.save_every > 0.0 && options.save_every.is_finite()) {
+        return Err(Error::InvalidSettings(
+            "--save-every must be a positive number of seconds".into(),
+        ));
     }
-    let photons = photon_settings(&args.photon, args.seed)?;
+    // An image, unless only a partial file is asked for.
+    let output: Option<PathBuf> = match (&args.output, &options.partial) {
+        (Some(o), _) => Some(o.clone()),
+        (None, Some(_)) => None,
+        (None, None) => Some("caustica.png".into()),
+    };
+    if let Some(o) = &output {
+        ImageFormat::from_path(o)?;
+    }
     let pool = thread_pool(args.threads)?;
-    let bars = Bars::new(args.quiet || args.json);
+    let quiet = args.quiet || args.json;
+    let bars = Bars::new(quiet);
     let control = Control {
         progress: &bars,
         cancel,
     };
 
     let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
-    let (scene, parse_seconds, build_seconds) = (loaded.scene, loaded.parse_seconds, loaded.build_seconds);
-    if !args.quiet {
+    let scene = &loaded.scene;
+    if !quiet {
         for warning in scene.warnings() {
             eprintln!("warning: {warning}");
         }
+        if progressive {
+            for note in physical_notes(scene) {
+                eprintln!("note: {note}");
+            }
+            let ignored = config.ignored_by_physical();
+            if !ignored.is_empty() {
+                eprintln!(
+                    "note: {} only apply to the course model's Whitted renderer; ignored here",
+                    ignored.join(", ")
+                );
+            }
+        }
     }
-    let (width, height) = image_size(scene.camera(), args.width, args.height);
-    check_image_size(width, height)?;
-
-    let estimate = EstimateSettings {
-        k: args.k,
-        max_radius: args.radius,
-        cone_filter: (args.cone_filter > 0.0).then_some(args.cone_filter),
-        ..EstimateSettings::default()
+    let mut session = RenderSession::new(scene, config.render_options(loaded.scene_id.clone())?)?;
+    let (width, height) = session.size();
+    let tone_map = if progressive {
+        ToneMap::Reinhard {
+            exposure: options.exposure,
+        }
+    } else {
+        ToneMap::Clamp
     };
-    let t_photons = Instant::now();
-    let map = if photons.target_stored > 0 {
-        let map = pool.install(|| PhotonMap::trace(&scene, &photons, estimate.k, control));
-        if !args.quiet && !args.json {
-            let s = &map.stats;
+    let save = |session: &RenderSession| -> Result<()> {
+        if let Some(o) = &output {
+            session.image().save(o, tone_map)?;
+        }
+        if let Some(p) = &options.partial {
+            session.accumulator().save(p)?;
+        }
+        Ok(())
+    };
+
+    let mut last_save = Instant::now();
+    let summary = pool.install(|| {
+        session.run(&plan, control, |session| {
+            // Progressive renders are rewritten as they converge; the final save is below.
+            if progressive && last_save.elapsed().as_secs_f64() >= options.save_every {
+                save(session)?;
+                last_save = Instant::now();
+            }
+            Ok(())
+        })
+    })?;
+    let photon_stats = session.caustic_map().map(|m| m.stats.clone());
+    if !quiet {
+        if let Some(s) = &photon_stats {
             eprintln!(
                 "photons: {} emitted, {} stored ({:.1}% useful) in {:.2} s{}",
                 s.emitted,
                 s.stored,
                 100.0 * s.useful_fraction(),
-                t_photons.elapsed().as_secs_f64(),
+                summary.photon_seconds,
                 if s.cap_reached {
                     " — emission cap reached before the budget was stored"
                 } else {
@@ -89,48 +156,122 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 eprintln!("photons: none stored (the scene has no mirror or glass that lights reach): no caustics");
             }
         }
-        Some(map)
-    } else {
-        None
-    };
-    let photon_seconds = t_photons.elapsed().as_secs_f64();
-
-    let image = ImageSettings {
-        width,
-        height,
-        aa: args.aa,
-        seed: args.seed,
-    };
-    let settings = WhittedSettings {
-        max_depth: depth,
-        reuse_caustic_estimates: !args.no_estimate_reuse,
-        ..WhittedSettings::default()
-    };
-    let t_render = Instant::now();
-    let caustics = map.as_ref().filter(|m| !m.is_empty()).map(|m| (m, &estimate));
-    let (film, complete) = pool.install(|| whitted::render(&scene, caustics, &settings, &image, control));
-    let render_seconds = t_render.elapsed().as_secs_f64();
-    film.save(&output, ToneMap::Clamp)?;
+    }
+    let passes_done = session.accumulator().pass_count();
+    if passes_done == 0 {
+        eprintln!("interrupted before the first pass finished: nothing was saved");
+        return Ok(crate::EXIT_INTERRUPTED);
+    }
+    save(&session)?;
 
     let total = start.elapsed().as_secs_f64();
-    let stored = map.as_ref().map_or(0, |m| m.stats.stored);
+    let complete = summary.complete;
+    let (parse_seconds, build_seconds) = (loaded.parse_seconds, loaded.build_seconds);
+    let ranges: Vec<String> = session
+        .accumulator()
+        .passes
+        .iter()
+        .map(|(a, b)| format!("{a}..{b}"))
+        .collect();
+    let photons_per_pass = match session.integrator() {
+        Integrator::Ppm(s) => s.photons_per_pass,
+        Integrator::Gi(s) => s.photons_per_pass,
+        _ => 0,
+    };
     if args.json {
-        println!(
-            "{{\"output\":{},\"width\":{width},\"height\":{height},\"samples_per_pixel\":{},\"photons_stored\":{stored},\"photons_emitted\":{},\"complete\":{complete},\"seconds\":{{\"parse\":{parse_seconds:.4},\"build\":{build_seconds:.4},\"photons\":{photon_seconds:.4},\"render\":{render_seconds:.4},\"total\":{total:.4}}},\"peak_memory_bytes\":{}}}",
-            crate::json::string(&output.display().to_string()),
-            args.aa * args.aa,
-            map.as_ref().map_or(0, |m| m.stats.emitted),
-            super::peak_memory_bytes().map_or("null".to_string(), |b| b.to_string()),
-        );
+        let summary = if progressive {
+            json!({
+                "output": shown(&output),
+                "partial": shown(&options.partial),
+                "integrator": session.integrator().name(),
+                "model": "physical",
+                "width": width,
+                "height": height,
+                "passes": passes_done,
+                "pass_ranges": ranges.join(","),
+                "photons_per_pass": photons_per_pass,
+                "complete": complete,
+                "seconds": {
+                    "parse": parse_seconds,
+                    "build": build_seconds,
+                    "render": summary.render_seconds,
+                    "total": total,
+                },
+                "peak_memory_bytes": super::peak_memory_bytes(),
+            })
+        } else {
+            let aa = config.aa;
+            json!({
+                "output": shown(&output),
+                "integrator": "whitted",
+                "model": "course",
+                "width": width,
+                "height": height,
+                "samples_per_pixel": aa * aa,
+                "photons_stored": photon_stats.as_ref().map_or(0, |s| s.stored),
+                "photons_emitted": photon_stats.as_ref().map_or(0, |s| s.emitted),
+                "complete": complete,
+                "seconds": {
+                    "parse": parse_seconds,
+                    "build": build_seconds,
+                    "photons": summary.photon_seconds,
+                    "render": summary.render_seconds,
+                    "total": total,
+                },
+                "peak_memory_bytes": super::peak_memory_bytes(),
+            })
+        };
+        println!("{summary}");
     } else if !args.quiet {
-        eprintln!(
-            "{} {}×{} at {} spp, {stored} photons stored — parse {parse_seconds:.2} s, build {build_seconds:.2} s, photons {photon_seconds:.2} s, render {render_seconds:.2} s, total {total:.2} s{}",
-            output.display(),
-            width,
-            height,
-            args.aa * args.aa,
-            if complete { "" } else { " (interrupted: partial image)" }
-        );
+        if progressive {
+            let written: Vec<String> = [&output, &options.partial]
+                .into_iter()
+                .flatten()
+                .map(|p| p.display().to_string())
+                .collect();
+            eprintln!(
+                "{} {width}×{height}, {passes_done} {} passes ({}){} — parse {parse_seconds:.2} s, build {build_seconds:.2} s, render {:.2} s, total {total:.2} s{}",
+                written.join(" and "),
+                session.integrator().name(),
+                ranges.join(","),
+                if photons_per_pass > 0 {
+                    format!(", {photons_per_pass} photons a pass")
+                } else {
+                    String::new()
+                },
+                summary.render_seconds,
+                if complete { "" } else { " (interrupted: the passes done are saved)" }
+            );
+        } else {
+            let stored = photon_stats.as_ref().map_or(0, |s| s.stored);
+            eprintln!(
+                "{} {width}×{height} at {} spp, {stored} photons stored — parse {parse_seconds:.2} s, build {build_seconds:.2} s, photons {:.2} s, render {:.2} s, total {total:.2} s{}",
+                output.as_ref().map_or(String::new(), |o| o.display().to_string()),
+                config.aa * config.aa,
+                summary.photon_seconds,
+                summary.render_seconds,
+                if complete { "" } else { " (interrupted: partial image)" }
+            );
+        }
     }
     Ok(if complete { 0 } else { crate::EXIT_INTERRUPTED })
+}
+
+/// What the physical model reads differently from the course's shading.
+fn physical_notes(scene: &Scene) -> Vec<String> {
+    let mut notes = Vec::new();
+    let attenuated = scene
+        .lights()
+        .iter()
+        .filter(|l| matches!(l, Light::Point { attenuation, .. } if *attenuation != [0.0, 0.0, 1.0]))
+        .count();
+    if attenuated > 0 {
+        notes.push(format!(
+            "the physical model ignores the attenuation coefficients of {attenuated} point light(s): light falls off with the inverse square"
+        ));
+    }
+    if scene.ambient() != caustica::math::Vec3::ZERO {
+        notes.push("the physical model ignores ambient light: indirect light is computed".into());
+    }
+    notes
 }

@@ -16,9 +16,11 @@
 //! estimation and the caustic map already count those paths.
 
 use super::direct::direct_light;
-use super::ppm::{pixel_angle, InitialRadius, PHOTON_SEED};
-use super::progressive::{radius_factor, sample_pass, Progressive};
+use super::ppm::PHOTON_SEED;
+use super::radius::{pixel_angle, radius_factor, InitialRadius};
 use super::specular_chain::camera_chain;
+use super::tiles::sample_pass;
+use super::Progressive;
 use crate::bsdf::{Bsdf, Transport};
 use crate::math::{offset_origin, Ray, Vec3};
 use crate::photon::is_caustic;

@@ -115,10 +115,10 @@ impl<'a> PathTracer<'a> {
     }
 }
 
-impl super::progressive::Progressive for PathTracer<'_> {
+impl super::Progressive for PathTracer<'_> {
     fn render_pass(&self, pass: u64, control: crate::progress::Control) -> Option<Vec<Vec3>> {
         let camera = self.scene.camera();
-        super::progressive::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
+        super::tiles::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             radiance(self.scene, &self.settings, camera.generate_ray(sx, sy), rng)
         })
     }

@@ -10,8 +10,10 @@
 //! from the photons within the pass's radius.
 
 use super::direct::direct_light;
-use super::progressive::{radius_factor, sample_pass, Progressive};
+use super::radius::{pixel_angle, radius_factor, InitialRadius};
 use super::specular_chain::camera_chain;
+use super::tiles::sample_pass;
+use super::Progressive;
 use crate::math::{Ray, Vec3};
 use crate::photon::is_direct;
 use crate::photon::map::PhotonMap;
@@ -19,32 +21,6 @@ use crate::photon::trace::trace_count;
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
-
-/// How the first pass's gather radius is chosen.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum InitialRadius {
-    /// This many pixels wide where the camera path meets the surface (its footprint), so the
-    /// blur starts at a size the user sees and shrinks from there.
-    Pixels(f32),
-    /// A fixed radius in scene units.
-    World(f32),
-}
-
-impl InitialRadius {
-    /// The first pass's radius at a point `path_length` from the eye along the camera path,
-    /// for pixels `pixel_angle` wide at unit distance.
-    pub fn at(self, pixel_angle: f32, path_length: f32) -> f32 {
-        match self {
-            InitialRadius::Pixels(px) => px * pixel_angle * path_length,
-            InitialRadius::World(r) => r,
-        }
-    }
-}
-
-/// Width of a pixel at unit distance from the eye, `height` pixels high.
-pub fn pixel_angle(camera: &crate::camera::Camera, height: usize) -> f32 {
-    camera.v.length() / camera.look.length().max(1e-30) / height.max(1) as f32
-}
 
 /// Settings of progressive photon mapping.
 #[derive(Clone, Debug, PartialEq)]

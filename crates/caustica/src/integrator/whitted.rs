@@ -184,7 +184,7 @@ pub fn render(
 ) -> (crate::film::Film, bool) {
     let camera = scene.camera();
     let reuse = settings.reuse_caustic_estimates;
-    super::render_tiles(image, control, "render", |sx, sy, _rng, pixel: &mut PixelCaustic| {
+    super::tiles::render_tiles(image, control, "render", |sx, sy, _rng, pixel: &mut PixelCaustic| {
         let ray = camera.generate_ray(sx, sy);
         let Some((map, estimate)) = caustics else {
             return radiance(

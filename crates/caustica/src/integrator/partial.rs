@@ -1,56 +1,17 @@
-//! Rendering in independent passes, and their sums kept, saved, loaded and merged.
+//! The sums of a run's passes, kept, saved, loaded and merged.
 //!
-//! Every pass is a complete, independent estimate of the image: one jittered camera sample per
-//! pixel and, for the photon integrators, a photon map of its own. Pass `i` draws from random
-//! streams derived from (seed, i) alone, and the photon radius of pass `i` depends on `i` alone,
-//! so passes can run in any order, on any machine: the average of the passes of several partial
-//! runs equals the average of one run over all of them.
+//! Every pass is a complete, independent estimate of the image, and pass `i` depends on (seed,
+//! i) alone, so passes can run in any order, on any machine: the average of the passes of
+//! several partial runs equals the average of one run over all of them.
 //!
 //! A partial file (`.part`) holds the sums of a run's passes: a short text header (format, image
 //! size, the run's settings fingerprint, the passes it holds) and then the sums as little-endian
 //! f64 triples, rows from the top.
 
-use super::shade_tiles;
 use crate::error::{Error, Result};
 use crate::film::Film;
 use crate::math::Vec3;
-use crate::progress::Control;
-use crate::sampling::Rng;
 use std::path::Path;
-
-/// An integrator that renders the image as a series of independent passes.
-pub trait Progressive: Sync {
-    /// Renders pass `pass` (global index) at `width`×`height`; `None` when cancelled.
-    fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>>;
-}
-
-/// One jittered sample per pixel of pass `pass`: `sample(sx, sy, rng)` with screen coordinates
-/// in [0, 1]² (y up). Tiles run in parallel; the result does not depend on the thread count.
-pub fn sample_pass<F>(
-    width: usize,
-    height: usize,
-    seed: u64,
-    pass: u64,
-    control: Control,
-    sample: F,
-) -> Option<Vec<Vec3>>
-where
-    F: Fn(f32, f32, &mut Rng) -> Vec3 + Sync,
-{
-    let (pixels, complete) = shade_tiles(width, height, control, false, |x, y| {
-        let mut rng = Rng::new(seed, (pass << 32) ^ (y * width + x) as u64);
-        let (jx, jy) = (rng.uniform(), rng.uniform());
-        let sx = (x as f32 + jx) / width as f32;
-        let sy = 1.0 - (y as f32 + jy) / height as f32;
-        let v = sample(sx, sy, &mut rng);
-        if v.is_finite() {
-            v
-        } else {
-            Vec3::ZERO
-        }
-    });
-    complete.then_some(pixels)
-}
 
 /// The sums of a set of passes.
 #[derive(Clone, Debug, PartialEq)]
@@ -253,58 +214,9 @@ fn parse_ranges(text: &str) -> Option<Vec<(u64, u64)>> {
         .collect()
 }
 
-/// The radius factor of pass `pass` (0-based) in Knaus & Zwicker's progressive photon mapping:
-/// r²ᵢ₊₁ = r²ᵢ (i + α) / (i + 1) for 1-based i, so r_pass = r_0 · √(Π_{k=1}^{pass} (k + α)/(k + 1)).
-pub fn radius_factor(pass: u64, alpha: f32) -> f32 {
-    let alpha = alpha as f64;
-    let log = if pass <= DIRECT_PRODUCT_PASSES {
-        (1..=pass).map(|k| ((k as f64 + alpha) / (k as f64 + 1.0)).ln()).sum()
-    } else {
-        // The product is Γ(n + 1 + α) / (Γ(1 + α) Γ(n + 2)): constant time for any pass.
-        let n = pass as f64;
-        ln_gamma(n + 1.0 + alpha) - ln_gamma(1.0 + alpha) - ln_gamma(n + 2.0)
-    };
-    (0.5 * log).exp() as f32
-}
-
-/// Passes up to which the radius product is summed term by term.
-const DIRECT_PRODUCT_PASSES: u64 = 4096;
-
-/// ln Γ(x) for x ≥ 1: shifted up to 8, then Stirling's series (error below 1e-10).
-fn ln_gamma(mut x: f64) -> f64 {
-    let mut shift = 0.0;
-    while x < 8.0 {
-        shift -= x.ln();
-        x += 1.0;
-    }
-    let inv = 1.0 / x;
-    let inv2 = inv * inv;
-    shift + (x - 0.5) * x.ln() - x
-        + 0.5 * (2.0 * std::f64::consts::PI).ln()
-        + inv * (1.0 / 12.0 - inv2 * (1.0 / 360.0 - inv2 / 1260.0))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn radius_schedule_follows_the_recurrence() {
-        assert_eq!(radius_factor(0, 0.7), 1.0);
-        let r1 = radius_factor(1, 0.7);
-        assert!((r1 * r1 - 1.7 / 2.0).abs() < 1e-6);
-        let (r9, r10) = (radius_factor(9, 0.7), radius_factor(10, 0.7));
-        assert!((r10 * r10 / (r9 * r9) - 10.7 / 11.0).abs() < 1e-5);
-        // r² falls like i^(α−1): a thousand passes shrink it by about 1000^0.3.
-        let r1000 = radius_factor(1000, 0.7);
-        assert!(r1000 * r1000 < 0.2 && r1000 * r1000 > 0.05, "{r1000}");
-        // The closed form used past 4096 passes continues the product.
-        let direct: f64 = (1..=5000u64).map(|k| ((k as f64 + 0.7) / (k as f64 + 1.0)).ln()).sum();
-        let direct = (0.5 * direct).exp() as f32;
-        assert!((radius_factor(5000, 0.7) / direct - 1.0).abs() < 1e-5);
-        let far = radius_factor(u32::MAX as u64, 0.7);
-        assert!(far > 0.0 && far < radius_factor(5000, 0.7));
-    }
 
     #[test]
     fn accumulations_merge_save_and_load() {

@@ -1,0 +1,310 @@
+//! Every render option by its command-line name, with the command line's defaults: what a
+//! front end (the `caustica` binary, the Python module) fills in and turns into an
+//! [`Integrator`] and a [`PassPlan`]. Both front ends go through here, so the same options give
+//! the same image.
+
+use super::gi::GiSettings;
+use super::path::PathSettings;
+use super::ppm::PpmSettings;
+use super::radius::InitialRadius;
+use super::session::{PassPlan, RenderOptions};
+use super::whitted::WhittedSettings;
+use super::{Integrator, WhittedOptions};
+use crate::error::{Error, Result};
+use crate::photon::{EstimateSettings, PhotonSettings};
+use std::str::FromStr;
+
+/// The shading model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Model {
+    /// The `.ray` look: the course's Whitted shading and caustics.
+    Course,
+    /// Radiometric units, inverse-square lights, Fresnel glass, emissive objects as lights.
+    Physical,
+}
+
+impl FromStr for Model {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<Model> {
+        match s {
+            "course" => Ok(Model::Course),
+            "physical" => Ok(Model::Physical),
+            other => Err(Error::InvalidSettings(format!(
+                "unknown model `{other}`: expected course or physical"
+            ))),
+        }
+    }
+}
+
+/// An integrator by name.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorKind {
+    /// The course model's Whitted ray tracer with caustics.
+    Whitted,
+    /// Path tracing.
+    Path,
+    /// Progressive photon mapping.
+    Ppm,
+    /// Jensen's photon mapping with final gathering.
+    Gi,
+}
+
+impl IntegratorKind {
+    /// The name on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Whitted => "whitted",
+            IntegratorKind::Path => "path",
+            IntegratorKind::Ppm => "ppm",
+            IntegratorKind::Gi => "gi",
+        }
+    }
+}
+
+impl FromStr for IntegratorKind {
+    type Err = Error;
+
+    fn from_str(s: &str) -> Result<IntegratorKind> {
+        match s {
+            "whitted" => Ok(IntegratorKind::Whitted),
+            "path" => Ok(IntegratorKind::Path),
+            "ppm" => Ok(IntegratorKind::Ppm),
+            "gi" => Ok(IntegratorKind::Gi),
+            other => Err(Error::InvalidSettings(format!(
+                "unknown integrator `{other}`: expected whitted, path, ppm or gi"
+            ))),
+        }
+    }
+}
+
+/// Every option of `caustica render` that shapes the image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderConfig {
+    /// `--model`.
+    pub model: Option<Model>,
+    /// `--integrator`.
+    pub integrator: Option<IntegratorKind>,
+    /// `--width`.
+    pub width: usize,
+    /// `--height`.
+    pub height: Option<usize>,
+    /// `--aa`.
+    pub aa: u32,
+    /// `--depth` (5 for whitted, 64 for the physical integrators).
+    pub depth: Option<u32>,
+    /// `--seed`.
+    pub seed: u64,
+    /// `--photons`: caustic photons to store (course), photons emitted per pass (physical).
+    pub photons: usize,
+    /// `--max-emitted`.
+    pub max_emitted: Option<u64>,
+    /// `--photons-per-light`.
+    pub photons_per_light: Option<Vec<usize>>,
+    /// `--no-aim`.
+    pub no_aim: bool,
+    /// `--k`.
+    pub k: usize,
+    /// `--radius`.
+    pub radius: Option<f32>,
+    /// `--cone-filter` (0: off).
+    pub cone_filter: f32,
+    /// `--no-estimate-reuse`.
+    pub no_estimate_reuse: bool,
+    /// `--passes`: N or A..B.
+    pub passes: Option<String>,
+    /// `--time`.
+    pub time: Option<f64>,
+    /// `--footprint`.
+    pub footprint: f32,
+    /// `--alpha`.
+    pub alpha: f32,
+    /// `--no-camera-specular`.
+    pub no_camera_specular: bool,
+}
+
+impl Default for RenderConfig {
+    fn default() -> Self {
+        RenderConfig {
+            model: None,
+            integrator: None,
+            width: 512,
+            height: None,
+            aa: 1,
+            depth: None,
+            seed: 0,
+            photons: 200_000,
+            max_emitted: None,
+            photons_per_light: None,
+            no_aim: false,
+            k: 100,
+            radius: None,
+            cone_filter: 1.1,
+            no_estimate_reuse: false,
+            passes: None,
+            time: None,
+            footprint: 2.0,
+            alpha: 2.0 / 3.0,
+            no_camera_specular: false,
+        }
+    }
+}
+
+impl RenderConfig {
+    /// The integrator `--model` and `--integrator` ask for: whitted for the course model (the
+    /// default), ppm for the physical model unless named.
+    pub fn integrator_kind(&self) -> Result<IntegratorKind> {
+        match (self.model, self.integrator) {
+            (Some(Model::Course), Some(kind)) if kind != IntegratorKind::Whitted => {
+                Err(Error::InvalidSettings(format!(
+                    "--integrator {} renders the physical model; drop --model course (or use --integrator whitted)",
+                    kind.name()
+                )))
+            }
+            (Some(Model::Physical), Some(IntegratorKind::Whitted)) => Err(Error::InvalidSettings(
+                "the whitted integrator renders the course model; with --model physical use path, ppm or gi".into(),
+            )),
+            (Some(Model::Physical), None) => Ok(IntegratorKind::Ppm),
+            (_, Some(kind)) => Ok(kind),
+            (_, None) => Ok(IntegratorKind::Whitted),
+        }
+    }
+
+    /// Photons to store, summed over lights when given per light.
+    pub fn photon_total(&self) -> usize {
+        match &self.photons_per_light {
+            Some(counts) => counts.iter().fold(0usize, |a, b| a.saturating_add(*b)),
+            None => self.photons,
+        }
+    }
+
+    /// The course model's photon settings.
+    pub fn photon_settings(&self) -> PhotonSettings {
+        PhotonSettings {
+            target_stored: self.photon_total(),
+            max_emitted: self.max_emitted.unwrap_or(0),
+            aim: !self.no_aim,
+            seed: self.seed,
+            per_light: self.photons_per_light.clone(),
+            ..PhotonSettings::default()
+        }
+    }
+
+    /// The integrator with its settings (checked).
+    pub fn integrator(&self) -> Result<Integrator> {
+        let kind = self.integrator_kind()?;
+        let progressive = kind != IntegratorKind::Whitted;
+        if !progressive && (self.passes.is_some() || self.time.is_some()) {
+            return Err(Error::InvalidSettings(
+                "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
+            ));
+        }
+        let depth = self.depth.unwrap_or(if progressive { 64 } else { 5 });
+        let initial_radius = match self.radius {
+            Some(r) => InitialRadius::World(r),
+            None => InitialRadius::Pixels(self.footprint),
+        };
+        let specular_camera_paths = !self.no_camera_specular;
+        let photons_per_pass = self.photon_total() as u64;
+        let integrator = match kind {
+            IntegratorKind::Whitted => Integrator::Whitted(WhittedOptions {
+                whitted: WhittedSettings {
+                    max_depth: depth,
+                    reuse_caustic_estimates: !self.no_estimate_reuse,
+                    ..WhittedSettings::default()
+                },
+                photons: self.photon_settings(),
+                estimate: EstimateSettings {
+                    k: self.k,
+                    max_radius: self.radius,
+                    cone_filter: (self.cone_filter != 0.0).then_some(self.cone_filter),
+                    ..EstimateSettings::default()
+                },
+                aa: self.aa,
+            }),
+            IntegratorKind::Path => Integrator::Path(PathSettings {
+                max_depth: depth,
+                specular_camera_paths,
+                ..PathSettings::default()
+            }),
+            IntegratorKind::Ppm => Integrator::Ppm(PpmSettings {
+                photons_per_pass,
+                alpha: self.alpha,
+                initial_radius,
+                max_depth: depth,
+                specular_camera_paths,
+            }),
+            IntegratorKind::Gi => Integrator::Gi(GiSettings {
+                photons_per_pass,
+                k_global: self.k,
+                caustic_radius: initial_radius,
+                alpha: self.alpha,
+                max_depth: depth,
+                specular_camera_paths,
+            }),
+        };
+        if progressive {
+            // Options the physical integrators read whatever their kind.
+            if self.radius.is_some_and(|r| !(r > 0.0 && r.is_finite())) {
+                return Err(Error::InvalidSettings("--radius must be a positive number".into()));
+            }
+            if self.k == 0 || self.k > 10_000 {
+                return Err(Error::InvalidSettings("--k must be between 1 and 10000".into()));
+            }
+            if !(self.footprint > 0.0 && self.footprint <= 10_000.0) {
+                return Err(Error::InvalidSettings(
+                    "--footprint must be a positive number of pixels (at most 10000)".into(),
+                ));
+            }
+            if !(self.alpha > 0.0 && self.alpha < 1.0) {
+                return Err(Error::InvalidSettings(
+                    "--alpha must lie strictly between 0 and 1".into(),
+                ));
+            }
+        } else if !(self.cone_filter == 0.0 || self.cone_filter >= 1.0) {
+            return Err(Error::InvalidSettings(
+                "--cone-filter must be 0 (off) or at least 1".into(),
+            ));
+        }
+        integrator.validate()?;
+        Ok(integrator)
+    }
+
+    /// Which passes to render (the physical integrators).
+    pub fn plan(&self) -> Result<PassPlan> {
+        PassPlan::new(self.passes.as_deref(), self.time)
+    }
+
+    /// The session options for a scene identified by `scene_id`.
+    pub fn render_options(&self, scene_id: impl Into<String>) -> Result<RenderOptions> {
+        Ok(RenderOptions {
+            integrator: self.integrator()?,
+            width: self.width,
+            height: self.height,
+            seed: self.seed,
+            scene_id: scene_id.into(),
+        })
+    }
+
+    /// Options given that only the course model's Whitted renderer reads, when the physical
+    /// model renders.
+    pub fn ignored_by_physical(&self) -> Vec<&'static str> {
+        let mut ignored = Vec::new();
+        if self.aa != 1 {
+            ignored.push("--aa (each pass takes one jittered sample per pixel)");
+        }
+        if self.photons_per_light.is_some() {
+            ignored.push("--photons-per-light");
+        }
+        if self.no_aim {
+            ignored.push("--no-aim");
+        }
+        if self.max_emitted.is_some() {
+            ignored.push("--max-emitted");
+        }
+        if self.no_estimate_reuse {
+            ignored.push("--no-estimate-reuse");
+        }
+        ignored
+    }
+}

@@ -1,0 +1,320 @@
+//! A render session: one integrator over one scene at one image size, run pass by pass into an
+//! [`Accumulator`] that hands out the current image and the partial sums, and merges the sums
+//! of other runs of the same settings.
+//!
+//! The course model's Whitted renderer makes its whole image in one pass (pass 0), its caustic
+//! photons traced first; the physical integrators render independent passes that converge.
+
+use super::gi::Gi;
+use super::partial::Accumulator;
+use super::path::PathTracer;
+use super::ppm::Ppm;
+use super::whitted;
+use super::{image_size, ImageSettings, Integrator, Progressive};
+use crate::error::{Error, Result};
+use crate::film::Film;
+use crate::photon::PhotonMap;
+use crate::progress::Control;
+use crate::scene::Scene;
+use std::time::Instant;
+
+/// Largest image side accepted: beyond it the film alone would not fit in memory.
+pub const MAX_SIDE: usize = 32_768;
+/// Largest pixel count (1 GiB of float RGB film).
+pub const MAX_PIXELS: usize = 1 << 26;
+/// Passes run when neither a count nor a time is given.
+pub const DEFAULT_PASSES: u64 = 64;
+
+/// What to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderOptions {
+    /// The integrator and its settings.
+    pub integrator: Integrator,
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels (default: the width over the camera's aspect ratio).
+    pub height: Option<usize>,
+    /// Seed of all random streams.
+    pub seed: u64,
+    /// What identifies the scene (its content and how it was read) in the run's fingerprint, so
+    /// that only parts of one run are merged.
+    pub scene_id: String,
+}
+
+/// Which passes to run: `first..end`, or from `first` until `time_limit` seconds have passed
+/// (at least one pass).
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassPlan {
+    /// The first pass.
+    pub first: u64,
+    /// One past the last pass; `None` runs until the time limit.
+    pub end: Option<u64>,
+    /// Seconds after which no new pass starts.
+    pub time_limit: Option<f64>,
+}
+
+impl Default for PassPlan {
+    fn default() -> Self {
+        PassPlan {
+            first: 0,
+            end: Some(DEFAULT_PASSES),
+            time_limit: None,
+        }
+    }
+}
+
+impl PassPlan {
+    /// The plan of `passes` — `N` (passes 0..N) or `A..B` — and `time` in seconds; with
+    /// neither, 64 passes.
+    pub fn new(passes: Option<&str>, time: Option<f64>) -> Result<PassPlan> {
+        if time.is_some_and(|t| !(t > 0.0 && t.is_finite())) {
+            return Err(Error::InvalidSettings(
+                "--time must be a positive number of seconds".into(),
+            ));
+        }
+        let bad = |s: &str| {
+            Error::InvalidSettings(format!(
+                "--passes {s}: expected a count N (passes 0..N) or a range A..B with A < B"
+            ))
+        };
+        let Some(spec) = passes else {
+            return Ok(PassPlan {
+                first: 0,
+                end: if time.is_some() { None } else { Some(DEFAULT_PASSES) },
+                time_limit: time,
+            });
+        };
+        let (first, end) = match spec.split_once("..") {
+            Some((a, b)) => (
+                a.trim().parse::<u64>().map_err(|_| bad(spec))?,
+                b.trim().parse::<u64>().map_err(|_| bad(spec))?,
+            ),
+            None => (0, spec.trim().parse::<u64>().map_err(|_| bad(spec))?),
+        };
+        // Pass indices feed 32 bits of the random streams' index.
+        if first >= end || end > u32::MAX as u64 {
+            return Err(bad(spec));
+        }
+        Ok(PassPlan {
+            first,
+            end: Some(end),
+            time_limit: time,
+        })
+    }
+}
+
+/// What a run did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RunSummary {
+    /// Whether it ran to its end (false when cancelled).
+    pub complete: bool,
+    /// Seconds spent tracing the course model's caustic photons.
+    pub photon_seconds: f64,
+    /// Seconds spent rendering passes.
+    pub render_seconds: f64,
+}
+
+/// Refuses image sizes that cannot be rendered, before any memory is committed.
+pub fn check_image_size(width: usize, height: usize) -> Result<()> {
+    if width == 0 || height == 0 {
+        return Err(Error::InvalidSettings(
+            "the image needs a width and height of at least 1 pixel".into(),
+        ));
+    }
+    if width > MAX_SIDE || height > MAX_SIDE || width.saturating_mul(height) > MAX_PIXELS {
+        return Err(Error::InvalidSettings(format!(
+            "{width}×{height} is too large: at most {MAX_SIDE} pixels a side and {MAX_PIXELS} pixels in all"
+        )));
+    }
+    Ok(())
+}
+
+/// One integrator rendering one scene.
+pub struct RenderSession<'a> {
+    scene: &'a Scene,
+    integrator: Integrator,
+    seed: u64,
+    accumulator: Accumulator,
+    passes: Option<Box<dyn Progressive + 'a>>,
+    caustic_map: Option<PhotonMap>,
+    photon_seconds: f64,
+}
+
+impl<'a> RenderSession<'a> {
+    /// A session for `scene`; the options are checked here.
+    pub fn new(scene: &'a Scene, options: RenderOptions) -> Result<RenderSession<'a>> {
+        options.integrator.validate()?;
+        let (width, height) = image_size(scene.camera(), options.width, options.height);
+        check_image_size(width, height)?;
+        let seed = options.seed;
+        let passes: Option<Box<dyn Progressive + 'a>> = match &options.integrator {
+            Integrator::Whitted(_) => None,
+            Integrator::Path(s) => Some(Box::new(PathTracer::new(scene, s.clone(), width, height, seed))),
+            Integrator::Ppm(s) => Some(Box::new(Ppm::new(scene, s.clone(), width, height, seed))),
+            Integrator::Gi(s) => Some(Box::new(Gi::new(scene, s.clone(), width, height, seed))),
+        };
+        let fingerprint = format!(
+            "scene {} size {width}x{height} seed {seed} {:?}",
+            options.scene_id, options.integrator
+        );
+        Ok(RenderSession {
+            scene,
+            integrator: options.integrator,
+            seed,
+            accumulator: Accumulator::new(width, height, fingerprint),
+            passes,
+            caustic_map: None,
+            photon_seconds: 0.0,
+        })
+    }
+
+    /// The image size.
+    pub fn size(&self) -> (usize, usize) {
+        (self.accumulator.width, self.accumulator.height)
+    }
+
+    /// The integrator.
+    pub fn integrator(&self) -> &Integrator {
+        &self.integrator
+    }
+
+    /// Everything that must agree for two runs' sums to be merged.
+    pub fn fingerprint(&self) -> &str {
+        &self.accumulator.fingerprint
+    }
+
+    /// The course model's caustic photon map, once traced (`None` when no photons are stored).
+    pub fn caustic_map(&self) -> Option<&PhotonMap> {
+        self.caustic_map.as_ref()
+    }
+
+    /// Traces the course model's caustic photons, once (a "photons" phase); nothing for the
+    /// other integrators or when no photons are asked for.
+    pub fn trace_photons(&mut self, control: Control) {
+        let Integrator::Whitted(options) = &self.integrator else {
+            return;
+        };
+        if self.caustic_map.is_some() || options.photons.target_stored == 0 {
+            return;
+        }
+        let start = Instant::now();
+        self.caustic_map = Some(PhotonMap::trace(
+            self.scene,
+            &options.photons,
+            options.estimate.k,
+            control,
+        ));
+        self.photon_seconds += start.elapsed().as_secs_f64();
+    }
+
+    /// Renders pass `pass` and adds it to the sums; returns whether it was completed. An
+    /// interrupted pass of a progressive integrator is dropped; the course model's single pass
+    /// keeps the tiles it finished.
+    pub fn render_pass(&mut self, pass: u64, control: Control) -> bool {
+        if let Some(passes) = &self.passes {
+            return match passes.render_pass(pass, control) {
+                Some(pixels) => {
+                    self.accumulator.add(pass, &pixels);
+                    true
+                }
+                None => false,
+            };
+        }
+        let Integrator::Whitted(options) = &self.integrator else {
+            return false;
+        };
+        let options = options.clone();
+        self.trace_photons(control);
+        let (width, height) = self.size();
+        let image = ImageSettings {
+            width,
+            height,
+            aa: options.aa,
+            seed: self.seed,
+        };
+        let caustics = self
+            .caustic_map
+            .as_ref()
+            .filter(|m| !m.is_empty())
+            .map(|m| (m, &options.estimate));
+        let (film, complete) = whitted::render(self.scene, caustics, &options.whitted, &image, control);
+        self.accumulator.add(pass, &film.pixels);
+        complete
+    }
+
+    /// Runs the passes of `plan` (the course model: its one pass), calling `after_pass` after
+    /// each; stops early when cancelled. Progress: "passes" counts passes, or tenths of a
+    /// second under a time limit.
+    pub fn run(
+        &mut self,
+        plan: &PassPlan,
+        control: Control,
+        mut after_pass: impl FnMut(&RenderSession) -> Result<()>,
+    ) -> Result<RunSummary> {
+        if self.passes.is_none() {
+            self.trace_photons(control);
+            let start = Instant::now();
+            let complete = !control.cancelled() && self.render_pass(0, control);
+            let render_seconds = start.elapsed().as_secs_f64();
+            after_pass(self)?;
+            return Ok(RunSummary {
+                complete: complete && !control.cancelled(),
+                photon_seconds: self.photon_seconds,
+                render_seconds,
+            });
+        }
+        let start = Instant::now();
+        let (bar_total, by_time) = match (plan.end, plan.time_limit) {
+            (Some(end), None) => (end - plan.first, false),
+            (_, Some(t)) => ((t * 10.0).ceil() as u64, true),
+            (None, None) => (DEFAULT_PASSES, false),
+        };
+        control.progress.start("passes", bar_total);
+        let mut reported = 0u64;
+        let mut pass = plan.first;
+        loop {
+            if plan.end.is_some_and(|end| pass >= end) || control.cancelled() {
+                break;
+            }
+            if let Some(limit) = plan.time_limit {
+                if self.accumulator.pass_count() > 0 && start.elapsed().as_secs_f64() >= limit {
+                    break;
+                }
+            }
+            if !self.render_pass(pass, control) {
+                break;
+            }
+            pass += 1;
+            let done = if by_time {
+                ((start.elapsed().as_secs_f64() * 10.0) as u64).min(bar_total)
+            } else {
+                self.accumulator.pass_count()
+            };
+            control.progress.advance(done.saturating_sub(reported));
+            reported = reported.max(done);
+            after_pass(self)?;
+        }
+        control.progress.finish();
+        Ok(RunSummary {
+            complete: !control.cancelled(),
+            photon_seconds: 0.0,
+            render_seconds: start.elapsed().as_secs_f64(),
+        })
+    }
+
+    /// The mean of the passes so far.
+    pub fn image(&self) -> Film {
+        self.accumulator.film()
+    }
+
+    /// The sums of the passes so far.
+    pub fn accumulator(&self) -> &Accumulator {
+        &self.accumulator
+    }
+
+    /// Adds the sums of another run of the same settings (refused otherwise, or when they share
+    /// a pass).
+    pub fn merge(&mut self, part: &Accumulator) -> Result<()> {
+        self.accumulator.merge(part)
+    }
+}

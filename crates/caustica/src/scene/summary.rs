@@ -1,0 +1,297 @@
+//! What a built scene holds, as plain data for people and programs: `caustica info` prints it
+//! as text or JSON, the Python module hands it out as a dict.
+
+use super::{ObjectRef, Scene};
+use crate::geometry::ShapeKind;
+use crate::light::Light;
+use crate::material::Channel;
+use crate::math::Aabb;
+use serde::Serialize;
+
+/// A summary of a scene.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneSummary {
+    /// The camera.
+    pub camera: CameraSummary,
+    /// The file's point and directional lights.
+    pub lights: Vec<LightSummary>,
+    /// Emissive objects (lights in the physical model).
+    pub area_lights: Vec<AreaLightSummary>,
+    /// Ambient light Ia.
+    pub ambient: [f32; 3],
+    /// Number of analytic shapes.
+    pub shapes: usize,
+    /// Number of meshes.
+    pub meshes: usize,
+    /// Number of triangles in all meshes.
+    pub triangles: usize,
+    /// Every object, shapes first.
+    pub objects: Vec<ObjectSummary>,
+    /// Materials, by id.
+    pub materials: Vec<MaterialSummary>,
+    /// Number of textures.
+    pub textures: usize,
+    /// World bounds (infinite, `null` in JSON, for an empty scene).
+    pub bounds: BoundsSummary,
+    /// Remarks made while reading and building.
+    pub warnings: Vec<String>,
+}
+
+/// The pinhole camera.
+#[derive(Clone, Debug, Serialize)]
+pub struct CameraSummary {
+    /// Eye position.
+    pub eye: [f32; 3],
+    /// From the eye to the image-plane centre.
+    pub look: [f32; 3],
+    /// Image-plane horizontal span.
+    pub u: [f32; 3],
+    /// Image-plane vertical span.
+    pub v: [f32; 3],
+    /// Width / height.
+    pub aspect_ratio: f32,
+}
+
+/// A point or directional light.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum LightSummary {
+    /// A point light.
+    Point {
+        /// Position.
+        position: [f32; 3],
+        /// Colour.
+        color: [f32; 3],
+        /// The course's (a, b, c) falloff.
+        attenuation: [f32; 3],
+    },
+    /// A directional light.
+    Directional {
+        /// The unit direction light travels.
+        direction: [f32; 3],
+        /// Colour.
+        color: [f32; 3],
+    },
+}
+
+/// An emissive object.
+#[derive(Clone, Debug, Serialize)]
+pub struct AreaLightSummary {
+    /// Index into [`SceneSummary::objects`].
+    pub object: usize,
+    /// World area.
+    pub area: f32,
+    /// Emitted radiance (a guess at the mean where textured).
+    pub radiance: [f32; 3],
+    /// Whether the radiance is the same everywhere on it.
+    pub uniform: bool,
+}
+
+/// One object.
+#[derive(Clone, Debug, Serialize)]
+pub struct ObjectSummary {
+    /// What it is: `sphere`, `box`, `square`, `cylinder`, `cone` or `mesh`.
+    pub kind: String,
+    /// Its parameters in words (a cone's height and radii, a cylinder's caps).
+    #[serde(skip_serializing_if = "String::is_empty")]
+    pub details: String,
+    /// A mesh's triangle count.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub triangles: Option<usize>,
+    /// Material id.
+    pub material: u32,
+    /// World bounds.
+    pub bounds: BoundsSummary,
+}
+
+/// A box.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct BoundsSummary {
+    /// Lower corner.
+    pub min: [f32; 3],
+    /// Upper corner.
+    pub max: [f32; 3],
+}
+
+/// A material parameter: a constant colour or a texture.
+#[derive(Clone, Debug, Serialize)]
+#[serde(untagged)]
+pub enum ChannelSummary {
+    /// A constant.
+    Constant([f32; 3]),
+    /// A texture by id.
+    Texture {
+        /// Texture id.
+        texture: u32,
+    },
+}
+
+/// A material's eight course parameters.
+#[derive(Clone, Debug, Serialize)]
+pub struct MaterialSummary {
+    /// kd
+    pub diffuse: ChannelSummary,
+    /// ks
+    pub specular: ChannelSummary,
+    /// kr
+    pub reflective: ChannelSummary,
+    /// kt
+    pub transmissive: ChannelSummary,
+    /// ke
+    pub emissive: ChannelSummary,
+    /// ka
+    pub ambient: ChannelSummary,
+    /// Phong exponent.
+    pub shininess: ChannelSummary,
+    /// Index of refraction.
+    pub index: ChannelSummary,
+}
+
+impl ChannelSummary {
+    fn of(c: &Channel) -> ChannelSummary {
+        match c {
+            Channel::Constant(v) => ChannelSummary::Constant(v.to_array()),
+            Channel::Texture(i) => ChannelSummary::Texture { texture: *i },
+        }
+    }
+}
+
+impl std::fmt::Display for ChannelSummary {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ChannelSummary::Constant([r, g, b]) if r == g && g == b => write!(f, "{r}"),
+            ChannelSummary::Constant([r, g, b]) => write!(f, "({r}, {g}, {b})"),
+            ChannelSummary::Texture { texture } => write!(f, "texture#{texture}"),
+        }
+    }
+}
+
+impl BoundsSummary {
+    fn of(b: &Aabb) -> BoundsSummary {
+        BoundsSummary {
+            min: b.min.to_array(),
+            max: b.max.to_array(),
+        }
+    }
+}
+
+/// A shape's kind and its parameters in words.
+fn describe(kind: &ShapeKind) -> (String, String) {
+    match kind {
+        ShapeKind::Sphere => ("sphere".into(), String::new()),
+        ShapeKind::Box => ("box".into(), String::new()),
+        ShapeKind::Square => ("square".into(), String::new()),
+        ShapeKind::Cone(c) => {
+            let caps = if c.capped { "capped" } else { "open" };
+            if c.bottom_radius == c.top_radius && c.height == 1.0 && c.bottom_radius == 1.0 {
+                ("cylinder".into(), caps.into())
+            } else {
+                (
+                    "cone".into(),
+                    format!(
+                        "height {}, radius {} to {}, {caps}",
+                        c.height, c.bottom_radius, c.top_radius
+                    ),
+                )
+            }
+        }
+    }
+}
+
+impl Scene {
+    /// What the scene holds.
+    pub fn summary(&self) -> SceneSummary {
+        let camera = self.camera();
+        let lights = self
+            .lights()
+            .course_lights()
+            .filter_map(|light| match light {
+                Light::Point {
+                    position,
+                    color,
+                    attenuation,
+                } => Some(LightSummary::Point {
+                    position: position.to_array(),
+                    color: color.to_array(),
+                    attenuation: *attenuation,
+                }),
+                Light::Directional { direction, color } => Some(LightSummary::Directional {
+                    direction: direction.to_array(),
+                    color: color.to_array(),
+                }),
+                Light::Area(_) => None,
+            })
+            .collect();
+        let object_index = |object: ObjectRef| match object {
+            ObjectRef::Shape(i) => i as usize,
+            ObjectRef::Mesh(i) => self.shapes().len() + i as usize,
+        };
+        let area_lights = self
+            .lights()
+            .area_lights()
+            .map(|light| AreaLightSummary {
+                object: object_index(light.object),
+                area: light.area,
+                radiance: light.radiance.to_array(),
+                uniform: light.uniform,
+            })
+            .collect();
+        let objects = self
+            .objects()
+            .map(|(object, bounds)| {
+                let (kind, details, triangles) = match object {
+                    ObjectRef::Shape(i) => {
+                        let (kind, details) = describe(&self.shapes()[i as usize].kind);
+                        (kind, details, None)
+                    }
+                    ObjectRef::Mesh(i) => (
+                        "mesh".to_string(),
+                        String::new(),
+                        Some(self.meshes()[i as usize].indices.len()),
+                    ),
+                };
+                ObjectSummary {
+                    kind,
+                    details,
+                    triangles,
+                    material: self.object_material(object),
+                    bounds: BoundsSummary::of(&bounds),
+                }
+            })
+            .collect();
+        let materials = self
+            .materials()
+            .iter()
+            .map(|m| MaterialSummary {
+                diffuse: ChannelSummary::of(&m.diffuse),
+                specular: ChannelSummary::of(&m.specular),
+                reflective: ChannelSummary::of(&m.reflective),
+                transmissive: ChannelSummary::of(&m.transmissive),
+                emissive: ChannelSummary::of(&m.emissive),
+                ambient: ChannelSummary::of(&m.ambient),
+                shininess: ChannelSummary::of(&m.shininess),
+                index: ChannelSummary::of(&m.index),
+            })
+            .collect();
+        SceneSummary {
+            camera: CameraSummary {
+                eye: camera.eye.to_array(),
+                look: camera.look.to_array(),
+                u: camera.u.to_array(),
+                v: camera.v.to_array(),
+                aspect_ratio: camera.aspect_ratio,
+            },
+            lights,
+            area_lights,
+            ambient: self.ambient().to_array(),
+            shapes: self.shapes().len(),
+            meshes: self.meshes().len(),
+            triangles: self.triangles().len(),
+            objects,
+            materials,
+            textures: self.textures().len(),
+            bounds: BoundsSummary::of(&self.bounds()),
+            warnings: self.warnings().to_vec(),
+        }
+    }
+}
