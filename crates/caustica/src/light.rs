@@ -15,6 +15,8 @@ pub mod emission;
 
 pub use area::AreaLight;
 
+use emission::{Emitter, Target};
+
 use crate::math::{luminance, offset_origin, Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::{ObjectRef, Scene, SurfaceHit};
@@ -143,6 +145,8 @@ pub struct LightSet {
     /// Light number of each shape and mesh (`u32::MAX` when it does not emit).
     shape_light: Vec<u32>,
     mesh_light: Vec<u32>,
+    /// Each light's uniform photon emitter.
+    emitters: Vec<Option<Emitter>>,
     /// The sphere around the scene, across which directional light enters.
     scene_center: Vec3,
     scene_radius: f32,
@@ -181,8 +185,14 @@ impl LightSet {
                 }
             }
         }
+        let sphere = Target {
+            center: scene_center,
+            radius: scene_radius,
+        };
+        let emitters = lights.iter().map(|light| Emitter::new(light, None, sphere)).collect();
         LightSet {
             lights,
+            emitters,
             probabilities,
             cdf,
             shape_light,

@@ -1,20 +1,22 @@
-//! Photon emission: photons leaving the lights, with their flux.
+//! Photon emission: photons leaving the lights, with their flux. Every light emits through an
+//! [`Emitter`], uniform or aimed:
 //!
-//! The physical model chooses a light in proportion to its power ([`LightSet::emit`]): point
-//! lights emit uniformly over the sphere, directional lights across a disc covering the scene,
-//! emissive objects from a point uniform by area in a cosine-weighted direction.
+//! - uniform: point lights over the whole sphere, directional lights across a disc covering the
+//!   scene, emissive objects from a point uniform by area in a cosine-weighted direction;
+//! - aimed (point and directional lights): only towards the bounding spheres of the objects that
+//!   can make caustics. Point lights sample a mixture of cones (one per target, weighted by solid
+//!   angle); directional lights a mixture of discs on a plane across the beam (one per target,
+//!   weighted by area).
 //!
-//! The course model's caustic photons leave each point or directional light by an [`Emitter`],
-//! aimed or uniform. Aimed emission sends photons only towards the bounding spheres of objects that can make
-//! caustics. Point lights sample a mixture of cones (one per target, weighted by solid angle);
-//! directional lights sample a mixture of discs on a plane across the beam (one per target,
-//! weighted by area). Each photon carries the light's intensity (or irradiance) divided by the
-//! mixture pdf actually used, so aiming changes the noise, never the expected power.
+//! Each photon carries the light's intensity (or irradiance, or radiance) divided by the pdf
+//! actually used, so aiming changes the noise, never the expected power. The physical model
+//! picks a light in proportion to its power ([`LightSet::emit`]); the course model shares a
+//! budget of stored caustic photons between its lights, each aimed.
 
-use super::area::AreaSample;
+use super::area::{AreaLight, AreaSample};
 use super::{Light, LightSet};
 use crate::math::{luminance, offset_origin, Aabb, Frame, Ray, Vec2, Vec3};
-use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, sample_uniform_sphere, Rng};
+use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, Rng};
 use crate::scene::{ObjectRef, Scene};
 use std::f32::consts::PI;
 
@@ -51,6 +53,8 @@ struct DiscLobe {
 
 #[derive(Clone, Debug)]
 enum Kind {
+    /// An emissive object, sampled by its own area sampler.
+    Area,
     Point {
         position: Vec3,
         cones: Vec<ConeLobe>,
@@ -75,10 +79,10 @@ pub struct Emitter {
 }
 
 impl Emitter {
-    /// The emitter of `light`, aimed at `targets` (or uniform over the scene when `targets` is
-    /// `None`). `None` when the light cannot send a photon anywhere useful.
-    pub fn new(light: &Light, targets: Option<&[Target]>, scene_bounds: &Aabb) -> Option<Emitter> {
-        let scene = Target::around(scene_bounds);
+    /// The emitter of `light`, aimed at `targets` (or uniform when `targets` is `None`; emissive
+    /// objects are never aimed); `scene` is the sphere around the scene, across which directional
+    /// light enters. `None` when the light cannot send a photon anywhere useful.
+    pub fn new(light: &Light, targets: Option<&[Target]>, scene: Target) -> Option<Emitter> {
         match *light {
             Light::Point { position, color, .. } => {
                 let cones: Vec<ConeLobe> = match targets {
@@ -96,7 +100,7 @@ impl Emitter {
                     4.0 * PI * luminance(color).max(0.0),
                 )
             }
-            Light::Area(_) => None,
+            Light::Area(ref area) => Emitter::finish(Kind::Area, area.radiance, vec![1.0], area.power()),
             Light::Directional { direction, color } => {
                 let frame = Frame::from_normal(direction);
                 let plane_origin = scene.center - direction * (scene.radius * 2.0 + 1.0);
@@ -156,15 +160,16 @@ impl Emitter {
         self.power
     }
 
-    /// A photon ray and its power before division by the number of photons emitted.
-    pub fn sample(&self, rng: &mut Rng) -> Option<(Ray, Vec3)> {
+    /// A photon from `light` (the light this emitter was made for) with its flux before
+    /// division by the number of photons emitted.
+    pub fn sample(&self, light: &Light, scene: &Scene, rng: &mut Rng) -> Option<EmittedPhoton> {
         let lobe = self.pick(rng.uniform());
         let u = rng.uniform2();
-        match &self.kind {
+        let (ray, flux) = match &self.kind {
             Kind::Point { position, cones } => {
                 let dir = sample_uniform_cone(u, cones[lobe].axis, cones[lobe].cos_max);
                 let pdf = self.cone_pdf(cones, dir);
-                (pdf > 0.0).then(|| (Ray::new(*position, dir), self.color / pdf))
+                (pdf > 0.0).then(|| (Ray::new(*position, dir), self.color / pdf))?
             }
             Kind::Directional {
                 direction,
@@ -176,9 +181,16 @@ impl Emitter {
                 let p = disc.center + sample_uniform_disc(u) * disc.radius;
                 let pdf = self.disc_pdf(discs, p);
                 let origin = *plane_origin + frame.x * p.x + frame.y * p.y;
-                (pdf > 0.0).then(|| (Ray::new(origin, *direction), self.color / pdf))
+                (pdf > 0.0).then(|| (Ray::new(origin, *direction), self.color / pdf))?
             }
-        }
+            Kind::Area => {
+                let Light::Area(area) = light else {
+                    return None;
+                };
+                return emit_from_area(area, scene, rng.uniform(), u, rng.uniform2());
+            }
+        };
+        Some(EmittedPhoton { ray, flux })
     }
 
     fn pick(&self, u: f32) -> usize {
@@ -260,54 +272,45 @@ pub struct EmittedPhoton {
 }
 
 impl LightSet {
-    /// One photon from a light chosen by power; `None` if the sample carries nothing.
+    /// One photon from a light chosen by power, its flux divided by the probability of the
+    /// choice; `None` if the sample carries nothing.
     pub fn emit(&self, scene: &Scene, rng: &mut Rng) -> Option<EmittedPhoton> {
         let (index, p_pick) = self.pick(rng.uniform())?;
-        let (u_pick, u, u_dir) = (rng.uniform(), rng.uniform2(), rng.uniform2());
-        let (scene_center, scene_radius) = self.scene_sphere();
-        match &self.lights[index] {
-            Light::Point { position, color, .. } => Some(EmittedPhoton {
-                ray: Ray::new(*position, sample_uniform_sphere(u_dir)),
-                flux: *color * (4.0 * PI / p_pick),
-            }),
-            Light::Directional { direction, color } => {
-                let frame = Frame::from_normal(*direction);
-                let d = sample_uniform_disc(u) * scene_radius;
-                let origin = scene_center - *direction * (2.0 * scene_radius + 1.0) + frame.x * d.x + frame.y * d.y;
-                let area = PI * scene_radius * scene_radius;
-                Some(EmittedPhoton {
-                    ray: Ray::new(origin, *direction),
-                    flux: *color * (area / p_pick),
-                })
-            }
-            Light::Area(light) => {
-                let sample = light.sample(scene, u_pick, u)?;
-                let le = if light.uniform {
-                    light.radiance
-                } else {
-                    emission_at(scene, &sample)
-                };
-                // A face at random (the outer one of a closed lamp that absorbs its own inward
-                // light), then a cosine-weighted direction: pdf ½·cos/π, or cos/π.
-                let (side, u2, faces) = if light.outward_only {
-                    (1.0, u_dir, 1.0)
-                } else if u_dir.x < 0.5 {
-                    (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y), 2.0)
-                } else {
-                    (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y), 2.0)
-                };
-                let normal = sample.normal * side;
-                let dir = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2));
-                if dir.dot(normal) <= 0.0 {
-                    return None;
-                }
-                Some(EmittedPhoton {
-                    ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
-                    flux: le * (faces * PI / (sample.pdf_area * p_pick)),
-                })
-            }
-        }
+        let emitter = self.emitters[index].as_ref()?;
+        let photon = emitter.sample(&self.lights[index], scene, rng)?;
+        Some(EmittedPhoton {
+            ray: photon.ray,
+            flux: photon.flux / p_pick,
+        })
     }
+}
+
+/// A photon from an emissive object: a point by area, a face, a cosine-weighted direction.
+fn emit_from_area(light: &AreaLight, scene: &Scene, u_pick: f32, u: Vec2, u_dir: Vec2) -> Option<EmittedPhoton> {
+    let sample = light.sample(scene, u_pick, u)?;
+    let le = if light.uniform {
+        light.radiance
+    } else {
+        emission_at(scene, &sample)
+    };
+    // A face at random (the outer one of a closed lamp that absorbs its own inward light), then
+    // a cosine-weighted direction: pdf ½·cos/π, or cos/π.
+    let (side, u2, faces) = if light.outward_only {
+        (1.0, u_dir, 1.0)
+    } else if u_dir.x < 0.5 {
+        (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y), 2.0)
+    } else {
+        (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y), 2.0)
+    };
+    let normal = sample.normal * side;
+    let dir = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2));
+    if dir.dot(normal) <= 0.0 {
+        return None;
+    }
+    Some(EmittedPhoton {
+        ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
+        flux: le * (faces * PI / sample.pdf_area),
+    })
 }
 
 /// The emitted radiance at a sampled light point, read from its material by a short ray.
@@ -356,12 +359,14 @@ mod tests {
         let cos_max = (1.0f32 - 1.0 / 25.0).sqrt();
         let exact = 2.0 * PI * (1.0 - cos_max); // intensity 1 × solid angle of the first sphere
         for aimed in [true, false] {
-            let e = Emitter::new(&light, aimed.then_some(&targets[..]), &bounds()).unwrap();
+            let e = Emitter::new(&light, aimed.then_some(&targets[..]), Target::around(&bounds())).unwrap();
             let mut rng = Rng::new(1, 0);
+            let empty = scene("");
             let n = 200_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                let (ray, power) = e.sample(&mut rng).unwrap();
+                let photon = e.sample(&light, &empty, &mut rng).unwrap();
+                let (ray, power) = (photon.ray, photon.flux);
                 let to = target.center - ray.origin;
                 if ray.dir.dot(to.normalize()) >= cos_max {
                     sum += power.x as f64;
@@ -394,12 +399,14 @@ mod tests {
         let exact = 2.0 * PI; // irradiance 2 through the unit disc across the beam
         for aimed in [true, false] {
             let small = Aabb::new(Vec3::splat(-3.0), Vec3::splat(3.0));
-            let e = Emitter::new(&light, aimed.then_some(&targets[..]), &small).unwrap();
+            let e = Emitter::new(&light, aimed.then_some(&targets[..]), Target::around(&small)).unwrap();
             let mut rng = Rng::new(2, 0);
+            let empty = scene("");
             let n = 2_000_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                let (ray, power) = e.sample(&mut rng).unwrap();
+                let photon = e.sample(&light, &empty, &mut rng).unwrap();
+                let (ray, power) = (photon.ray, photon.flux);
                 let p = ray.origin;
                 if p.x * p.x + p.y * p.y <= 1.0 {
                     sum += power.x as f64;

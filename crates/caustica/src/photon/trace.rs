@@ -21,7 +21,7 @@
 
 use super::{Photon, DIFFUSE, REFLECTED, REFRACTED};
 use crate::bsdf::{Bsdf, Transport};
-use crate::light::emission::{caustic_targets, Emitter};
+use crate::light::emission::{caustic_targets, Emitter, Target};
 use crate::light::{distance_attenuation, Light};
 use crate::material::refraction_geometry;
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
@@ -117,7 +117,7 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
             if !settings.first_hit && targets.is_empty() {
                 return None;
             }
-            Emitter::new(light, aim.then_some(&targets[..]), &bounds)
+            Emitter::new(light, aim.then_some(&targets[..]), Target::around(&bounds))
         })
         .collect();
     let total_power: f32 = emitters.iter().flatten().map(Emitter::power).sum();
@@ -206,9 +206,10 @@ fn trace_light(
                 let count = BATCH.min(cap - first.min(cap));
                 trace_batch(first..first + count, |i, out| {
                     let mut rng = Rng::new(settings.seed, stream | i);
-                    if let Some((ray, power)) = emitter.sample(&mut rng) {
+                    if let Some(photon) = emitter.sample(model.light, scene, &mut rng) {
                         let light = light_index.min(255) as u8;
-                        trace_path(scene, model, ray, power, light, settings.max_bounces, &mut rng, out);
+                        let max_bounces = settings.max_bounces;
+                        trace_path(scene, model, photon.ray, photon.flux, light, max_bounces, &mut rng, out);
                     }
                 })
             })
