@@ -65,6 +65,7 @@ pub struct BsdfSample {
 
 impl Bsdf {
     /// The lobes at a surface point of `scene`, seen from direction `wo` (unit, away from it).
+    #[inline]
     pub fn at(scene: &Scene, hit: &SurfaceHit, wo: Vec3) -> Bsdf {
         Bsdf::new(&scene.phong(hit), hit.shading_normal, hit.geometric_normal, wo)
     }

@@ -1,9 +1,11 @@
 //! caustica: a photon-mapping renderer for caustics that reads SBT-raytracer `.ray` scenes.
 //!
-//! The pipeline runs one way: a `.ray` file is parsed into a plain [`scene::ray_file::ast`]
-//! description, built into a [`scene::Scene`] (world-space shapes, BVH, lights, materials),
-//! lights emit photons into a [`photon`] map, and an [`integrator`] turns camera rays into a
-//! [`film::Film`] that is written as PNG or EXR.
+//! The pipeline runs one way (docs/architecture.md): a reader in [`format`] turns a scene file
+//! into a format-neutral [`description::SceneDescription`], [`scene::build`] makes it a
+//! renderable [`scene::Scene`] (world-space shapes, BVHs, materials, [`light`]s), lights emit
+//! [`photon`]s into a photon map, and an [`integrator`] run by a
+//! [`RenderSession`](integrator::RenderSession) turns camera rays into a [`film::Film`] that is
+//! written as PNG or EXR.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 

@@ -90,6 +90,7 @@ pub struct SurfaceParams {
 
 impl Material {
     /// The values at texture coordinates `uv`.
+    #[inline]
     pub fn eval(&self, textures: &[Texture], uv: Vec2) -> SurfaceParams {
         let shininess = match self.shininess {
             Channel::Constant(c) => luminance(c),

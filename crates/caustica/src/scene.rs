@@ -261,6 +261,7 @@ impl Scene {
     }
 
     /// The course's eight material values at a surface point.
+    #[inline]
     pub fn phong(&self, hit: &SurfaceHit) -> SurfaceParams {
         match hit.material {
             MaterialRef::One(id) => self.materials[id as usize].eval(&self.textures, hit.uv),
@@ -272,6 +273,7 @@ impl Scene {
     }
 
     /// The emitted radiance (`emissive`) at a surface point.
+    #[inline]
     pub fn emission(&self, hit: &SurfaceHit) -> Vec3 {
         match hit.material {
             MaterialRef::One(id) => self.materials[id as usize].emissive.eval(&self.textures, hit.uv),

@@ -157,7 +157,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
             }
         }
     }
-    let passes_done = session.accumulator().pass_count();
+    let passes_done = session.pass_count();
     if passes_done == 0 {
         eprintln!("interrupted before the first pass finished: nothing was saved");
         return Ok(crate::EXIT_INTERRUPTED);
@@ -167,12 +167,16 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let total = start.elapsed().as_secs_f64();
     let complete = summary.complete;
     let (parse_seconds, build_seconds) = (loaded.parse_seconds, loaded.build_seconds);
-    let ranges: Vec<String> = session
-        .accumulator()
-        .passes
-        .iter()
-        .map(|(a, b)| format!("{a}..{b}"))
-        .collect();
+    let ranges: Vec<String> = if progressive {
+        session
+            .accumulator()
+            .passes
+            .iter()
+            .map(|(a, b)| format!("{a}..{b}"))
+            .collect()
+    } else {
+        vec!["0..1".into()]
+    };
     let photons_per_pass = match session.integrator() {
         Integrator::Ppm(s) => s.photons_per_pass,
         Integrator::Gi(s) => s.photons_per_pass,

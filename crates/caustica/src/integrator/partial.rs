@@ -41,6 +41,18 @@ impl Accumulator {
         }
     }
 
+    /// Only the size and fingerprint, for a run that keeps no sums; adding to it or saving it is
+    /// refused.
+    pub fn without_sums(width: usize, height: usize, fingerprint: impl Into<String>) -> Accumulator {
+        Accumulator {
+            width,
+            height,
+            fingerprint: fingerprint.into(),
+            passes: Vec::new(),
+            sum: Vec::new(),
+        }
+    }
+
     /// Number of passes held.
     pub fn pass_count(&self) -> u64 {
         self.passes.iter().map(|(a, b)| b - a).sum()

@@ -134,7 +134,10 @@ pub struct RenderSession<'a> {
     scene: &'a Scene,
     integrator: Integrator,
     seed: u64,
+    /// The physical integrators' sums; for the course model only its size and fingerprint.
     accumulator: Accumulator,
+    /// The course model's image (kept as it is: one pass needs no sums).
+    whitted_image: Option<Film>,
     passes: Option<Box<dyn Progressive + 'a>>,
     caustic_map: Option<PhotonMap>,
     photon_seconds: f64,
@@ -161,7 +164,12 @@ impl<'a> RenderSession<'a> {
             scene,
             integrator: options.integrator,
             seed,
-            accumulator: Accumulator::new(width, height, fingerprint),
+            accumulator: if passes.is_some() {
+                Accumulator::new(width, height, fingerprint)
+            } else {
+                Accumulator::without_sums(width, height, fingerprint)
+            },
+            whitted_image: None,
             passes,
             caustic_map: None,
             photon_seconds: 0.0,
@@ -238,7 +246,7 @@ impl<'a> RenderSession<'a> {
             .filter(|m| !m.is_empty())
             .map(|m| (m, &options.estimate));
         let (film, complete) = whitted::render(self.scene, caustics, &options.whitted, &image, control);
-        self.accumulator.add(pass, &film.pixels);
+        self.whitted_image = Some(film);
         complete
     }
 
@@ -254,7 +262,7 @@ impl<'a> RenderSession<'a> {
         if self.passes.is_none() {
             self.trace_photons(control);
             let start = Instant::now();
-            let complete = !control.cancelled() && self.render_pass(0, control);
+            let complete = self.render_pass(0, control) && !control.cancelled();
             let render_seconds = start.elapsed().as_secs_f64();
             after_pass(self)?;
             return Ok(RunSummary {
@@ -302,12 +310,24 @@ impl<'a> RenderSession<'a> {
         })
     }
 
-    /// The mean of the passes so far.
+    /// The mean of the passes so far (the course model: its image, black before it is made).
     pub fn image(&self) -> Film {
-        self.accumulator.film()
+        match &self.whitted_image {
+            Some(film) => film.clone(),
+            None if self.passes.is_none() => Film::new(self.accumulator.width, self.accumulator.height),
+            None => self.accumulator.film(),
+        }
     }
 
-    /// The sums of the passes so far.
+    /// Passes rendered so far.
+    pub fn pass_count(&self) -> u64 {
+        match self.passes {
+            Some(_) => self.accumulator.pass_count(),
+            None => u64::from(self.whitted_image.is_some()),
+        }
+    }
+
+    /// The sums of the passes so far (empty for the course model, which keeps no sums).
     pub fn accumulator(&self) -> &Accumulator {
         &self.accumulator
     }

@@ -163,6 +163,11 @@ impl Emitter {
     /// A photon from `light` (the light this emitter was made for) with its flux before
     /// division by the number of photons emitted.
     pub fn sample(&self, light: &Light, scene: &Scene, rng: &mut Rng) -> Option<EmittedPhoton> {
+        if let (Kind::Area, Light::Area(area)) = (&self.kind, light) {
+            let u_pick = rng.uniform();
+            let (u, u_dir) = (rng.uniform2(), rng.uniform2());
+            return emit_from_area(area, scene, u_pick, u, u_dir);
+        }
         let lobe = self.pick(rng.uniform());
         let u = rng.uniform2();
         let (ray, flux) = match &self.kind {
@@ -183,12 +188,7 @@ impl Emitter {
                 let origin = *plane_origin + frame.x * p.x + frame.y * p.y;
                 (pdf > 0.0).then(|| (Ray::new(origin, *direction), self.color / pdf))?
             }
-            Kind::Area => {
-                let Light::Area(area) = light else {
-                    return None;
-                };
-                return emit_from_area(area, scene, rng.uniform(), u, rng.uniform2());
-            }
+            Kind::Area => return None,
         };
         Some(EmittedPhoton { ray, flux })
     }
