@@ -66,6 +66,48 @@ pub enum LightDesc {
         /// Where the block is.
         span: Span,
     },
+    /// A point light shining into a cone.
+    Spot {
+        /// Position in world space.
+        position: Vec3,
+        /// The direction it shines, as written (not normalised).
+        direction: Vec3,
+        /// Colour (intensity on the axis).
+        color: Vec3,
+        /// Attenuation (constant a, linear b, quadratic c).
+        attenuation: [f32; 3],
+        /// Half-angle of full intensity, in degrees.
+        inner_degrees: f32,
+        /// Half-angle beyond which it is dark, in degrees (at least `inner_degrees`).
+        outer_degrees: f32,
+        /// Exponent of a cos^e falloff from the axis (0: none).
+        exponent: f32,
+        /// Where the block is.
+        span: Span,
+    },
+    /// A sun: a far light of small angular size.
+    Sun {
+        /// The direction its light travels, as written (not normalised).
+        direction: Vec3,
+        /// Irradiance on a surface facing it.
+        color: Vec3,
+        /// Angular diameter in degrees (0.53 for the sun seen from the earth).
+        angle_degrees: f32,
+        /// Where the block is.
+        span: Span,
+    },
+    /// The sky around the scene: radiance `color` times an optional latitude–longitude image.
+    Environment {
+        /// Radiance scale.
+        color: Vec3,
+        /// The image (EXR or Radiance HDR), resolved against the scene's folder.
+        map: Option<PathBuf>,
+        /// The image's frame turned into the world's (a rotation; identity: +y up, the image's
+        /// centre towards −z).
+        rotation: glam::Mat3,
+        /// Where the block is (and the map's file name in it, for errors reading it).
+        span: Span,
+    },
 }
 
 /// A material parameter: a constant or a texture map.

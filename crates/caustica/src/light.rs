@@ -3,22 +3,28 @@
 //! next-event estimation and for photon emission). Units and conventions: docs/radiometry.md.
 //!
 //! In the physical model a point light's colour is its intensity I (W/sr) and it falls off with
-//! the inverse square (the file's attenuation coefficients are ignored); a directional light's
-//! colour is the irradiance E (W/m²) on a surface facing it; an emissive object emits radiance
-//! ke (W/m²/sr) from both faces. In the course model emissive objects are not light sources:
-//! their `emissive` term only colours themselves.
+//! the inverse square (the file's attenuation coefficients are ignored), a spot light's is the
+//! intensity on its axis; a directional light's colour is the irradiance E (W/m²) on a surface
+//! facing it, and so is a sun's, spread over its small disc; an emissive object emits radiance
+//! ke (W/m²/sr) from both faces; the environment's colour (times its map) is the radiance of
+//! the sky. In the course model emissive objects are not light sources (their `emissive` term
+//! only colours themselves), a sun is a directional light and the environment is only seen, as
+//! the background.
 //!
-//! Photon emission is in [`emission`]; emissive objects are sampled by [`area`].
+//! Photon emission is in [`emission`]; emissive objects are sampled by [`area`], the sky by
+//! [`environment`].
 
 pub mod area;
 pub mod emission;
+pub mod environment;
 
 pub use area::AreaLight;
+pub use environment::Environment;
 
 use emission::{Emitter, Target};
 
 use crate::math::{luminance, offset_origin, Ray, Vec3};
-use crate::sampling::Rng;
+use crate::sampling::{sample_uniform_cone, Rng};
 use crate::scene::{ObjectRef, Scene, SurfaceHit};
 use std::f32::consts::PI;
 
@@ -41,6 +47,39 @@ pub enum Light {
         /// Colour (irradiance on a surface facing the light).
         color: Vec3,
     },
+    /// A point light whose intensity falls off away from an axis: full inside the inner cone,
+    /// none outside the outer cone, a smooth step between, times cos^exponent of the angle to
+    /// the axis.
+    Spot {
+        /// World position.
+        position: Vec3,
+        /// Unit axis: the direction the light shines.
+        direction: Vec3,
+        /// Colour (intensity on the axis).
+        color: Vec3,
+        /// The course's (a, b, c) falloff with distance.
+        attenuation: [f32; 3],
+        /// Cosine of the inner cone's half-angle.
+        cos_inner: f32,
+        /// Cosine of the outer cone's half-angle.
+        cos_outer: f32,
+        /// Exponent of the cosine falloff (0: none).
+        exponent: f32,
+    },
+    /// A far light of small angular size: the irradiance `color` on a surface facing it, spread
+    /// uniformly over a disc of directions.
+    Sun {
+        /// Unit travel direction of its centre.
+        direction: Vec3,
+        /// Irradiance on a surface facing it.
+        color: Vec3,
+        /// Cosine of the disc's angular radius.
+        cos_max: f32,
+        /// 1 − `cos_max`, computed without cancellation.
+        one_minus_cos: f32,
+    },
+    /// The sky around the scene.
+    Environment(Environment),
     /// An emissive object (physical model only).
     Area(AreaLight),
 }
@@ -78,37 +117,134 @@ impl Light {
                     intensity: color * distance_attenuation(attenuation, distance),
                 })
             }
-            Light::Directional { direction, color } => Some(LightSample {
+            Light::Spot {
+                position,
+                direction,
+                color,
+                attenuation,
+                cos_inner,
+                cos_outer,
+                exponent,
+            } => {
+                let to_light = position - p;
+                let distance = to_light.length();
+                if distance == 0.0 || !distance.is_finite() {
+                    return None;
+                }
+                let wi = to_light / distance;
+                let profile = spot_profile(-wi.dot(direction), cos_inner, cos_outer, exponent);
+                Some(LightSample {
+                    wi,
+                    distance,
+                    intensity: color * (profile * distance_attenuation(attenuation, distance)),
+                })
+            }
+            Light::Directional { direction, color } | Light::Sun { direction, color, .. } => Some(LightSample {
                 wi: -direction,
                 distance: f32::INFINITY,
                 intensity: color,
             }),
-            Light::Area(_) => None,
+            Light::Environment(_) | Light::Area(_) => None,
         }
     }
 
-    /// Whether the course model shades with this light (point and directional lights).
-    pub fn is_course_light(&self) -> bool {
-        !matches!(self, Light::Area(_))
+    /// A sun from the angular `diameter_degrees` of its disc; a directional light when that is 0.
+    pub fn sun(direction: Vec3, color: Vec3, diameter_degrees: f32) -> Light {
+        let half = (0.5 * diameter_degrees).to_radians().clamp(0.0, 0.5 * PI);
+        if half <= 0.0 {
+            return Light::Directional { direction, color };
+        }
+        let s = (0.5 * half).sin();
+        Light::Sun {
+            direction,
+            color,
+            cos_max: half.cos(),
+            one_minus_cos: 2.0 * s * s,
+        }
     }
 
-    /// The light's colour: intensity, irradiance, or an emissive object's radiance.
+    /// Whether the course model shades with this light and emits caustic photons from it
+    /// (point, spot, directional lights and suns).
+    pub fn is_course_light(&self) -> bool {
+        !matches!(self, Light::Area(_) | Light::Environment(_))
+    }
+
+    /// The light's colour: intensity, irradiance, or radiance.
     pub fn color(&self) -> Vec3 {
         match self {
-            Light::Point { color, .. } | Light::Directional { color, .. } => *color,
+            Light::Point { color, .. }
+            | Light::Spot { color, .. }
+            | Light::Directional { color, .. }
+            | Light::Sun { color, .. } => *color,
+            Light::Environment(env) => env.color,
             Light::Area(area) => area.radiance,
         }
     }
 
-    /// Emitted power (luminance) under the physical model; a directional light's is the power
-    /// through the disc of radius `scene_radius` across its beam.
+    /// Emitted power (luminance) under the physical model; far lights' is the power through
+    /// the disc of radius `scene_radius` across their beams.
     pub fn power(&self, scene_radius: f32) -> f32 {
+        let disc = PI * scene_radius * scene_radius;
         match self {
             Light::Point { color, .. } => 4.0 * PI * luminance(*color).max(0.0),
-            Light::Directional { color, .. } => PI * scene_radius * scene_radius * luminance(*color).max(0.0),
+            Light::Spot {
+                color,
+                cos_inner,
+                cos_outer,
+                exponent,
+                ..
+            } => spot_solid_angle(*cos_inner, *cos_outer, *exponent) * luminance(*color).max(0.0),
+            Light::Directional { color, .. } | Light::Sun { color, .. } => disc * luminance(*color).max(0.0),
+            Light::Environment(env) => disc * env.luminance_integral(),
             Light::Area(area) => area.power(),
         }
     }
+
+    /// A sun's radiance within its disc: E / (π sin²θ), zero for other lights.
+    fn sun_radiance(&self) -> Vec3 {
+        match self {
+            Light::Sun {
+                color, one_minus_cos, ..
+            } => *color / (PI * one_minus_cos * (2.0 - one_minus_cos)),
+            _ => Vec3::ZERO,
+        }
+    }
+}
+
+/// A spot light's intensity relative to its axis at cosine `cos` from the axis.
+#[inline]
+pub fn spot_profile(cos: f32, cos_inner: f32, cos_outer: f32, exponent: f32) -> f32 {
+    if cos <= cos_outer {
+        return 0.0;
+    }
+    let step = if cos >= cos_inner || cos_inner <= cos_outer {
+        1.0
+    } else {
+        let t = (cos - cos_outer) / (cos_inner - cos_outer);
+        t * t * (3.0 - 2.0 * t)
+    };
+    if exponent > 0.0 {
+        step * cos.max(0.0).powf(exponent)
+    } else {
+        step
+    }
+}
+
+/// ∫ profile dω over the sphere: a spot light's power per unit intensity (numerically, in cos).
+pub fn spot_solid_angle(cos_inner: f32, cos_outer: f32, exponent: f32) -> f32 {
+    let steps = 1024;
+    let span = 1.0 - cos_outer;
+    let sum: f32 = (0..steps)
+        .map(|i| {
+            spot_profile(
+                cos_outer + span * (i as f32 + 0.5) / steps as f32,
+                cos_inner,
+                cos_outer,
+                exponent,
+            )
+        })
+        .sum();
+    2.0 * PI * span * sum / steps as f32
 }
 
 /// The course's falloff min(1, 1 / (a + b d + c d²)); 1 where the denominator is not positive.
@@ -267,7 +403,53 @@ impl LightSet {
                 let d = d2.sqrt();
                 (to / d, d, *color / d2)
             }
+            Light::Spot {
+                position,
+                direction,
+                color,
+                cos_inner,
+                cos_outer,
+                exponent,
+                ..
+            } => {
+                let to = *position - p;
+                let d2 = to.length_squared();
+                if !(d2 > 0.0 && d2.is_finite()) {
+                    return None;
+                }
+                let d = d2.sqrt();
+                let wi = to / d;
+                let profile = spot_profile(-wi.dot(*direction), *cos_inner, *cos_outer, *exponent);
+                if profile <= 0.0 {
+                    return None;
+                }
+                (wi, d, *color * (profile / d2))
+            }
             Light::Directional { direction, color } => (-*direction, f32::INFINITY, *color),
+            light @ Light::Sun { direction, cos_max, .. } => {
+                let wi = sample_uniform_cone(u, -*direction, *cos_max);
+                let pdf = p_pick * self.sun_pdf(light);
+                if !scene.unoccluded(p, ng, wi, f32::INFINITY) {
+                    return None;
+                }
+                return Some(DirectSample {
+                    wi,
+                    contribution: light.sun_radiance() / pdf,
+                    pdf,
+                });
+            }
+            Light::Environment(env) => {
+                let s = env.sample(u)?;
+                if !scene.unoccluded(p, ng, s.wi, f32::INFINITY) {
+                    return None;
+                }
+                let pdf = p_pick * s.pdf;
+                return Some(DirectSample {
+                    wi: s.wi,
+                    contribution: s.radiance / pdf,
+                    pdf,
+                });
+            }
             Light::Area(light) => return sample_area_direct(scene, light, p, ng, p_pick, u_pick, u),
         };
         if !scene.unoccluded(p, ng, wi, distance) {
@@ -278,6 +460,64 @@ impl LightSet {
             contribution: value / p_pick,
             pdf: 0.0,
         })
+    }
+
+    /// Solid-angle pdf of a sun's uniform cone.
+    fn sun_pdf(&self, light: &Light) -> f32 {
+        match light {
+            Light::Sun { one_minus_cos, .. } => 1.0 / (2.0 * PI * one_minus_cos),
+            _ => 0.0,
+        }
+    }
+
+    /// Radiance arriving along a ray that leaves the scene in direction `dir` (unit): the sky
+    /// and any sun whose disc it points into (physical model).
+    pub fn escaped(&self, dir: Vec3) -> Vec3 {
+        let mut l = Vec3::ZERO;
+        for light in &self.lights {
+            match light {
+                Light::Environment(env) => l += env.radiance(dir),
+                Light::Sun { direction, cos_max, .. } if -dir.dot(*direction) >= *cos_max => l += light.sun_radiance(),
+                _ => {}
+            }
+        }
+        l
+    }
+
+    /// Solid-angle pdf with which [`LightSet::sample_direct`] would pick the escaping direction
+    /// `dir` (the sky's and suns' part), for weighting BSDF samples that escape.
+    pub fn pdf_escaped(&self, dir: Vec3) -> f32 {
+        let mut pdf = 0.0;
+        for (light, &p_pick) in self.lights.iter().zip(&self.probabilities) {
+            match light {
+                Light::Environment(env) => pdf += p_pick * env.pdf(dir),
+                Light::Sun { direction, cos_max, .. } if -dir.dot(*direction) >= *cos_max => {
+                    pdf += p_pick * self.sun_pdf(light)
+                }
+                _ => {}
+            }
+        }
+        pdf
+    }
+
+    /// What a course-model ray that leaves the scene sees: the environment's radiance, black
+    /// without one.
+    pub fn background(&self, dir: Vec3) -> Vec3 {
+        self.lights
+            .iter()
+            .filter_map(|l| match l {
+                Light::Environment(env) => Some(env.radiance(dir)),
+                _ => None,
+            })
+            .fold(Vec3::ZERO, |a, b| a + b)
+    }
+
+    /// Whether light arrives from outside the scene (an environment or a sun): rays that escape
+    /// carry radiance.
+    pub fn has_sky(&self) -> bool {
+        self.lights
+            .iter()
+            .any(|l| matches!(l, Light::Environment(_) | Light::Sun { .. }))
     }
 
     /// Solid-angle pdf with which [`LightSet::sample_direct`] from `from` would pick the

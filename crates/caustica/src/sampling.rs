@@ -117,6 +117,121 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
     cos_theta.max(0.0) / PI
 }
 
+/// A piecewise-constant distribution over [0, 1) in `n` equal cells, weighted by `weights`.
+#[derive(Clone, Debug)]
+pub struct Distribution1D {
+    /// Each cell's weight divided by the mean weight: the density within the cell.
+    density: Vec<f32>,
+    /// Running sums of the cell probabilities, ending at 1.
+    cdf: Vec<f32>,
+    /// The sum of the weights.
+    total: f32,
+}
+
+impl Distribution1D {
+    /// The distribution of non-negative `weights` (uniform when they are all zero).
+    pub fn new(weights: &[f32]) -> Distribution1D {
+        let n = weights.len().max(1);
+        let clean: Vec<f32> = (0..n)
+            .map(|i| {
+                weights
+                    .get(i)
+                    .copied()
+                    .filter(|w| w.is_finite() && *w > 0.0)
+                    .unwrap_or(0.0)
+            })
+            .collect();
+        let total: f32 = clean.iter().map(|&w| w as f64).sum::<f64>() as f32;
+        let probabilities: Vec<f64> = if total > 0.0 {
+            clean.iter().map(|&w| w as f64 / total as f64).collect()
+        } else {
+            vec![1.0 / n as f64; n]
+        };
+        let mut acc = 0.0f64;
+        let mut cdf: Vec<f32> = probabilities
+            .iter()
+            .map(|p| {
+                acc += p;
+                acc as f32
+            })
+            .collect();
+        if let Some(last) = cdf.last_mut() {
+            *last = 1.0;
+        }
+        let density = probabilities.iter().map(|p| (p * n as f64) as f32).collect();
+        Distribution1D { density, cdf, total }
+    }
+
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.cdf.len()
+    }
+
+    /// Whether the distribution has no cell (never: at least one).
+    pub fn is_empty(&self) -> bool {
+        self.cdf.is_empty()
+    }
+
+    /// The sum of the weights it was made from.
+    pub fn total(&self) -> f32 {
+        self.total
+    }
+
+    /// A point in [0, 1) drawn from the distribution, its cell, and the density there.
+    pub fn sample(&self, u: f32) -> (f32, usize, f32) {
+        let cell = self.cdf.partition_point(|&c| c <= u).min(self.cdf.len() - 1);
+        let low = if cell == 0 { 0.0 } else { self.cdf[cell - 1] };
+        let width = self.cdf[cell] - low;
+        let t = if width > 0.0 {
+            ((u - low) / width).clamp(0.0, 1.0)
+        } else {
+            0.5
+        };
+        let x = ((cell as f32 + t) / self.cdf.len() as f32).min(1.0 - f32::EPSILON);
+        (x, cell, self.density[cell])
+    }
+
+    /// The density at `x` in [0, 1).
+    pub fn pdf(&self, x: f32) -> f32 {
+        let cell = ((x * self.cdf.len() as f32) as usize).min(self.cdf.len() - 1);
+        self.density[cell]
+    }
+}
+
+/// A piecewise-constant distribution over [0, 1)² on a grid of `width` × `height` cells (rows
+/// from v = 0): a row by its total weight, then a column within it.
+#[derive(Clone, Debug)]
+pub struct Distribution2D {
+    rows: Distribution1D,
+    columns: Vec<Distribution1D>,
+}
+
+impl Distribution2D {
+    /// The distribution of `weights`, `width` per row, rows from v = 0.
+    pub fn new(weights: &[f32], width: usize) -> Distribution2D {
+        let width = width.max(1);
+        let columns: Vec<Distribution1D> = weights.chunks(width).map(Distribution1D::new).collect();
+        let row_weights: Vec<f32> = columns.iter().map(Distribution1D::total).collect();
+        Distribution2D {
+            rows: Distribution1D::new(&row_weights),
+            columns,
+        }
+    }
+
+    /// A point (u, v) in [0, 1)² and the density there.
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32) {
+        let (v, row, pdf_row) = self.rows.sample(u.y);
+        let (x, _, pdf_column) = self.columns[row].sample(u.x);
+        (Vec2::new(x, v), pdf_row * pdf_column)
+    }
+
+    /// The density at (u, v).
+    pub fn pdf(&self, uv: Vec2) -> f32 {
+        let row = ((uv.y * self.rows.len() as f32) as usize).min(self.rows.len() - 1);
+        self.rows.pdf(uv.y) * self.columns[row].pdf(uv.x)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -168,5 +283,40 @@ mod tests {
         let n = 50_000;
         let s: f32 = (0..n).map(|_| sample_cosine_hemisphere(rng.uniform2()).z).sum();
         assert!((s / n as f32 - 2.0 / 3.0).abs() < 0.005);
+    }
+
+    /// Samples land in each cell in proportion to its weight, and the density they report is
+    /// the weight over the mean weight.
+    #[test]
+    fn piecewise_constant_distributions_sample_their_weights() {
+        let weights = [0.0, 1.0, 3.0, 0.0, 4.0];
+        let d = Distribution1D::new(&weights);
+        let mut rng = Rng::new(11, 0);
+        let mut counts = [0u32; 5];
+        let n = 200_000;
+        for _ in 0..n {
+            let (x, cell, pdf) = d.sample(rng.uniform());
+            assert_eq!(cell, (x * 5.0) as usize);
+            assert!((pdf - weights[cell] / 1.6).abs() < 1e-5);
+            assert_eq!(pdf, d.pdf(x));
+            counts[cell] += 1;
+        }
+        for (c, w) in counts.iter().zip(weights) {
+            assert!((*c as f64 / n as f64 - w as f64 / 8.0).abs() < 0.005, "{counts:?}");
+        }
+        let flat = Distribution1D::new(&[0.0, 0.0]);
+        assert_eq!(flat.pdf(0.7), 1.0);
+        // In 2D, the estimate Σ f / pdf of ∫ f over the square is exact for f ∝ the weights.
+        let grid = [1.0, 2.0, 0.0, 5.0, 1.0, 3.0];
+        let d2 = Distribution2D::new(&grid, 3);
+        let mut sum = 0.0f64;
+        for _ in 0..10_000 {
+            let (uv, pdf) = d2.sample(rng.uniform2());
+            assert!((pdf - d2.pdf(uv)).abs() < 1e-4 * pdf);
+            let cell = (uv.y * 2.0) as usize * 3 + (uv.x * 3.0) as usize;
+            sum += (grid[cell] / pdf) as f64;
+        }
+        let integral = grid.iter().sum::<f32>() as f64 / 6.0;
+        assert!((sum / 10_000.0 - integral).abs() < 1e-3, "{}", sum / 10_000.0);
     }
 }

@@ -26,6 +26,12 @@ impl Texture {
         self.height
     }
 
+    /// The texel in column `x`, row `y` (rows from the top).
+    #[inline]
+    pub fn texel(&self, x: usize, y: usize) -> Vec3 {
+        self.texels[y * self.width + x]
+    }
+
     /// Bilinearly filtered colour at `uv`, u to the right and v upwards, clamped at the edges.
     pub fn lookup(&self, uv: Vec2) -> Vec3 {
         let x = (uv.x.clamp(0.0, 1.0) * self.width as f32 - 0.5).clamp(0.0, (self.width - 1) as f32);

@@ -60,6 +60,26 @@ fn text(scene: &str, s: &SceneSummary) -> String {
             LightSummary::Directional { direction, color } => {
                 format!("  directional  towards {direction:?}  colour {color:?}")
             }
+            LightSummary::Spot {
+                position,
+                direction,
+                color,
+                attenuation,
+                inner_angle,
+                outer_angle,
+                exponent,
+            } => format!(
+                "  spot         at {position:?}  towards {direction:?}  colour {color:?}  cone {inner_angle}°–{outer_angle}°  exponent {exponent}  attenuation {attenuation:?}"
+            ),
+            LightSummary::Sun {
+                direction,
+                color,
+                angle,
+            } => format!("  sun          towards {direction:?}  colour {color:?}  angle {angle}°"),
+            LightSummary::Environment { color, mapped } => format!(
+                "  environment  colour {color:?}{}",
+                if *mapped { " × map" } else { "" }
+            ),
         });
     }
     if !s.area_lights.is_empty() {

@@ -1,9 +1,9 @@
-//! Next-event estimation under the physical model: one light sample per smooth surface point,
-//! weighted against BSDF sampling by multiple importance sampling (power heuristic) where the
-//! caller also counts the emitters its BSDF samples hit.
+//! Direct light under the physical model: one light sample per smooth surface point
+//! (next-event estimation), weighted against BSDF sampling by multiple importance sampling
+//! (power heuristic) where the caller also counts the emitters and sky its BSDF samples reach.
 
-use crate::bsdf::Bsdf;
-use crate::math::Vec3;
+use crate::bsdf::{Bsdf, BsdfSample};
+use crate::math::{offset_origin, Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 
@@ -43,4 +43,37 @@ pub fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3, mis:
 #[inline]
 pub fn emitted(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
     scene.emission(hit).max(Vec3::ZERO)
+}
+
+/// Whether BSDF samples can reach light at all: only emissive objects and the sky can be hit
+/// (point, spot and directional lights are deltas). Without them next-event estimation alone is
+/// direct lighting.
+pub fn bsdf_can_reach_light(scene: &Scene) -> bool {
+    let lights = scene.lights();
+    lights.has_sky() || lights.area_lights().next().is_some()
+}
+
+/// The light that the smooth-lobe sample `sample` from the surface point `hit` reaches directly —
+/// an emitter's surface or the sky — weighted against next-event estimation: the BSDF half of
+/// direct lighting by MIS (the caller multiplies by `sample.weight`).
+pub fn direct_by_bsdf(scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample) -> Vec3 {
+    let lights = scene.lights();
+    let ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+    match scene.intersect(&ray, f32::INFINITY) {
+        None => {
+            let le = lights.escaped(sample.wi);
+            if le == Vec3::ZERO {
+                return Vec3::ZERO;
+            }
+            le * power_heuristic(sample.pdf, lights.pdf_escaped(sample.wi))
+        }
+        Some(isect) => {
+            let reached = scene.surface(&ray, &isect);
+            let le = emitted(scene, &reached);
+            if le == Vec3::ZERO {
+                return Vec3::ZERO;
+            }
+            le * power_heuristic(sample.pdf, lights.pdf_direct(hit.point, &reached))
+        }
+    }
 }

@@ -15,7 +15,7 @@
 //! A gather ray that reaches a light, directly or by a specular chain, adds nothing: next-event
 //! estimation and the caustic map already count those paths.
 
-use super::direct::direct_light;
+use super::direct::{bsdf_can_reach_light, direct_light, emitted, power_heuristic};
 use super::ppm::PHOTON_SEED;
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
 use super::specular_chain::camera_chain;
@@ -82,6 +82,9 @@ pub struct Gi<'a> {
     height: usize,
     seed: u64,
     pixel_angle: f32,
+    /// Whether direct light also comes by BSDF sampling (emissive objects or a sky), weighted
+    /// against the light sample.
+    mis: bool,
 }
 
 impl<'a> Gi<'a> {
@@ -94,6 +97,7 @@ impl<'a> Gi<'a> {
             height,
             seed,
             pixel_angle: pixel_angle(scene.camera(), height),
+            mis: bsdf_can_reach_light(scene),
         }
     }
 
@@ -130,35 +134,61 @@ impl<'a> Gi<'a> {
             rng,
             |hit, bsdf, wo, path_length, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                direct_light(self.scene, hit, bsdf, wo, false, rng)
+                direct_light(self.scene, hit, bsdf, wo, self.mis, rng)
                     + maps.caustic.radiance_within(hit.point, bsdf, wo, r)
             },
             |hit, sample, path_length, rng| {
                 let origin = offset_origin(hit.point, hit.geometric_normal, sample.wi);
-                sample.weight * self.gather(maps, Ray::new(origin, sample.wi), path_length, rng, 0)
+                let from = Some((hit.point, sample.pdf));
+                sample.weight * self.gather(maps, Ray::new(origin, sample.wi), from, path_length, rng, 0)
             },
         )
     }
 
-    /// Light arriving along a gather ray, emission excluded: the global map's estimate at the
-    /// smooth surface it reaches through mirrors and glass. Where that surface is closer than
-    /// the global map's gather radius (corners, contact shadows) the map's blur would show, so
-    /// up to [`EXACT_LEVELS`] times the light there is computed like at the first surface instead.
-    fn gather(&self, maps: &GiMaps, ray: Ray, path_length: f32, rng: &mut Rng, level: u32) -> Vec3 {
+    /// Light arriving along a gather ray: the global map's estimate at the smooth surface it
+    /// reaches through mirrors and glass. Where that surface is closer than the global map's
+    /// gather radius (corners, contact shadows) the map's blur would show, so up to
+    /// [`EXACT_LEVELS`] times the light there is computed like at the first surface instead.
+    /// Emission the ray meets straight away (an emitter or the sky) counts weighted against the
+    /// light sample of the point it left (`from`: that point and the ray's pdf; none when the
+    /// ray left by a specular lobe, whose lights the caustic map counts).
+    fn gather(
+        &self,
+        maps: &GiMaps,
+        ray: Ray,
+        from: Option<(Vec3, f32)>,
+        path_length: f32,
+        rng: &mut Rng,
+        level: u32,
+    ) -> Vec3 {
         let scene = self.scene;
+        let lights = scene.lights();
         let s = &self.settings;
         let mut ray = ray;
         let mut beta = Vec3::ONE;
         let mut path_length = path_length;
         let mut segment = 0.0f32;
+        // Emission at the first surface (or sky) the ray meets, weighted against the light sample.
+        let mut emitted_first = Vec3::ZERO;
+        let mut direct_from = from.filter(|_| self.mis);
         for _ in 0..=s.max_depth {
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                if let Some((_, pdf)) = direct_from {
+                    let le = lights.escaped(ray.dir);
+                    return le * power_heuristic(pdf, lights.pdf_escaped(ray.dir));
+                }
                 break;
             };
             let hit = scene.surface(&ray, &isect);
             path_length += isect.t;
             segment += isect.t;
             let wo = -ray.dir;
+            if let Some((point, pdf)) = direct_from.take() {
+                let le = emitted(scene, &hit);
+                if le != Vec3::ZERO {
+                    emitted_first = le * power_heuristic(pdf, lights.pdf_direct(point, &hit));
+                }
+            }
             let bsdf = Bsdf::at(scene, &hit, wo);
             if bsdf.is_black() {
                 break;
@@ -166,16 +196,17 @@ impl<'a> Gi<'a> {
             if bsdf.is_smooth() {
                 if level >= EXACT_LEVELS || segment > maps.global_radius {
                     let r = maps.global_radius * 0.5 * maps.caustic_factor;
-                    return beta * maps.global.radiance_within(hit.point, &bsdf, wo, r);
+                    return emitted_first + beta * maps.global.radiance_within(hit.point, &bsdf, wo, r);
                 }
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                let mut l = direct_light(scene, &hit, &bsdf, wo, false, rng);
+                let mut l = direct_light(scene, &hit, &bsdf, wo, self.mis, rng);
                 l += maps.caustic.radiance_within(hit.point, &bsdf, wo, r);
                 if let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) {
                     let next = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
-                    l += sample.weight * self.gather(maps, next, path_length, rng, level + 1);
+                    let from = (!sample.specular).then_some((hit.point, sample.pdf));
+                    l += sample.weight * self.gather(maps, next, from, path_length, rng, level + 1);
                 }
-                return beta * l;
+                return emitted_first + beta * l;
             }
             let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
                 break;
@@ -183,7 +214,7 @@ impl<'a> Gi<'a> {
             beta *= sample.weight;
             ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
         }
-        Vec3::ZERO
+        emitted_first
     }
 }
 

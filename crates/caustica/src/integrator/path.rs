@@ -44,6 +44,16 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng)
     let mut last_point = ray.origin;
     for depth in 0..=settings.max_depth {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+            // The sky and suns, weighted against having sampled them directly.
+            let le = lights.escaped(ray.dir);
+            if le != Vec3::ZERO {
+                let weight = if specular {
+                    1.0
+                } else {
+                    power_heuristic(last_pdf, lights.pdf_escaped(ray.dir))
+                };
+                l += beta * le * weight;
+            }
             break;
         };
         let hit = scene.surface(&ray, &isect);

@@ -9,7 +9,7 @@
 //! light comes from next-event estimation and everything else (caustics, indirect diffuse light)
 //! from the photons within the pass's radius.
 
-use super::direct::direct_light;
+use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
 use super::specular_chain::camera_chain;
 use super::tiles::sample_pass;
@@ -62,6 +62,9 @@ pub struct Ppm<'a> {
     seed: u64,
     /// Width of a pixel at unit distance from the eye.
     pixel_angle: f32,
+    /// Whether direct light also comes by BSDF sampling (emissive objects or a sky), weighted
+    /// against the light sample.
+    mis: bool,
 }
 
 impl<'a> Ppm<'a> {
@@ -75,6 +78,7 @@ impl<'a> Ppm<'a> {
             height,
             seed,
             pixel_angle,
+            mis: bsdf_can_reach_light(scene),
         }
     }
 
@@ -104,9 +108,15 @@ impl<'a> Ppm<'a> {
             rng,
             |hit, bsdf, wo, path_length, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
-                direct_light(self.scene, hit, bsdf, wo, false, rng) + map.radiance_within(hit.point, bsdf, wo, r)
+                direct_light(self.scene, hit, bsdf, wo, self.mis, rng) + map.radiance_within(hit.point, bsdf, wo, r)
             },
-            |_, _, _, _| Vec3::ZERO,
+            |hit, sample, _, _| {
+                if self.mis {
+                    sample.weight * direct_by_bsdf(self.scene, hit, sample)
+                } else {
+                    Vec3::ZERO
+                }
+            },
         )
     }
 }

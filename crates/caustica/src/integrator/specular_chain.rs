@@ -31,6 +31,8 @@ where
     let mut path_length = 0.0f32;
     for depth in 0..=max_depth {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+            // Only the camera and specular chains get here: the sky counts in full.
+            l += beta * scene.lights().escaped(ray.dir);
             break;
         };
         let hit = scene.surface(&ray, &isect);

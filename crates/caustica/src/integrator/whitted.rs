@@ -53,7 +53,7 @@ where
     C: Fn(&SurfaceHit, &SurfaceParams, Vec3, Vec3, u32) -> Vec3,
 {
     let Some(isect) = scene.intersect(ray, f32::INFINITY) else {
-        return Vec3::ZERO;
+        return scene.lights().background(ray.dir);
     };
     let hit = scene.surface(ray, &isect);
     let p = &scene.phong(&hit);

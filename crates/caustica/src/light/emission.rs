@@ -14,7 +14,7 @@
 //! budget of stored caustic photons between its lights, each aimed.
 
 use super::area::{AreaLight, AreaSample};
-use super::{Light, LightSet};
+use super::{spot_profile, Light, LightSet};
 use crate::math::{luminance, offset_origin, Aabb, Frame, Ray, Vec2, Vec3};
 use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, Rng};
 use crate::scene::{ObjectRef, Scene};
@@ -51,20 +51,37 @@ struct DiscLobe {
     radius: f32,
 }
 
+/// A spot light's cone: the axis and its profile (see [`spot_profile`]).
+#[derive(Clone, Copy, Debug)]
+struct SpotCone {
+    axis: Vec3,
+    cos_inner: f32,
+    cos_outer: f32,
+    exponent: f32,
+}
+
 #[derive(Clone, Debug)]
 enum Kind {
     /// An emissive object, sampled by its own area sampler.
     Area,
+    /// A point or spot light: a mixture of cones of directions.
     Point {
         position: Vec3,
         cones: Vec<ConeLobe>,
+        spot: Option<SpotCone>,
     },
+    /// A directional light or a sun: a mixture of discs on a plane across the beam; a sun's
+    /// photons leave in directions spread over its cone (cos_max, 1 − cos_max).
     Directional {
         direction: Vec3,
         frame: Frame,
         plane_origin: Vec3,
         discs: Vec<DiscLobe>,
+        sun: Option<(f32, f32)>,
     },
+    /// The sky: a direction by the environment's own sampling, then a point on a disc across
+    /// it, the scene's or the targets' as seen along that direction.
+    Environment { scene: Target, discs: Vec<Target> },
 }
 
 /// One light's photon source.
@@ -83,50 +100,87 @@ impl Emitter {
     /// objects are never aimed); `scene` is the sphere around the scene, across which directional
     /// light enters. `None` when the light cannot send a photon anywhere useful.
     pub fn new(light: &Light, targets: Option<&[Target]>, scene: Target) -> Option<Emitter> {
+        let point = |position: Vec3, color: Vec3, spot: Option<SpotCone>| {
+            let cones: Vec<ConeLobe> = match (targets, spot) {
+                (None, None) => vec![ConeLobe {
+                    axis: Vec3::Z,
+                    cos_max: -1.0,
+                }],
+                (None, Some(spot)) => vec![ConeLobe {
+                    axis: spot.axis,
+                    cos_max: spot.cos_outer,
+                }],
+                (Some(ts), _) => ts.iter().map(|t| cone_towards(position, t)).collect(),
+            };
+            let weights: Vec<f32> = cones.iter().map(|c| 1.0 - c.cos_max).collect();
+            let power = light.power(scene.radius);
+            Emitter::finish(Kind::Point { position, cones, spot }, color, weights, power)
+        };
+        let directional = |direction: Vec3, color: Vec3, sun: Option<(f32, f32)>| {
+            let frame = Frame::from_normal(direction);
+            let plane_origin = scene.center - direction * (scene.radius * 2.0 + 1.0);
+            // A sun's photons lean by up to its angular radius: widen each disc so that every
+            // leaning ray that can reach the target starts inside it.
+            let lean = sun.map_or(0.0, |(cos_max, _)| (1.0 - cos_max * cos_max).max(0.0).sqrt() / cos_max);
+            let to_disc = |t: &Target| {
+                let local = frame.to_local(t.center - plane_origin);
+                DiscLobe {
+                    center: Vec2::new(local.x, local.y),
+                    radius: t.radius + (local.z.max(0.0) + t.radius) * lean,
+                }
+            };
+            let discs: Vec<DiscLobe> = match targets {
+                None => vec![to_disc(&scene)],
+                Some(ts) => ts.iter().map(to_disc).collect(),
+            };
+            let weights: Vec<f32> = discs.iter().map(|d| d.radius * d.radius).collect();
+            let power = luminance(color).max(0.0) * PI * scene.radius * scene.radius;
+            let kind = Kind::Directional {
+                direction,
+                frame,
+                plane_origin,
+                discs,
+                sun,
+            };
+            Emitter::finish(kind, color, weights, power)
+        };
         match *light {
-            Light::Point { position, color, .. } => {
-                let cones: Vec<ConeLobe> = match targets {
-                    None => vec![ConeLobe {
-                        axis: Vec3::Z,
-                        cos_max: -1.0,
-                    }],
-                    Some(ts) => ts.iter().map(|t| cone_towards(position, t)).collect(),
-                };
-                let weights: Vec<f32> = cones.iter().map(|c| 1.0 - c.cos_max).collect();
-                Emitter::finish(
-                    Kind::Point { position, cones },
-                    color,
-                    weights,
-                    4.0 * PI * luminance(color).max(0.0),
-                )
-            }
+            Light::Point { position, color, .. } => point(position, color, None),
+            Light::Spot {
+                position,
+                direction,
+                color,
+                cos_inner,
+                cos_outer,
+                exponent,
+                ..
+            } => point(
+                position,
+                color,
+                Some(SpotCone {
+                    axis: direction,
+                    cos_inner,
+                    cos_outer,
+                    exponent,
+                }),
+            ),
             Light::Area(ref area) => Emitter::finish(Kind::Area, area.radiance, vec![1.0], area.power()),
-            Light::Directional { direction, color } => {
-                let frame = Frame::from_normal(direction);
-                let plane_origin = scene.center - direction * (scene.radius * 2.0 + 1.0);
-                let to_disc = |t: &Target| {
-                    let local = frame.to_local(t.center - plane_origin);
-                    DiscLobe {
-                        center: Vec2::new(local.x, local.y),
-                        radius: t.radius,
-                    }
-                };
-                let discs: Vec<DiscLobe> = match targets {
-                    None => vec![to_disc(&scene)],
-                    Some(ts) => ts.iter().map(to_disc).collect(),
-                };
-                let weights: Vec<f32> = discs.iter().map(|d| d.radius * d.radius).collect();
-                let power = luminance(color).max(0.0) * PI * scene.radius * scene.radius;
+            Light::Directional { direction, color } => directional(direction, color, None),
+            Light::Sun {
+                direction,
+                color,
+                cos_max,
+                one_minus_cos,
+            } => directional(direction, color, Some((cos_max, one_minus_cos))),
+            Light::Environment(ref env) => {
+                let discs: Vec<Target> = targets.map_or_else(|| vec![scene], <[Target]>::to_vec);
+                let weights = discs.iter().map(|d| d.radius * d.radius).collect();
+                let kind = Kind::Environment { scene, discs };
                 Emitter::finish(
-                    Kind::Directional {
-                        direction,
-                        frame,
-                        plane_origin,
-                        discs,
-                    },
-                    color,
+                    kind,
+                    env.color.max(Vec3::splat(1e-30)),
                     weights,
-                    power,
+                    light.power(scene.radius),
                 )
             }
         }
@@ -171,22 +225,57 @@ impl Emitter {
         let lobe = self.pick(rng.uniform());
         let u = rng.uniform2();
         let (ray, flux) = match &self.kind {
-            Kind::Point { position, cones } => {
+            Kind::Point { position, cones, spot } => {
                 let dir = sample_uniform_cone(u, cones[lobe].axis, cones[lobe].cos_max);
                 let pdf = self.cone_pdf(cones, dir);
-                (pdf > 0.0).then(|| (Ray::new(*position, dir), self.color / pdf))?
+                let profile = spot.map_or(1.0, |s| {
+                    spot_profile(dir.dot(s.axis), s.cos_inner, s.cos_outer, s.exponent)
+                });
+                (pdf > 0.0 && profile > 0.0).then(|| (Ray::new(*position, dir), self.color * (profile / pdf)))?
             }
             Kind::Directional {
                 direction,
                 frame,
                 plane_origin,
                 discs,
+                sun,
             } => {
                 let disc = &discs[lobe];
                 let p = disc.center + sample_uniform_disc(u) * disc.radius;
                 let pdf = self.disc_pdf(discs, p);
                 let origin = *plane_origin + frame.x * p.x + frame.y * p.y;
-                (pdf > 0.0).then(|| (Ray::new(origin, *direction), self.color / pdf))?
+                let (dir, spread) = match sun {
+                    None => (*direction, 1.0),
+                    // Over the sun's disc: radiance E / (π sin²θ) × cos × the cone's solid angle.
+                    Some((cos_max, one_minus_cos)) => {
+                        let dir = sample_uniform_cone(rng.uniform2(), *direction, *cos_max);
+                        (dir, 2.0 * dir.dot(*direction) / (2.0 - one_minus_cos))
+                    }
+                };
+                (pdf > 0.0).then(|| (Ray::new(origin, dir), self.color * (spread / pdf)))?
+            }
+            Kind::Environment { scene, discs } => {
+                let Light::Environment(env) = light else {
+                    return None;
+                };
+                let sky = env.sample(rng.uniform2())?;
+                let dir = -sky.wi;
+                let frame = Frame::from_normal(dir);
+                let plane_origin = scene.center - dir * (scene.radius * 2.0 + 1.0);
+                let project = |t: &Target| {
+                    let local = frame.to_local(t.center - plane_origin);
+                    DiscLobe {
+                        center: Vec2::new(local.x, local.y),
+                        radius: t.radius,
+                    }
+                };
+                let lobes: Vec<DiscLobe> = discs.iter().map(project).collect();
+                let disc = &lobes[lobe];
+                let p = disc.center + sample_uniform_disc(u) * disc.radius;
+                let pdf_area = self.disc_pdf(&lobes, p);
+                let origin = plane_origin + frame.x * p.x + frame.y * p.y;
+                (pdf_area > 0.0 && sky.pdf > 0.0)
+                    .then(|| (Ray::new(origin, dir), sky.radiance / (sky.pdf * pdf_area)))?
             }
             Kind::Area => return None,
         };
@@ -457,6 +546,73 @@ mod tests {
                 "{objects}: {} vs {exact}",
                 sum / n as f64
             );
+        }
+    }
+
+    /// The flux that far lights send through a sphere in the scene: E·πr² for a directional
+    /// light or a sun, πr²·∫L dω for the sky — whether the photons are aimed at the sphere or
+    /// spread over the scene.
+    #[test]
+    fn far_lights_send_their_flux_through_a_sphere_aimed_or_not() {
+        use crate::light::Environment;
+        use crate::texture::Texture;
+        let sky_map = Texture::new(
+            16,
+            8,
+            (0..128)
+                .map(|i| if i == 20 { Vec3::splat(50.0) } else { Vec3::splat(0.3) })
+                .collect(),
+        )
+        .unwrap();
+        let sky = Environment::new(Vec3::new(1.0, 0.8, 0.6), Some(sky_map), crate::math::Mat3::IDENTITY);
+        let sky_flux_density = sky.luminance_integral();
+        let target = Target {
+            center: Vec3::new(0.7, -0.2, 0.4),
+            radius: 0.6,
+        };
+        let scene_sphere = Target {
+            center: Vec3::ZERO,
+            radius: 3.0,
+        };
+        let lights = [
+            (
+                Light::Directional {
+                    direction: Vec3::new(0.2, -1.0, 0.1).normalize(),
+                    color: Vec3::splat(2.0),
+                },
+                2.0 * PI * 0.36,
+            ),
+            (
+                Light::sun(Vec3::new(-0.3, -1.0, 0.2).normalize(), Vec3::splat(2.0), 5.0),
+                2.0 * PI * 0.36 * 2.0 / (1.0 + 2.5f32.to_radians().cos()),
+            ),
+            (Light::Environment(sky), PI * 0.36 * sky_flux_density),
+        ];
+        let empty = scene("");
+        for (light, exact) in lights {
+            for aimed in [false, true] {
+                let targets = [target];
+                let e = Emitter::new(&light, aimed.then_some(&targets[..]), scene_sphere).unwrap();
+                let mut rng = Rng::new(4, 0);
+                let n = 400_000;
+                let mut sum = 0.0f64;
+                for _ in 0..n {
+                    let Some(p) = e.sample(&light, &empty, &mut rng) else {
+                        continue;
+                    };
+                    // Does the ray pass through the sphere?
+                    let oc = target.center - p.ray.origin;
+                    let t = oc.dot(p.ray.dir);
+                    if t > 0.0 && (oc - p.ray.dir * t).length_squared() <= target.radius * target.radius {
+                        sum += crate::math::luminance(p.flux) as f64;
+                    }
+                }
+                let estimate = sum / n as f64;
+                assert!(
+                    (estimate / exact as f64 - 1.0).abs() < 0.02,
+                    "{light:?} aimed {aimed}: {estimate} vs {exact}"
+                );
+            }
         }
     }
 }

@@ -411,7 +411,9 @@ impl PhotonModel for CourseModel<'_> {
 #[inline]
 pub fn falloff_scale(light: &Light, path_length: f32) -> f32 {
     match light {
-        Light::Point { attenuation, .. } => path_length * path_length * distance_attenuation(*attenuation, path_length),
+        Light::Point { attenuation, .. } | Light::Spot { attenuation, .. } => {
+            path_length * path_length * distance_attenuation(*attenuation, path_length)
+        }
         _ => 1.0,
     }
 }

@@ -10,7 +10,7 @@ use crate::geometry::cone::Cone;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Shape, ShapeKind, ShapeSettings};
 use crate::image_io;
-use crate::light::Light;
+use crate::light::{Environment, Light};
 use crate::material::{Channel, Material};
 use crate::math::{Aabb, Mat3, Vec3};
 use crate::progress::{NoProgress, Progress};
@@ -51,8 +51,11 @@ fn build_objects(
 ) -> Result<Scene, ParseError> {
     let mut builder = Builder::default();
     let camera = desc.camera.as_ref().map(Camera::from_desc).unwrap_or_default();
-    let lights = desc.lights.iter().filter_map(convert_light).collect();
     let mut warnings: Vec<String> = desc.warnings.iter().map(|(w, _)| w.clone()).collect();
+    let mut lights = Vec::new();
+    for light in &desc.lights {
+        lights.extend(convert_light(light, &mut warnings)?);
+    }
     if desc.camera.is_none() {
         warnings.push("the scene has no camera: using the default one at the origin looking down −z".into());
     }
@@ -100,8 +103,15 @@ fn material_is_emissive(m: &MaterialDesc) -> bool {
     !matches!(m.emissive, Param::Constant(c) if c == Vec3::ZERO)
 }
 
-fn convert_light(light: &LightDesc) -> Option<Light> {
-    match light {
+fn convert_light(light: &LightDesc, warnings: &mut Vec<String>) -> Result<Option<Light>, ParseError> {
+    let mut unit = |v: &Vec3, what: &str| {
+        let d = v.normalize_or_zero();
+        if d == Vec3::ZERO || !d.is_finite() {
+            warnings.push(format!("a {what} with a zero direction gives no light: left out"));
+        }
+        (d != Vec3::ZERO && d.is_finite()).then_some(d)
+    };
+    Ok(match light {
         LightDesc::Point {
             position,
             color,
@@ -113,13 +123,62 @@ fn convert_light(light: &LightDesc) -> Option<Light> {
             attenuation: *attenuation,
         }),
         LightDesc::Directional { direction, color, .. } => {
-            let direction = direction.normalize_or_zero();
-            (direction != Vec3::ZERO).then_some(Light::Directional {
+            unit(direction, "directional light").map(|direction| Light::Directional {
                 direction,
                 color: *color,
             })
         }
-    }
+        LightDesc::Spot {
+            position,
+            direction,
+            color,
+            attenuation,
+            inner_degrees,
+            outer_degrees,
+            exponent,
+            ..
+        } => unit(direction, "spot light").map(|direction| {
+            let outer = outer_degrees.clamp(0.0, 180.0);
+            let inner = inner_degrees.clamp(0.0, outer);
+            Light::Spot {
+                position: *position,
+                direction,
+                color: *color,
+                attenuation: *attenuation,
+                cos_inner: inner.to_radians().cos(),
+                cos_outer: outer.to_radians().cos(),
+                exponent: exponent.max(0.0),
+            }
+        }),
+        LightDesc::Sun {
+            direction,
+            color,
+            angle_degrees,
+            ..
+        } => unit(direction, "sun").map(|direction| Light::sun(direction, *color, *angle_degrees)),
+        LightDesc::Environment {
+            color,
+            map,
+            rotation,
+            span,
+        } => {
+            let texture = match map {
+                None => None,
+                Some(path) => Some(image_io::load_texture(path).map_err(|e| {
+                    let reason = match e {
+                        Error::Image { message, .. } => message,
+                        other => other.to_string(),
+                    };
+                    ParseError::new(
+                        format!("cannot read the environment map `{}`: {reason}", path.display()),
+                        span.clone(),
+                    )
+                    .with_help("environment maps are EXR or Radiance HDR images in latitude–longitude layout, resolved against the scene file's folder")
+                })?),
+            };
+            Some(Light::Environment(Environment::new(*color, texture, *rotation)))
+        }
+    })
 }
 
 #[derive(Default)]

@@ -13,7 +13,7 @@ use serde::Serialize;
 pub struct SceneSummary {
     /// The camera.
     pub camera: CameraSummary,
-    /// The file's point and directional lights.
+    /// The file's lights (emissive objects are in `area_lights`).
     pub lights: Vec<LightSummary>,
     /// Emissive objects (lights in the physical model).
     pub area_lights: Vec<AreaLightSummary>,
@@ -71,6 +71,39 @@ pub enum LightSummary {
         direction: [f32; 3],
         /// Colour.
         color: [f32; 3],
+    },
+    /// A spot light.
+    Spot {
+        /// Position.
+        position: [f32; 3],
+        /// The unit direction it shines.
+        direction: [f32; 3],
+        /// Colour on its axis.
+        color: [f32; 3],
+        /// The course's (a, b, c) falloff.
+        attenuation: [f32; 3],
+        /// Half-angle of full intensity, in degrees.
+        inner_angle: f32,
+        /// Half-angle beyond which it is dark, in degrees.
+        outer_angle: f32,
+        /// Exponent of the cosine falloff.
+        exponent: f32,
+    },
+    /// A sun.
+    Sun {
+        /// The unit direction its light travels.
+        direction: [f32; 3],
+        /// Irradiance on a surface facing it.
+        color: [f32; 3],
+        /// Angular diameter in degrees.
+        angle: f32,
+    },
+    /// The sky.
+    Environment {
+        /// Radiance (times the map).
+        color: [f32; 3],
+        /// Whether an image map modulates it.
+        mapped: bool,
     },
 }
 
@@ -204,7 +237,7 @@ impl Scene {
         let camera = self.camera();
         let lights = self
             .lights()
-            .course_lights()
+            .iter()
             .filter_map(|light| match light {
                 Light::Point {
                     position,
@@ -218,6 +251,37 @@ impl Scene {
                 Light::Directional { direction, color } => Some(LightSummary::Directional {
                     direction: direction.to_array(),
                     color: color.to_array(),
+                }),
+                Light::Spot {
+                    position,
+                    direction,
+                    color,
+                    attenuation,
+                    cos_inner,
+                    cos_outer,
+                    exponent,
+                } => Some(LightSummary::Spot {
+                    position: position.to_array(),
+                    direction: direction.to_array(),
+                    color: color.to_array(),
+                    attenuation: *attenuation,
+                    inner_angle: cos_inner.clamp(-1.0, 1.0).acos().to_degrees(),
+                    outer_angle: cos_outer.clamp(-1.0, 1.0).acos().to_degrees(),
+                    exponent: *exponent,
+                }),
+                Light::Sun {
+                    direction,
+                    color,
+                    cos_max,
+                    ..
+                } => Some(LightSummary::Sun {
+                    direction: direction.to_array(),
+                    color: color.to_array(),
+                    angle: 2.0 * cos_max.clamp(-1.0, 1.0).acos().to_degrees(),
+                }),
+                Light::Environment(env) => Some(LightSummary::Environment {
+                    color: env.color.to_array(),
+                    mapped: env.has_map(),
                 }),
                 Light::Area(_) => None,
             })

@@ -59,6 +59,8 @@ const POINT_LIGHT_FIELDS: &[&str] = &[
     "quadratic_attenuation_coeff",
 ];
 const DIRECTIONAL_LIGHT_FIELDS: &[&str] = &["direction", "color", "colour"];
+const SUN_LIGHT_FIELDS: &[&str] = &["direction", "color", "colour", "angle"];
+const ENVIRONMENT_LIGHT_FIELDS: &[&str] = &["color", "colour", "map"];
 const MESH_FIELDS: &[&str] = &[
     "material",
     "name",
@@ -137,6 +139,8 @@ impl<'a> Parser<'a> {
                     "camera" => self.camera()?,
                     "point_light" => self.point_light()?,
                     "directional_light" => self.directional_light()?,
+                    "sun_light" => self.sun_light()?,
+                    "environment_light" => self.environment_light()?,
                     "ambient_light" => self.ambient_light()?,
                     "material" => {
                         let base = self.default_material.clone();
@@ -530,6 +534,103 @@ impl<'a> Parser<'a> {
         self.scene
             .lights
             .push(LightDesc::Directional { direction, color, span });
+        Ok(())
+    }
+
+    /// `sun_light { direction; color; angle }`: a caustica extension (docs/scene-format.md).
+    fn sun_light(&mut self) -> Result<(), ParseError> {
+        let keyword = self.cur.next();
+        let (mut direction, mut color, mut angle) = (None, None, None);
+        self.block(
+            &keyword,
+            |p, token, key| {
+                let duplicate = match key {
+                    "direction" => direction.is_some(),
+                    "color" | "colour" => color.is_some(),
+                    "angle" => angle.is_some(),
+                    _ => return Ok(false),
+                };
+                if duplicate {
+                    return Err(ParseError::new(
+                        format!("`sun_light` has a second `{key}`"),
+                        token.span.clone(),
+                    ));
+                }
+                p.key_equals()?;
+                match key {
+                    "direction" => direction = Some(p.vec3("for `direction`")?),
+                    "angle" => {
+                        let (value, span) = p.cur.number("(the sun's angular diameter in degrees) for `angle`")?;
+                        if !(0.0..=90.0).contains(&value) {
+                            return Err(ParseError::new(
+                                format!(
+                                    "`angle` is the sun's angular diameter in degrees, between 0 and 90, not {value}"
+                                ),
+                                span,
+                            ));
+                        }
+                        angle = Some(value);
+                    }
+                    _ => color = Some(p.vec3(&format!("for `{key}`"))?),
+                }
+                p.cur.eat(Tok::Semicolon);
+                Ok(true)
+            },
+            SUN_LIGHT_FIELDS,
+        )?;
+        let span = keyword.span.start..self.cur.prev_end();
+        let (direction, color) = match (direction, color) {
+            (Some(direction), Some(color)) => (direction, color),
+            (None, _) => return Err(ParseError::new("`sun_light` needs a `direction`", span)),
+            (_, None) => return Err(ParseError::new("`sun_light` needs a `color`", span)),
+        };
+        self.scene.lights.push(LightDesc::Sun {
+            direction,
+            color,
+            angle_degrees: angle.unwrap_or(0.53),
+            span,
+        });
+        Ok(())
+    }
+
+    /// `environment_light { color; map = "sky.exr"; }`: a caustica extension.
+    fn environment_light(&mut self) -> Result<(), ParseError> {
+        let keyword = self.cur.next();
+        let (mut color, mut map) = (None, None);
+        let scene_dir = self.scene_dir;
+        self.block(
+            &keyword,
+            |p, token, key| {
+                let duplicate = match key {
+                    "color" | "colour" => color.is_some(),
+                    "map" => map.is_some(),
+                    _ => return Ok(false),
+                };
+                if duplicate {
+                    return Err(ParseError::new(
+                        format!("`environment_light` has a second `{key}`"),
+                        token.span.clone(),
+                    ));
+                }
+                p.key_equals()?;
+                if key == "map" {
+                    let (file, _) = p.identifier("(the image file, in quotes) for `map`")?;
+                    map = Some(scene_dir.join(file));
+                } else {
+                    color = Some(p.vec3(&format!("for `{key}`"))?);
+                }
+                p.cur.eat(Tok::Semicolon);
+                Ok(true)
+            },
+            ENVIRONMENT_LIGHT_FIELDS,
+        )?;
+        let span = keyword.span.start..self.cur.prev_end();
+        self.scene.lights.push(LightDesc::Environment {
+            color: color.unwrap_or(Vec3::ONE),
+            map,
+            rotation: glam::Mat3::IDENTITY,
+            span,
+        });
         Ok(())
     }
 
