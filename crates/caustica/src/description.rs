@@ -148,8 +148,10 @@ pub struct MaterialDesc {
     pub transmissive: Param,
     /// Phong exponent (a constant is a grey triple; a texture is luminance × 128, §6.1).
     pub shininess: Param,
-    /// Index of refraction (grey triple).
+    /// Index of refraction (grey triple); with `abbe`, the index n_d at 587.6 nm.
     pub index: Param,
+    /// Abbe number V_d of a dispersive glass (caustica extension): n_F − n_C = (n_d − 1) / V_d.
+    pub abbe: Option<f32>,
     /// Name registered with `name`, if any.
     pub name: Option<String>,
 }
@@ -166,6 +168,7 @@ impl Default for MaterialDesc {
             transmissive: Param::grey(0.0),
             shininess: Param::grey(0.0),
             index: Param::grey(1.0),
+            abbe: None,
             name: None,
         }
     }

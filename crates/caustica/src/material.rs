@@ -63,8 +63,10 @@ pub struct Material {
     pub transmissive: Channel,
     /// Phong exponent (texture: luminance × 128, §6.1).
     pub shininess: Channel,
-    /// Index of refraction (luminance of the value).
+    /// Index of refraction (luminance of the value); with `abbe`, n_d at 587.6 nm.
     pub index: Channel,
+    /// Abbe number V_d of a dispersive glass.
+    pub abbe: Option<f32>,
 }
 
 /// A material's values at one surface point.

@@ -311,6 +311,7 @@ impl Builder {
             transmissive: self.channel(&desc.transmissive)?,
             shininess: self.channel(&desc.shininess)?,
             index: self.channel(&desc.index)?,
+            abbe: desc.abbe,
         };
         let key = MaterialKey(
             [
@@ -328,6 +329,7 @@ impl Builder {
                 Channel::Constant(v) => [0, v.x.to_bits(), v.y.to_bits(), v.z.to_bits()],
                 Channel::Texture(i) => [1, *i, 0, 0],
             })
+            .chain([material.abbe.map_or(0, f32::to_bits)])
             .collect(),
         );
         if let Some(&id) = self.material_ids.get(&key) {

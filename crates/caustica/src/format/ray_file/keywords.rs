@@ -56,6 +56,7 @@ pub(crate) const RESERVED: &[&str] = &[
     "transmissive",
     "shininess",
     "index",
+    "abbe",
     "name",
     "map",
     "true",

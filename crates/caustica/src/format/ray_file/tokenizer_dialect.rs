@@ -39,6 +39,7 @@ const MATERIAL_FIELDS: &[&str] = &[
     "transmissive",
     "shininess",
     "index",
+    "abbe",
     "name",
 ];
 const CAMERA_FIELDS: &[&str] = &[
@@ -700,6 +701,20 @@ impl<'a> Parser<'a> {
                     }
                     name = Some((value, span));
                 }
+                "abbe" => {
+                    self.key_equals()?;
+                    let (value, span) = self
+                        .cur
+                        .number("(the Abbe number V_d of a dispersive glass) for `abbe`")?;
+                    if !(value > 0.0 && value.is_finite()) {
+                        return Err(ParseError::new(
+                            format!("`abbe` is an Abbe number, positive (about 20 to 90 for glasses), not {value}"),
+                            span,
+                        ));
+                    }
+                    self.cur.eat(Tok::Semicolon);
+                    material.abbe = Some(value);
+                }
                 _ if COLOUR_FIELDS.contains(&key) || key == "shininess" || key == "index" => {
                     self.key_equals()?;
                     let value = if self.cur.at_word("map") {
@@ -713,7 +728,7 @@ impl<'a> Parser<'a> {
                     *field_mut(&mut material, key) = value;
                 }
                 _ => {
-                    let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `name`";
+                    let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `abbe`, `name`";
                     return Err(self.bad_word(&format!("a material field ({list}) or `}}`"), MATERIAL_FIELDS));
                 }
             }
