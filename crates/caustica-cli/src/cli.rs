@@ -217,6 +217,13 @@ pub struct ProgressiveOptions {
     /// image (for comparing with one).
     #[arg(long)]
     pub no_camera_specular: bool,
+    /// Physical model: carry light at sampled wavelengths (hero-wavelength sampling) instead of
+    /// RGB [default: when the scene has a dispersive glass, `abbe`].
+    #[arg(long, overrides_with = "no_spectral")]
+    pub spectral: bool,
+    /// Physical model: carry light in RGB even with dispersive glass (which then does not disperse).
+    #[arg(long)]
+    pub no_spectral: bool,
     /// ppm: Knaus–Zwicker α in (0, 1); the radius² shrinks by (i + α)/(i + 1) each pass.
     #[arg(long, default_value_t = 2.0 / 3.0)]
     pub alpha: f32,

@@ -76,7 +76,7 @@ fn caustic_photons(n: usize) -> Vec<Photon> {
                 (r * t.cos(), r * t.sin())
             };
             let dir = Vec3::new(rng.uniform() - 0.5, -1.0, rng.uniform() - 0.5).normalize();
-            Photon::new(Vec3::new(x, 0.0, z), Vec3::splat(1e-6), dir, Vec3::Y, 1, 0)
+            Photon::new(Vec3::new(x, 0.0, z), Vec3::splat(1e-6), dir, Vec3::Y, 1)
         })
         .collect()
 }

@@ -12,10 +12,11 @@
 //! material creates energy. Directions point away from the surface; `n` is the outward shading
 //! normal as the shape defines it.
 
-use crate::material::SurfaceParams;
-use crate::math::{reflect, Frame, Vec3};
+use crate::material::{MaterialRef, MaterialSpectra, SurfaceParams};
+use crate::math::{reflect, Frame, Vec3, Vec4};
 use crate::sampling::sample_cosine_hemisphere;
 use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{cauchy_index, SigmoidPolynomial, Spectrum, Wavelengths};
 use std::f32::consts::PI;
 
 /// Whether a path carries radiance (from the camera) or importance (from a light): refraction
@@ -37,12 +38,16 @@ pub struct Bsdf {
     ng: Vec3,
     /// Whether `wo` is on the outward side (a ray arriving from outside).
     outside: bool,
-    diffuse: Vec3,
-    glossy: Vec3,
+    diffuse: Spectrum,
+    glossy: Spectrum,
     exponent: f32,
-    mirror: Vec3,
-    transmission: Vec3,
+    mirror: Spectrum,
+    transmission: Spectrum,
+    /// Index of refraction (at the hero wavelength for a dispersive glass).
     index: f32,
+    /// Whether the dielectric's index depends on the wavelength (a glass with an Abbe number,
+    /// under spectral transport).
+    dispersive: bool,
     /// Lobe selection probabilities: diffuse, glossy, mirror, dielectric.
     pick: [f32; 4],
 }
@@ -53,7 +58,7 @@ pub struct BsdfSample {
     /// Unit direction away from the surface.
     pub wi: Vec3,
     /// f · |cos θi| / pdf: the factor the path's throughput is multiplied by.
-    pub weight: Vec3,
+    pub weight: Spectrum,
     /// Solid-angle pdf of the whole mixture for a smooth lobe; the discrete probability of the
     /// event for a specular one.
     pub pdf: f32,
@@ -61,18 +66,39 @@ pub struct BsdfSample {
     pub specular: bool,
     /// Whether the direction crossed the surface.
     pub transmitted: bool,
+    /// Whether the direction holds for the hero wavelength only (a dispersive glass): the path
+    /// must drop its other wavelengths.
+    pub dispersive: bool,
 }
 
 impl Bsdf {
-    /// The lobes at a surface point of `scene`, seen from direction `wo` (unit, away from it).
+    /// The lobes at a surface point of `scene`, seen from direction `wo` (unit, away from it),
+    /// for light at wavelengths `wl`.
     #[inline]
-    pub fn at(scene: &Scene, hit: &SurfaceHit, wo: Vec3) -> Bsdf {
-        Bsdf::new(&scene.phong(hit), hit.shading_normal, hit.geometric_normal, wo)
+    pub fn at(scene: &Scene, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Bsdf {
+        let params = scene.phong(hit);
+        let abbe = scene.abbe(hit);
+        let spectra = match (wl.is_spectral(), hit.material) {
+            (true, MaterialRef::One(id)) => Some(scene.material_spectra(id)),
+            _ => None,
+        };
+        Bsdf::new(&params, hit.shading_normal, hit.geometric_normal, wo, wl, spectra, abbe)
     }
 
     /// The lobes of `params` at a point with outward shading normal `ns` and geometric normal
-    /// `ng`, seen from direction `wo` (unit, away from the surface).
-    pub fn new(params: &SurfaceParams, ns: Vec3, ng: Vec3, wo: Vec3) -> Bsdf {
+    /// `ng`, seen from direction `wo` (unit, away from the surface), for light at wavelengths
+    /// `wl`. A material's fitted spectra (`spectra`) are used for its constant colours; `abbe`
+    /// makes its dielectric dispersive.
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        params: &SurfaceParams,
+        ns: Vec3,
+        ng: Vec3,
+        wo: Vec3,
+        wl: &Wavelengths,
+        spectra: Option<&MaterialSpectra>,
+        abbe: Option<f32>,
+    ) -> Bsdf {
         let outside = wo.dot(ng) >= 0.0;
         let facing = if wo.dot(ns) >= 0.0 { ns } else { -ns };
         let ng_facing = if outside { ng } else { -ng };
@@ -84,13 +110,25 @@ impl Bsdf {
             clamp(params.transmissive),
         );
         let total = (kd + ks + kr + kt).max_element();
+        let scale = if total > 1.0 { 1.0 / total } else { 1.0 };
         if total > 1.0 {
-            let s = 1.0 / total;
-            kd *= s;
-            ks *= s;
-            kr *= s;
-            kt *= s;
+            kd *= scale;
+            ks *= scale;
+            kr *= scale;
+            kt *= scale;
         }
+        // A colour at the wavelengths: the material's fitted spectrum (scaled like the colour)
+        // where it has one, else the table's.
+        let spectrum = |rgb: Vec3, fit: Option<SigmoidPolynomial>| match (wl, fit) {
+            (Wavelengths::Sampled { lambda, .. }, Some(fit)) => Vec4::from_array(lambda.map(|l| fit.eval(l))) * scale,
+            _ => wl.reflectance(rgb),
+        };
+        let fits = spectra.copied().unwrap_or_default();
+        let index = if params.index > 0.0 { params.index } else { 1.0 };
+        let (index, dispersive) = match (abbe, wl.hero()) {
+            (Some(v), Some(lambda)) if kt != Vec3::ZERO => (cauchy_index(index, v, lambda), true),
+            _ => (index, false),
+        };
         let mut pick = [kd.max_element(), ks.max_element(), kr.max_element(), 0.0];
         if kt != Vec3::ZERO {
             // The dielectric reflects even where kt is small; sample it by its larger part.
@@ -104,12 +142,13 @@ impl Bsdf {
             frame: Frame::from_normal(facing),
             ng: ng_facing,
             outside,
-            diffuse: kd,
-            glossy: ks,
+            diffuse: spectrum(kd, fits.diffuse),
+            glossy: spectrum(ks, fits.specular),
             exponent: params.shininess.max(0.0),
-            mirror: kr,
-            transmission: kt,
-            index: if params.index > 0.0 { params.index } else { 1.0 },
+            mirror: spectrum(kr, fits.reflective),
+            transmission: spectrum(kt, fits.transmissive),
+            index,
+            dispersive,
             pick,
         }
     }
@@ -134,14 +173,14 @@ impl Bsdf {
     }
 
     /// The smooth lobes' f(wo, wi) (delta lobes are never hit by a given direction).
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
         let n = self.frame.z;
         let cos_i = n.dot(wi);
         if cos_i <= 0.0 || self.ng.dot(wi) <= 0.0 {
-            return Vec3::ZERO;
+            return Spectrum::ZERO;
         }
         let mut f = self.diffuse * (1.0 / PI);
-        if self.glossy != Vec3::ZERO {
+        if self.glossy != Spectrum::ZERO {
             let cos_a = reflect(-wo, n).dot(wi);
             if cos_a > 0.0 {
                 f += self.glossy * ((self.exponent + 2.0) / (2.0 * PI) * cos_a.powf(self.exponent));
@@ -193,6 +232,7 @@ impl Bsdf {
                 pdf,
                 specular: false,
                 transmitted: false,
+                dispersive: false,
             });
         }
         x -= p_diffuse + p_glossy;
@@ -204,6 +244,7 @@ impl Bsdf {
                 pdf: p_mirror,
                 specular: true,
                 transmitted: false,
+                dispersive: false,
             });
         }
         if p_dielectric <= 0.0 {
@@ -218,10 +259,11 @@ impl Bsdf {
             let wi = reflect(-wo, n);
             return Some(BsdfSample {
                 wi,
-                weight: Vec3::ONE / p_dielectric,
+                weight: Spectrum::ONE / p_dielectric,
                 pdf: p_dielectric * f,
                 specular: true,
                 transmitted: false,
+                dispersive: self.dispersive,
             });
         }
         let wi = crate::math::refract(-wo, n, 1.0 / eta)?;
@@ -235,6 +277,7 @@ impl Bsdf {
             pdf: p_dielectric * (1.0 - f),
             specular: true,
             transmitted: true,
+            dispersive: self.dispersive,
         })
     }
 }
@@ -257,6 +300,8 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 mod tests {
     use super::*;
     use crate::sampling::Rng;
+
+    const RGB: Wavelengths = Wavelengths::Rgb;
 
     fn params(kd: f32, ks: f32, n: f32) -> SurfaceParams {
         SurfaceParams {
@@ -290,7 +335,7 @@ mod tests {
         let n = Vec3::Z;
         let wo = Vec3::Z;
         for (kd, ks, exp) in [(0.8, 0.0, 1.0), (0.0, 0.9, 10.0), (0.0, 0.9, 200.0), (0.5, 0.4, 30.0)] {
-            let bsdf = Bsdf::new(&params(kd, ks, exp), n, n, wo);
+            let bsdf = Bsdf::new(&params(kd, ks, exp), n, n, wo, &RGB, None, None);
             let mut rng = Rng::new(1, 0);
             let count = 200_000;
             let mut sum = 0.0f64;
@@ -318,7 +363,7 @@ mod tests {
     fn pdf_integrates_to_one_over_the_hemisphere() {
         let n = Vec3::Z;
         let wo = Vec3::new(0.6, 0.0, 0.8);
-        let bsdf = Bsdf::new(&params(0.3, 0.5, 5.0), n, n, wo);
+        let bsdf = Bsdf::new(&params(0.3, 0.5, 5.0), n, n, wo, &RGB, None, None);
         let mut rng = Rng::new(2, 0);
         let count = 400_000;
         let mut sum = 0.0f64;
@@ -342,7 +387,7 @@ mod tests {
         };
         let n = Vec3::Z;
         let wo = Vec3::new(0.0, 0.5f32.sin(), 0.5f32.cos());
-        let bsdf = Bsdf::new(&glass, n, n, wo);
+        let bsdf = Bsdf::new(&glass, n, n, wo, &RGB, None, None);
         assert!(!bsdf.is_smooth());
         let mut rng = Rng::new(3, 0);
         let count = 100_000;
@@ -366,7 +411,15 @@ mod tests {
         assert!((reflected / count as f64 - f).abs() < 0.004);
         assert!((total / count as f64 - 1.0).abs() < 1e-4, "photons keep their flux");
         // From inside, a steep ray is totally reflected.
-        let inside = Bsdf::new(&glass, n, n, -Vec3::new(0.0, 0.9f32.sin(), 0.9f32.cos()));
+        let inside = Bsdf::new(
+            &glass,
+            n,
+            n,
+            -Vec3::new(0.0, 0.9f32.sin(), 0.9f32.cos()),
+            &RGB,
+            None,
+            None,
+        );
         let s = inside
             .sample(
                 -Vec3::new(0.0, 0.9f32.sin(), 0.9f32.cos()),
@@ -385,7 +438,7 @@ mod tests {
             reflective: Vec3::splat(0.6),
             ..SurfaceParams::default()
         };
-        let bsdf = Bsdf::new(&p, Vec3::Z, Vec3::Z, Vec3::Z);
+        let bsdf = Bsdf::new(&p, Vec3::Z, Vec3::Z, Vec3::Z, &RGB, None, None);
         assert!((bsdf.diffuse.x + bsdf.mirror.x - 1.0).abs() < 1e-6);
         assert!((bsdf.diffuse.x / bsdf.mirror.x - 0.8 / 0.6).abs() < 1e-5);
     }

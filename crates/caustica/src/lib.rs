@@ -28,6 +28,7 @@ pub mod presets;
 pub mod progress;
 pub mod sampling;
 pub mod scene;
+pub mod spectrum;
 pub mod texture;
 
 pub use error::{Error, ParseError, Result};

@@ -26,6 +26,7 @@ use emission::{Emitter, Target};
 use crate::math::{luminance, offset_origin, Ray, Vec3};
 use crate::sampling::{sample_uniform_cone, Rng};
 use crate::scene::{ObjectRef, Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, Wavelengths};
 use std::f32::consts::PI;
 
 /// The closed set of lights.
@@ -263,9 +264,10 @@ pub fn distance_attenuation(abc: [f32; 3], d: f32) -> f32 {
 pub struct DirectSample {
     /// Unit direction towards the light.
     pub wi: Vec3,
-    /// Incident radiance (area lights) or irradiance (point, directional) divided by the
-    /// probability of the sample: multiplied by f·cos it is the estimate.
-    pub contribution: Vec3,
+    /// Incident radiance (area lights, suns, the sky) or irradiance (point, spot, directional)
+    /// at the path's wavelengths, divided by the probability of the sample: multiplied by f·cos
+    /// it is the estimate.
+    pub contribution: Spectrum,
     /// Solid-angle pdf including the choice of light, for MIS; 0 for delta lights.
     pub pdf: f32,
 }
@@ -388,7 +390,13 @@ impl LightSet {
 
     /// Samples one light for the point `hit` (visibility included): `None` when the light
     /// chosen sends nothing there.
-    pub fn sample_direct(&self, scene: &Scene, hit: &SurfaceHit, rng: &mut Rng) -> Option<DirectSample> {
+    pub fn sample_direct(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+    ) -> Option<DirectSample> {
         let (index, p_pick) = self.pick(rng.uniform())?;
         let (u_pick, u) = (rng.uniform(), rng.uniform2());
         let p = hit.point;
@@ -434,7 +442,7 @@ impl LightSet {
                 }
                 return Some(DirectSample {
                     wi,
-                    contribution: light.sun_radiance() / pdf,
+                    contribution: wl.unbounded(light.sun_radiance()) / pdf,
                     pdf,
                 });
             }
@@ -446,18 +454,18 @@ impl LightSet {
                 let pdf = p_pick * s.pdf;
                 return Some(DirectSample {
                     wi: s.wi,
-                    contribution: s.radiance / pdf,
+                    contribution: wl.unbounded(s.radiance) / pdf,
                     pdf,
                 });
             }
-            Light::Area(light) => return sample_area_direct(scene, light, p, ng, p_pick, u_pick, u),
+            Light::Area(light) => return sample_area_direct(scene, light, p, ng, p_pick, (u_pick, u), wl),
         };
         if !scene.unoccluded(p, ng, wi, distance) {
             return None;
         }
         Some(DirectSample {
             wi,
-            contribution: value / p_pick,
+            contribution: wl.unbounded(value) / p_pick,
             pdf: 0.0,
         })
     }
@@ -471,13 +479,15 @@ impl LightSet {
     }
 
     /// Radiance arriving along a ray that leaves the scene in direction `dir` (unit): the sky
-    /// and any sun whose disc it points into (physical model).
-    pub fn escaped(&self, dir: Vec3) -> Vec3 {
-        let mut l = Vec3::ZERO;
+    /// and any sun whose disc it points into (physical model), at the wavelengths `wl`.
+    pub fn escaped(&self, dir: Vec3, wl: &Wavelengths) -> Spectrum {
+        let mut l = Spectrum::ZERO;
         for light in &self.lights {
             match light {
-                Light::Environment(env) => l += env.radiance(dir),
-                Light::Sun { direction, cos_max, .. } if -dir.dot(*direction) >= *cos_max => l += light.sun_radiance(),
+                Light::Environment(env) => l += wl.unbounded(env.radiance(dir)),
+                Light::Sun { direction, cos_max, .. } if -dir.dot(*direction) >= *cos_max => {
+                    l += wl.unbounded(light.sun_radiance())
+                }
                 _ => {}
             }
         }
@@ -541,8 +551,8 @@ fn sample_area_direct(
     p: Vec3,
     ng: Vec3,
     p_pick: f32,
-    u_pick: f32,
-    u: glam::Vec2,
+    (u_pick, u): (f32, glam::Vec2),
+    wl: &Wavelengths,
 ) -> Option<DirectSample> {
     let drawn = light.sample_towards(scene, p, u_pick, u)?;
     let sample = drawn.point;
@@ -560,7 +570,7 @@ fn sample_area_direct(
     if isect.prim != sample.prim || (isect.t - (sample.point - origin).length()).abs() > 1e-3 * (1.0 + d) {
         return None;
     }
-    let le = scene.emission(&scene.surface(&ray, &isect));
+    let le = scene.emission_spectrum(&scene.surface(&ray, &isect), wl);
     let pdf = p_pick * drawn.pdf_solid;
     Some(DirectSample {
         wi,

@@ -1,6 +1,7 @@
 //! Materials of the `.ray` format (§6): constant or texture-mapped parameters, evaluated at a hit.
 
-use crate::math::{luminance, Vec2, Vec3};
+use crate::math::{luminance, Vec2, Vec3, Vec4};
+use crate::spectrum::{fit_reflectance, SigmoidPolynomial, Spectrum, Wavelengths};
 use crate::texture::Texture;
 
 /// A parameter: a constant or an index into the scene's textures.
@@ -69,6 +70,55 @@ pub struct Material {
     pub abbe: Option<f32>,
 }
 
+/// A material's constant colours as fitted smooth spectra (for spectral transport); `None`
+/// where the colour comes from a texture.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MaterialSpectra {
+    /// kd
+    pub diffuse: Option<SigmoidPolynomial>,
+    /// ks
+    pub specular: Option<SigmoidPolynomial>,
+    /// kr
+    pub reflective: Option<SigmoidPolynomial>,
+    /// kt
+    pub transmissive: Option<SigmoidPolynomial>,
+    /// ke, fitted to its colour scaled to a largest component of ½ (see
+    /// [`MaterialSpectra::emission`]).
+    pub emissive: Option<SigmoidPolynomial>,
+}
+
+impl MaterialSpectra {
+    /// The fits of `material`'s constant colours (a colour above 1 is fitted clamped: the
+    /// physical model scales such materials down anyway).
+    pub fn of(material: &Material) -> MaterialSpectra {
+        let fit = |c: &Channel| match c {
+            Channel::Constant(rgb) => Some(fit_reflectance(*rgb)),
+            Channel::Texture(_) => None,
+        };
+        let emissive = match material.emissive {
+            Channel::Constant(rgb) if rgb.max_element() > 0.0 => Some(fit_reflectance(rgb / (2.0 * rgb.max_element()))),
+            _ => None,
+        };
+        MaterialSpectra {
+            diffuse: fit(&material.diffuse),
+            specular: fit(&material.specular),
+            reflective: fit(&material.reflective),
+            transmissive: fit(&material.transmissive),
+            emissive,
+        }
+    }
+
+    /// The emitted radiance `le` (this material's constant `emissive`) at the wavelengths.
+    pub fn emission(&self, le: Vec3, wl: &Wavelengths) -> Spectrum {
+        match (self.emissive, wl) {
+            (Some(fit), Wavelengths::Sampled { lambda, .. }) => {
+                Vec4::from_array(lambda.map(|l| fit.eval(l))) * (2.0 * le.max_element())
+            }
+            _ => wl.unbounded(le),
+        }
+    }
+}
+
 /// A material's values at one surface point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SurfaceParams {
@@ -129,6 +179,11 @@ impl Material {
     /// Whether the material can turn a photon specularly (mirror or glass): what makes caustics.
     pub fn is_specular(&self) -> bool {
         self.reflective.may_be_nonzero() || self.transmissive.may_be_nonzero()
+    }
+
+    /// Whether the emission is read from a texture.
+    pub fn emissive_is_textured(&self) -> bool {
+        matches!(self.emissive, Channel::Texture(_))
     }
 
     /// Whether any emissive value is non-zero.

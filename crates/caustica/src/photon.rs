@@ -2,8 +2,9 @@
 //! ([`map`]; Jensen, "Rendering Caustics on Non-Lambertian Surfaces", GI 1996), and pictures of
 //! them. Photons leave the lights by [`crate::light::emission`].
 //!
-//! A photon is stored compactly in 24 bytes: position (3 × f32), power in Ward's shared-exponent
-//! RGBE (4 bytes, as in Jensen's own photon map), the incoming direction in 32-bit octahedral
+//! A photon is stored compactly in 24 bytes: position (3 × f32), power as four 8-bit mantissas
+//! sharing an 8-bit exponent (Ward's RGBE, as in Jensen's own photon map, with a fourth channel
+//! for the physical model's fourth wavelength), the incoming direction in 32-bit octahedral
 //! form, the receiver's normal in 16-bit octahedral form, and path flags.
 
 pub mod kd_tree;
@@ -14,7 +15,7 @@ pub mod trace;
 pub use map::{EstimateSettings, PhotonMap};
 pub use trace::{PhotonSettings, PhotonStats};
 
-use crate::math::{Vec2, Vec3};
+use crate::math::{Vec2, Vec3, Vec4};
 
 /// The median distance to the k-th nearest item, measured around up to 256 items spread
 /// through `items` (in tree order): how wide a gather of about k photons is where they are
@@ -46,6 +47,10 @@ pub const REFLECTED: u8 = 1;
 pub const REFRACTED: u8 = 2;
 /// The path met a smooth (diffuse or glossy) surface before landing (physical model).
 pub const DIFFUSE: u8 = 4;
+/// The path went through a dispersive glass under spectral transport: only its hero wavelength
+/// is left, its power already multiplied by the number of wavelengths. A camera path that
+/// dispersed too has made that multiplication itself, so it divides such photons by it again.
+pub const DISPERSED: u8 = 8;
 
 /// Whether a photon arrived straight from its light.
 #[inline]
@@ -68,35 +73,46 @@ pub struct Photon {
     power: [u8; 4],
     direction: [u16; 2],
     normal: [u8; 2],
-    /// [`REFLECTED`] and/or [`REFRACTED`].
+    exponent: u8,
+    /// [`REFLECTED`], [`REFRACTED`], [`DIFFUSE`], [`DISPERSED`].
     pub flags: u8,
-    /// The light that emitted it.
-    pub light: u8,
 }
 
 impl Photon {
-    /// Packs a photon; `direction` is the unit direction it travelled, `normal` the unit surface
-    /// normal on the side it arrived from.
-    pub fn new(position: Vec3, power: Vec3, direction: Vec3, normal: Vec3, flags: u8, light: u8) -> Photon {
+    /// Packs a photon of RGB power (the course model); `direction` is the unit direction it
+    /// travelled, `normal` the unit surface normal on the side it arrived from.
+    pub fn new(position: Vec3, power: Vec3, direction: Vec3, normal: Vec3, flags: u8) -> Photon {
+        Photon::with_spectrum(position, power.extend(0.0), direction, normal, flags)
+    }
+
+    /// Packs a photon carrying four values: RGB, or four wavelengths (the physical model).
+    pub fn with_spectrum(position: Vec3, power: Vec4, direction: Vec3, normal: Vec3, flags: u8) -> Photon {
+        let (power, exponent) = encode_shared_exponent(power);
         Photon {
             position,
-            power: encode_rgbe(power),
+            power,
             direction: encode_oct16(direction),
             normal: encode_oct8(normal),
+            exponent,
             flags,
-            light,
         }
     }
 
-    /// Power (flux).
+    /// RGB power (flux): the first three values.
     #[inline]
     pub fn power(&self) -> Vec3 {
-        decode_rgbe(self.power)
+        self.spectrum().truncate()
+    }
+
+    /// All four values of the power.
+    #[inline]
+    pub fn spectrum(&self) -> Vec4 {
+        decode_shared_exponent(self.power, self.exponent)
     }
 
     /// Replaces the power.
     pub fn set_power(&mut self, power: Vec3) {
-        self.power = encode_rgbe(power);
+        (self.power, self.exponent) = encode_shared_exponent(power.extend(0.0));
     }
 
     /// Unit direction of travel.
@@ -125,12 +141,13 @@ impl kd_tree::KdPoint for Photon {
     }
 }
 
-/// Ward's RGBE: three 8-bit mantissas sharing an 8-bit exponent (rounded to nearest).
-fn encode_rgbe(c: Vec3) -> [u8; 4] {
-    let c = c.max(Vec3::ZERO);
+/// Ward's RGBE with a fourth channel: four 8-bit mantissas sharing an 8-bit exponent (rounded
+/// to nearest).
+fn encode_shared_exponent(c: Vec4) -> ([u8; 4], u8) {
+    let c = c.max(Vec4::ZERO);
     let m = c.max_element();
     if m.is_nan() || m <= 1e-32 || !m.is_finite() {
-        return [0; 4];
+        return ([0; 4], 0);
     }
     // m = f · 2^e with f in [0.5, 1), read from its bits (m is a normal float here).
     let mut e = ((m.to_bits() >> 23) & 0xff) as i32 - 126;
@@ -140,7 +157,7 @@ fn encode_rgbe(c: Vec3) -> [u8; 4] {
         scale *= 0.5;
     }
     let q = |x: f32| round_non_negative(x * scale).min(255) as u8;
-    [q(c.x), q(c.y), q(c.z), (e + 128).clamp(0, 255) as u8]
+    ([q(c.x), q(c.y), q(c.z), q(c.w)], (e + 128).clamp(0, 255) as u8)
 }
 
 /// 2^k for an exponent of a normal float, built from its bits.
@@ -156,18 +173,18 @@ fn round_non_negative(x: f32) -> u32 {
     whole + u32::from(x - whole as f32 >= 0.5)
 }
 
-fn decode_rgbe(c: [u8; 4]) -> Vec3 {
-    if c[3] == 0 {
-        return Vec3::ZERO;
+fn decode_shared_exponent(c: [u8; 4], exponent: u8) -> Vec4 {
+    if exponent == 0 {
+        return Vec4::ZERO;
     }
     // 2^(e − 136) built from its bits (a normal float for every stored exponent but the lowest).
-    let e = c[3] as i32 - 136;
+    let e = exponent as i32 - 136;
     let f = if e > -127 {
         f32::from_bits(((e + 127) as u32) << 23)
     } else {
         (e as f32).exp2()
     };
-    Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32) * f
+    Vec4::new(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32) * f
 }
 
 /// Octahedral map of a unit vector to [0, 1]².
@@ -223,19 +240,30 @@ mod tests {
             Vec3::new(1234.5, 1.0, 700.0),
             Vec3::splat(0.999),
         ] {
-            let back = decode_rgbe(encode_rgbe(c));
+            let (m, e) = encode_shared_exponent(c.extend(0.0));
+            let back = decode_shared_exponent(m, e).truncate();
             let tol = c.max_element() / 256.0;
             assert!((back - c).abs().max_element() <= tol, "{c:?} -> {back:?}");
         }
-        assert_eq!(decode_rgbe(encode_rgbe(Vec3::ZERO)), Vec3::ZERO);
-        assert_eq!(decode_rgbe(encode_rgbe(Vec3::splat(f32::NAN))), Vec3::ZERO);
+        let round_trip = |c: Vec4| {
+            let (m, e) = encode_shared_exponent(c);
+            decode_shared_exponent(m, e)
+        };
+        assert_eq!(round_trip(Vec4::ZERO), Vec4::ZERO);
+        assert_eq!(round_trip(Vec4::splat(f32::NAN)), Vec4::ZERO);
+        let four = Vec4::new(0.5, 2.0, 0.25, 1.5);
+        assert!((round_trip(four) - four).abs().max_element() <= 2.0 / 256.0);
     }
 
     #[test]
     fn rgbe_exponents_decode_exactly() {
         for e in 1..=255u8 {
             let want = Vec3::splat(200.0) * ((e as i32 - 136) as f32).exp2();
-            assert_eq!(decode_rgbe([200, 200, 200, e]), want, "exponent byte {e}");
+            assert_eq!(
+                decode_shared_exponent([200, 200, 200, 0], e).truncate(),
+                want,
+                "exponent byte {e}"
+            );
         }
     }
 
@@ -264,7 +292,7 @@ mod tests {
             Vec3::new(-0.577, 0.577, 0.577).normalize(),
         ];
         for d in dirs {
-            let p = Photon::new(Vec3::ZERO, Vec3::ONE, d, d, 0, 0);
+            let p = Photon::new(Vec3::ZERO, Vec3::ONE, d, d, 0);
             assert!(p.direction().dot(d) > 0.99999, "{d:?} {:?}", p.direction());
             assert!(p.normal().dot(d) > 0.995);
         }

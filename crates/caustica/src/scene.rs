@@ -11,10 +11,12 @@ use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::Shape;
 use crate::light::{Light, LightSet};
-use crate::material::{Material, MaterialRef, SurfaceParams};
+use crate::material::{Material, MaterialRef, MaterialSpectra, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use crate::progress::Progress;
+use crate::spectrum::{Spectrum, Wavelengths};
 use crate::texture::Texture;
+use std::sync::OnceLock;
 
 /// A triangle mesh's shading data in world space; its triangles live in [`Scene::triangles`].
 #[derive(Clone, Debug)]
@@ -90,6 +92,8 @@ pub struct Scene {
     lights: LightSet,
     ambient: Vec3,
     materials: Vec<Material>,
+    /// Each material's fitted spectra, made the first time spectral transport asks.
+    material_spectra: Vec<OnceLock<MaterialSpectra>>,
     textures: Vec<Texture>,
     shapes: Vec<Shape>,
     /// Material id of each shape.
@@ -180,6 +184,7 @@ impl Scene {
             camera,
             lights: LightSet::default(),
             ambient,
+            material_spectra: materials.iter().map(|_| OnceLock::new()).collect(),
             materials,
             textures,
             shapes,
@@ -269,6 +274,36 @@ impl Scene {
                 let p = ids.map(|id| self.materials[id as usize].eval(&self.textures, hit.uv));
                 SurfaceParams::blend([&p[0], &p[1], &p[2]], weights)
             }
+        }
+    }
+
+    /// Material `id`'s constant colours as smooth spectra (fitted on first use).
+    pub fn material_spectra(&self, id: u32) -> &MaterialSpectra {
+        self.material_spectra[id as usize].get_or_init(|| MaterialSpectra::of(&self.materials[id as usize]))
+    }
+
+    /// Whether some material is a dispersive glass.
+    pub fn has_dispersion(&self) -> bool {
+        self.materials.iter().any(|m| m.abbe.is_some())
+    }
+
+    /// The Abbe number of a dispersive glass at a surface point.
+    #[inline]
+    pub fn abbe(&self, hit: &SurfaceHit) -> Option<f32> {
+        match hit.material {
+            MaterialRef::One(id) => self.materials[id as usize].abbe,
+            MaterialRef::Blend { ids, .. } => ids.iter().find_map(|&id| self.materials[id as usize].abbe),
+        }
+    }
+
+    /// The emitted radiance at a surface point at the wavelengths `wl`.
+    pub fn emission_spectrum(&self, hit: &SurfaceHit, wl: &Wavelengths) -> Spectrum {
+        let le = self.emission(hit).max(Vec3::ZERO);
+        match (wl.is_spectral(), hit.material) {
+            (true, MaterialRef::One(id)) if !self.materials[id as usize].emissive_is_textured() => {
+                self.material_spectra(id).emission(le, wl)
+            }
+            _ => wl.unbounded(le),
         }
     }
 

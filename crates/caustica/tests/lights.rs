@@ -10,6 +10,7 @@ use caustica::light::{spot_solid_angle, Light};
 use caustica::math::Vec3;
 use caustica::sampling::Rng;
 use caustica::scene::{build, BuildSettings, Scene};
+use caustica::spectrum::Wavelengths;
 use common::{control, rel, scene};
 use std::f32::consts::PI;
 use std::path::Path;
@@ -123,7 +124,7 @@ fn spot_light_lights_its_cone() {
     let n = 200_000;
     let mut sum = 0.0f64;
     for _ in 0..n {
-        if let Some(p) = s.lights().emit(&s, &mut rng) {
+        if let Some(p) = s.lights().emit(&s, &Wavelengths::Rgb, &mut rng) {
             sum += p.flux.x as f64;
         }
     }

@@ -42,6 +42,11 @@ pub fn config(args: &RenderArgs) -> Result<RenderConfig> {
         footprint: p.footprint,
         alpha: p.alpha,
         no_camera_specular: p.no_camera_specular,
+        spectral: match (p.spectral, p.no_spectral) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
+        },
     })
 }
 

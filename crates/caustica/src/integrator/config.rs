@@ -121,6 +121,9 @@ pub struct RenderConfig {
     pub alpha: f32,
     /// `--no-camera-specular`.
     pub no_camera_specular: bool,
+    /// `--spectral` / `--no-spectral` (physical model): light at sampled wavelengths or in RGB;
+    /// by default spectral exactly when the scene has a dispersive glass.
+    pub spectral: Option<bool>,
 }
 
 impl Default for RenderConfig {
@@ -146,6 +149,7 @@ impl Default for RenderConfig {
             footprint: 2.0,
             alpha: 2.0 / 3.0,
             no_camera_specular: false,
+            spectral: None,
         }
     }
 }
@@ -225,6 +229,7 @@ impl RenderConfig {
             IntegratorKind::Path => Integrator::Path(PathSettings {
                 max_depth: depth,
                 specular_camera_paths,
+                spectral: self.spectral,
                 ..PathSettings::default()
             }),
             IntegratorKind::Ppm => Integrator::Ppm(PpmSettings {
@@ -233,6 +238,7 @@ impl RenderConfig {
                 initial_radius,
                 max_depth: depth,
                 specular_camera_paths,
+                spectral: self.spectral,
             }),
             IntegratorKind::Gi => Integrator::Gi(GiSettings {
                 photons_per_pass,
@@ -241,6 +247,7 @@ impl RenderConfig {
                 alpha: self.alpha,
                 max_depth: depth,
                 specular_camera_paths,
+                spectral: self.spectral,
             }),
         };
         if progressive {

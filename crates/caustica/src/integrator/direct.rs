@@ -6,6 +6,7 @@ use crate::bsdf::{Bsdf, BsdfSample};
 use crate::math::{offset_origin, Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Power heuristic (β = 2) weight of a strategy with pdf `a` against one with pdf `b`.
 #[inline]
@@ -22,13 +23,21 @@ pub fn power_heuristic(a: f32, b: f32) -> f32 {
 
 /// Direct light at a smooth surface point by one light sample, weighted against BSDF sampling
 /// when `mis` is set (the caller then also counts emitters its BSDF samples hit).
-pub fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3, mis: bool, rng: &mut Rng) -> Vec3 {
-    let Some(sample) = scene.lights().sample_direct(scene, hit, rng) else {
-        return Vec3::ZERO;
+pub fn direct_light(
+    scene: &Scene,
+    hit: &SurfaceHit,
+    bsdf: &Bsdf,
+    wo: Vec3,
+    mis: bool,
+    wl: &Wavelengths,
+    rng: &mut Rng,
+) -> Spectrum {
+    let Some(sample) = scene.lights().sample_direct(scene, hit, wl, rng) else {
+        return Spectrum::ZERO;
     };
     let f = bsdf.eval(wo, sample.wi);
-    if f == Vec3::ZERO {
-        return Vec3::ZERO;
+    if f == Spectrum::ZERO {
+        return Spectrum::ZERO;
     }
     let cos = bsdf.normal().dot(sample.wi).abs();
     let weight = if mis && sample.pdf > 0.0 {
@@ -39,10 +48,10 @@ pub fn direct_light(scene: &Scene, hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3, mis:
     f * sample.contribution * (cos * weight)
 }
 
-/// Emitted radiance of a surface towards any direction (two-sided).
+/// Emitted radiance of a surface towards any direction (two-sided), at the wavelengths `wl`.
 #[inline]
-pub fn emitted(scene: &Scene, hit: &SurfaceHit) -> Vec3 {
-    scene.emission(hit).max(Vec3::ZERO)
+pub fn emitted(scene: &Scene, hit: &SurfaceHit, wl: &Wavelengths) -> Spectrum {
+    scene.emission_spectrum(hit, wl)
 }
 
 /// Whether BSDF samples can reach light at all: only emissive objects and the sky can be hit
@@ -56,22 +65,22 @@ pub fn bsdf_can_reach_light(scene: &Scene) -> bool {
 /// The light that the smooth-lobe sample `sample` from the surface point `hit` reaches directly —
 /// an emitter's surface or the sky — weighted against next-event estimation: the BSDF half of
 /// direct lighting by MIS (the caller multiplies by `sample.weight`).
-pub fn direct_by_bsdf(scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample) -> Vec3 {
+pub fn direct_by_bsdf(scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample, wl: &Wavelengths) -> Spectrum {
     let lights = scene.lights();
     let ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
     match scene.intersect(&ray, f32::INFINITY) {
         None => {
-            let le = lights.escaped(sample.wi);
-            if le == Vec3::ZERO {
-                return Vec3::ZERO;
+            let le = lights.escaped(sample.wi, wl);
+            if le == Spectrum::ZERO {
+                return Spectrum::ZERO;
             }
             le * power_heuristic(sample.pdf, lights.pdf_escaped(sample.wi))
         }
         Some(isect) => {
             let reached = scene.surface(&ray, &isect);
-            let le = emitted(scene, &reached);
-            if le == Vec3::ZERO {
-                return Vec3::ZERO;
+            let le = emitted(scene, &reached, wl);
+            if le == Spectrum::ZERO {
+                return Spectrum::ZERO;
             }
             le * power_heuristic(sample.pdf, lights.pdf_direct(hit.point, &reached))
         }

@@ -16,7 +16,7 @@
 //! estimation and the caustic map already count those paths.
 
 use super::direct::{bsdf_can_reach_light, direct_light, emitted, power_heuristic};
-use super::ppm::PHOTON_SEED;
+use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
 use super::specular_chain::camera_chain;
 use super::tiles::sample_pass;
@@ -29,6 +29,7 @@ use crate::photon::trace::trace_count;
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
+use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of the photon-map global illumination integrator.
 #[derive(Clone, Debug, PartialEq)]
@@ -47,6 +48,9 @@ pub struct GiSettings {
     /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
     /// through glass is black, as in a particle tracer's image — for comparing with one).
     pub specular_camera_paths: bool,
+    /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
+    /// dispersive glass).
+    pub spectral: Option<bool>,
 }
 
 impl Default for GiSettings {
@@ -58,6 +62,7 @@ impl Default for GiSettings {
             alpha: 2.0 / 3.0,
             max_depth: 64,
             specular_camera_paths: true,
+            spectral: None,
         }
     }
 }
@@ -85,6 +90,8 @@ pub struct Gi<'a> {
     /// Whether direct light also comes by BSDF sampling (emissive objects or a sky), weighted
     /// against the light sample.
     mis: bool,
+    /// Whether light is carried at sampled wavelengths.
+    spectral: bool,
 }
 
 impl<'a> Gi<'a> {
@@ -92,23 +99,24 @@ impl<'a> Gi<'a> {
     pub fn new(scene: &'a Scene, settings: GiSettings, width: usize, height: usize, seed: u64) -> Gi<'a> {
         Gi {
             scene,
-            settings,
             width,
             height,
             seed,
             pixel_angle: pixel_angle(scene.camera(), height),
             mis: bsdf_can_reach_light(scene),
+            spectral: settings_spectral(&settings.spectral, scene),
+            settings,
         }
     }
 
-    /// The maps of pass `pass`.
-    pub fn maps(&self, pass: u64, control: Control) -> GiMaps {
+    /// The maps of pass `pass`, at the pass's wavelengths `wl`.
+    pub fn maps(&self, pass: u64, wl: &Wavelengths, control: Control) -> GiMaps {
         let photons = trace_count(
             self.scene,
             self.settings.photons_per_pass,
-            self.seed ^ PHOTON_SEED,
-            pass,
+            (self.seed ^ PHOTON_SEED, pass),
             self.settings.max_depth,
+            wl,
             control,
         );
         let caustic: Vec<_> = photons.iter().copied().filter(is_caustic).collect();
@@ -124,23 +132,29 @@ impl<'a> Gi<'a> {
         }
     }
 
-    fn radiance(&self, maps: &GiMaps, ray: Ray, rng: &mut Rng) -> Vec3 {
+    fn radiance(&self, maps: &GiMaps, ray: Ray, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
         let s = &self.settings;
         camera_chain(
             self.scene,
             ray,
             s.max_depth,
             s.specular_camera_paths,
+            wl,
             rng,
-            |hit, bsdf, wo, path_length, rng| {
+            |hit, bsdf, wo, path_length, dispersed, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                direct_light(self.scene, hit, bsdf, wo, self.mis, rng)
-                    + maps.caustic.radiance_within(hit.point, bsdf, wo, r)
+                direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
+                    + maps.caustic.radiance_within(hit.point, bsdf, wo, r, dispersed)
             },
-            |hit, sample, path_length, rng| {
+            |hit, sample, path_length, dispersed, rng| {
                 let origin = offset_origin(hit.point, hit.geometric_normal, sample.wi);
-                let from = Some((hit.point, sample.pdf));
-                sample.weight * self.gather(maps, Ray::new(origin, sample.wi), from, path_length, rng, 0)
+                let gather = Gather {
+                    from: Some((hit.point, sample.pdf)),
+                    path_length,
+                    dispersed,
+                    level: 0,
+                };
+                sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
             },
         )
     }
@@ -152,29 +166,22 @@ impl<'a> Gi<'a> {
     /// Emission the ray meets straight away (an emitter or the sky) counts weighted against the
     /// light sample of the point it left (`from`: that point and the ray's pdf; none when the
     /// ray left by a specular lobe, whose lights the caustic map counts).
-    fn gather(
-        &self,
-        maps: &GiMaps,
-        ray: Ray,
-        from: Option<(Vec3, f32)>,
-        path_length: f32,
-        rng: &mut Rng,
-        level: u32,
-    ) -> Vec3 {
+    fn gather(&self, maps: &GiMaps, ray: Ray, at: Gather, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
         let scene = self.scene;
         let lights = scene.lights();
         let s = &self.settings;
         let mut ray = ray;
-        let mut beta = Vec3::ONE;
-        let mut path_length = path_length;
+        let mut beta = wl.grey(1.0);
+        let mut dispersed = at.dispersed;
+        let mut path_length = at.path_length;
         let mut segment = 0.0f32;
         // Emission at the first surface (or sky) the ray meets, weighted against the light sample.
-        let mut emitted_first = Vec3::ZERO;
-        let mut direct_from = from.filter(|_| self.mis);
+        let mut emitted_first = Spectrum::ZERO;
+        let mut direct_from = at.from.filter(|_| self.mis);
         for _ in 0..=s.max_depth {
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
                 if let Some((_, pdf)) = direct_from {
-                    let le = lights.escaped(ray.dir);
+                    let le = lights.escaped(ray.dir, wl);
                     return le * power_heuristic(pdf, lights.pdf_escaped(ray.dir));
                 }
                 break;
@@ -184,27 +191,38 @@ impl<'a> Gi<'a> {
             segment += isect.t;
             let wo = -ray.dir;
             if let Some((point, pdf)) = direct_from.take() {
-                let le = emitted(scene, &hit);
-                if le != Vec3::ZERO {
+                let le = emitted(scene, &hit, wl);
+                if le != Spectrum::ZERO {
                     emitted_first = le * power_heuristic(pdf, lights.pdf_direct(point, &hit));
                 }
             }
-            let bsdf = Bsdf::at(scene, &hit, wo);
+            let bsdf = Bsdf::at(scene, &hit, wo, wl);
             if bsdf.is_black() {
                 break;
             }
             if bsdf.is_smooth() {
-                if level >= EXACT_LEVELS || segment > maps.global_radius {
+                if at.level >= EXACT_LEVELS || segment > maps.global_radius {
                     let r = maps.global_radius * 0.5 * maps.caustic_factor;
-                    return emitted_first + beta * maps.global.radiance_within(hit.point, &bsdf, wo, r);
+                    let global = maps.global.radiance_within(hit.point, &bsdf, wo, r, dispersed);
+                    return emitted_first + beta * global;
                 }
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                let mut l = direct_light(scene, &hit, &bsdf, wo, self.mis, rng);
-                l += maps.caustic.radiance_within(hit.point, &bsdf, wo, r);
+                let mut l = direct_light(scene, &hit, &bsdf, wo, self.mis, wl, rng);
+                l += maps.caustic.radiance_within(hit.point, &bsdf, wo, r, dispersed);
                 if let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) {
                     let next = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
-                    let from = (!sample.specular).then_some((hit.point, sample.pdf));
-                    l += sample.weight * self.gather(maps, next, from, path_length, rng, level + 1);
+                    let mut weight = sample.weight;
+                    let mut next_dispersed = dispersed;
+                    if sample.dispersive {
+                        wl.terminate_secondary(&mut weight, &mut next_dispersed);
+                    }
+                    let deeper = Gather {
+                        from: (!sample.specular).then_some((hit.point, sample.pdf)),
+                        path_length,
+                        dispersed: next_dispersed,
+                        level: at.level + 1,
+                    };
+                    l += weight * self.gather(maps, next, deeper, wl, rng);
                 }
                 return emitted_first + beta * l;
             }
@@ -212,10 +230,24 @@ impl<'a> Gi<'a> {
                 break;
             };
             beta *= sample.weight;
+            if sample.dispersive {
+                wl.terminate_secondary(&mut beta, &mut dispersed);
+            }
             ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
         }
         emitted_first
     }
+}
+
+/// Where a gather ray starts: the point and pdf it left by (for weighting the emission it meets
+/// straight away; none after a specular lobe), the camera path's length so far, whether the
+/// camera path has dispersed, and how many gathers deep it is.
+#[derive(Clone, Copy, Debug)]
+struct Gather {
+    from: Option<(Vec3, f32)>,
+    path_length: f32,
+    dispersed: bool,
+    level: u32,
 }
 
 /// Gather bounces computed exactly, rather than read from the global map, for close surfaces.
@@ -223,13 +255,14 @@ const EXACT_LEVELS: u32 = 2;
 
 impl Progressive for Gi<'_> {
     fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
-        let maps = self.maps(pass, control);
+        let wl = pass_wavelengths(self.spectral, self.seed, pass);
+        let maps = self.maps(pass, &wl, control);
         if control.cancelled() {
             return None;
         }
         let camera = self.scene.camera();
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
-            self.radiance(&maps, camera.generate_ray(sx, sy), rng)
+            wl.to_rgb(self.radiance(&maps, camera.generate_ray(sx, sy), &wl, rng))
         })
     }
 }

@@ -9,6 +9,7 @@ use crate::bsdf::{Bsdf, Transport};
 use crate::math::{offset_origin, Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::Scene;
+use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of the path tracer.
 #[derive(Clone, Debug, PartialEq)]
@@ -20,6 +21,9 @@ pub struct PathSettings {
     /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
     /// through glass is black, as in a particle tracer's image — for comparing with one).
     pub specular_camera_paths: bool,
+    /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
+    /// dispersive glass).
+    pub spectral: Option<bool>,
 }
 
 impl Default for PathSettings {
@@ -28,16 +32,18 @@ impl Default for PathSettings {
             max_depth: 64,
             roulette_depth: 3,
             specular_camera_paths: true,
+            spectral: None,
         }
     }
 }
 
-/// Radiance arriving along `ray` (unit direction).
-pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng) -> Vec3 {
+/// Radiance arriving along `ray` (unit direction) at the wavelengths `wl`.
+pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
     let lights = scene.lights();
     let mut ray = ray;
-    let mut l = Vec3::ZERO;
-    let mut beta = Vec3::ONE;
+    let mut l = Spectrum::ZERO;
+    let mut beta = wl.grey(1.0);
+    let mut dispersed = false;
     // The last bounce's pdf and point, for weighting emitters that BSDF sampling hits.
     let mut specular = true;
     let mut last_pdf = 0.0f32;
@@ -45,8 +51,8 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng)
     for depth in 0..=settings.max_depth {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
             // The sky and suns, weighted against having sampled them directly.
-            let le = lights.escaped(ray.dir);
-            if le != Vec3::ZERO {
+            let le = lights.escaped(ray.dir, wl);
+            if le != Spectrum::ZERO {
                 let weight = if specular {
                     1.0
                 } else {
@@ -58,8 +64,8 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng)
         };
         let hit = scene.surface(&ray, &isect);
         let wo = -ray.dir;
-        let le = emitted(scene, &hit);
-        if le != Vec3::ZERO {
+        let le = emitted(scene, &hit, wl);
+        if le != Spectrum::ZERO {
             let weight = if specular {
                 1.0
             } else {
@@ -70,12 +76,12 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng)
         if depth == settings.max_depth {
             break;
         }
-        let bsdf = Bsdf::at(scene, &hit, wo);
+        let bsdf = Bsdf::at(scene, &hit, wo, wl);
         if bsdf.is_black() {
             break;
         }
         if bsdf.is_smooth() {
-            l += beta * direct_light(scene, &hit, &bsdf, wo, true, rng);
+            l += beta * direct_light(scene, &hit, &bsdf, wo, true, wl, rng);
         }
         let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
             break;
@@ -84,6 +90,9 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng)
             break;
         }
         beta *= sample.weight;
+        if sample.dispersive {
+            wl.terminate_secondary(&mut beta, &mut dispersed);
+        }
         specular = sample.specular;
         last_pdf = sample.pdf;
         last_point = hit.point;
@@ -99,7 +108,7 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, rng: &mut Rng)
     if l.is_finite() {
         l
     } else {
-        Vec3::ZERO
+        Spectrum::ZERO
     }
 }
 
@@ -128,8 +137,21 @@ impl<'a> PathTracer<'a> {
 impl super::Progressive for PathTracer<'_> {
     fn render_pass(&self, pass: u64, control: crate::progress::Control) -> Option<Vec<Vec3>> {
         let camera = self.scene.camera();
+        let spectral = super::ppm::settings_spectral(&self.settings.spectral, self.scene);
         super::tiles::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
-            radiance(self.scene, &self.settings, camera.generate_ray(sx, sy), rng)
+            // Each sample its own wavelengths: no photons need to agree with it.
+            let wl = if spectral {
+                Wavelengths::sample(rng.uniform())
+            } else {
+                Wavelengths::Rgb
+            };
+            wl.to_rgb(radiance(
+                self.scene,
+                &self.settings,
+                camera.generate_ray(sx, sy),
+                &wl,
+                rng,
+            ))
         })
     }
 }

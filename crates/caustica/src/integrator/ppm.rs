@@ -21,6 +21,7 @@ use crate::photon::trace::trace_count;
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
+use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of progressive photon mapping.
 #[derive(Clone, Debug, PartialEq)]
@@ -36,6 +37,9 @@ pub struct PpmSettings {
     /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
     /// through glass is black, as in a particle tracer's image — for comparing with one).
     pub specular_camera_paths: bool,
+    /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
+    /// dispersive glass).
+    pub spectral: Option<bool>,
 }
 
 impl Default for PpmSettings {
@@ -46,12 +50,31 @@ impl Default for PpmSettings {
             initial_radius: InitialRadius::Pixels(2.0),
             max_depth: 64,
             specular_camera_paths: true,
+            spectral: None,
         }
     }
 }
 
 /// Seed offset that separates photon streams from camera streams.
 pub(crate) const PHOTON_SEED: u64 = 0x70_686f_746f_6e73;
+
+/// Seed offset of the streams that draw each pass's wavelengths.
+pub(crate) const WAVELENGTH_SEED: u64 = 0x7761_7665_6c65_6e67;
+
+/// The wavelengths every path of pass `pass` carries: photons and camera paths must agree, so
+/// one set serves the whole pass (RGB channels when not `spectral`).
+pub(crate) fn pass_wavelengths(spectral: bool, seed: u64, pass: u64) -> Wavelengths {
+    if spectral {
+        Wavelengths::sample(Rng::new(seed ^ WAVELENGTH_SEED, pass).uniform())
+    } else {
+        Wavelengths::Rgb
+    }
+}
+
+/// Whether a scene renders spectrally: as asked, or when it has a dispersive glass.
+pub(crate) fn settings_spectral(asked: &Option<bool>, scene: &Scene) -> bool {
+    asked.unwrap_or_else(|| scene.has_dispersion())
+}
 
 /// The progressive photon mapper over a whole image.
 pub struct Ppm<'a> {
@@ -65,6 +88,8 @@ pub struct Ppm<'a> {
     /// Whether direct light also comes by BSDF sampling (emissive objects or a sky), weighted
     /// against the light sample.
     mis: bool,
+    /// Whether light is carried at sampled wavelengths.
+    spectral: bool,
 }
 
 impl<'a> Ppm<'a> {
@@ -73,23 +98,25 @@ impl<'a> Ppm<'a> {
         let pixel_angle = pixel_angle(scene.camera(), height);
         Ppm {
             scene,
-            settings,
             width,
             height,
             seed,
             pixel_angle,
             mis: bsdf_can_reach_light(scene),
+            spectral: settings_spectral(&settings.spectral, scene),
+            settings,
         }
     }
 
-    /// The photons of pass `pass` that the estimate uses (all but direct ones).
-    pub fn photon_map(&self, pass: u64, control: Control) -> PhotonMap {
+    /// The photons of pass `pass` that the estimate uses (all but direct ones), at the pass's
+    /// wavelengths `wl`.
+    pub fn photon_map(&self, pass: u64, wl: &Wavelengths, control: Control) -> PhotonMap {
         let mut photons = trace_count(
             self.scene,
             self.settings.photons_per_pass,
-            self.seed ^ PHOTON_SEED,
-            pass,
+            (self.seed ^ PHOTON_SEED, pass),
             self.settings.max_depth,
+            wl,
             control,
         );
         photons.retain(|p| !is_direct(p));
@@ -99,22 +126,24 @@ impl<'a> Ppm<'a> {
     /// Radiance along a camera ray with the photons of one pass: smooth lobes are counted in
     /// full at the first smooth surface (next-event estimation and photons), only specular ones
     /// continue the path.
-    fn radiance(&self, map: &PhotonMap, ray: Ray, radius_factor: f32, rng: &mut Rng) -> Vec3 {
+    fn radiance(&self, map: &PhotonMap, ray: Ray, radius_factor: f32, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
         camera_chain(
             self.scene,
             ray,
             self.settings.max_depth,
             self.settings.specular_camera_paths,
+            wl,
             rng,
-            |hit, bsdf, wo, path_length, rng| {
+            |hit, bsdf, wo, path_length, dispersed, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
-                direct_light(self.scene, hit, bsdf, wo, self.mis, rng) + map.radiance_within(hit.point, bsdf, wo, r)
+                direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
+                    + map.radiance_within(hit.point, bsdf, wo, r, dispersed)
             },
-            |hit, sample, _, _| {
+            |hit, sample, _, _, _| {
                 if self.mis {
-                    sample.weight * direct_by_bsdf(self.scene, hit, sample)
+                    sample.weight * direct_by_bsdf(self.scene, hit, sample, wl)
                 } else {
-                    Vec3::ZERO
+                    Spectrum::ZERO
                 }
             },
         )
@@ -123,14 +152,15 @@ impl<'a> Ppm<'a> {
 
 impl Progressive for Ppm<'_> {
     fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
-        let map = self.photon_map(pass, control);
+        let wl = pass_wavelengths(self.spectral, self.seed, pass);
+        let map = self.photon_map(pass, &wl, control);
         if control.cancelled() {
             return None;
         }
         let factor = radius_factor(pass, self.settings.alpha);
         let camera = self.scene.camera();
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
-            self.radiance(&map, camera.generate_ray(sx, sy), factor, rng)
+            wl.to_rgb(self.radiance(&map, camera.generate_ray(sx, sy), factor, &wl, rng))
         })
     }
 }

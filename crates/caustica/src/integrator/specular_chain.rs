@@ -5,47 +5,53 @@ use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{offset_origin, Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, Wavelengths};
 
-/// Follows a camera ray through mirrors and glass, adding the emission it meets. At each smooth
-/// surface it adds `beta · at_smooth(hit, bsdf, wo, path length)`; where the surface's BSDF then
-/// samples a smooth lobe the chain ends with `beta · beyond(hit, sample, path length)` (nothing
-/// for photon mapping, a final gather for Jensen's method). With `through_specular` off, a
-/// camera ray that meets a mirror or glass first stops there.
+/// Follows a camera ray through mirrors and glass at the wavelengths `wl`, adding the emission
+/// it meets. At each smooth surface it adds `beta · at_smooth(hit, bsdf, wo, path length)`;
+/// where the surface's BSDF then samples a smooth lobe the chain ends with
+/// `beta · beyond(hit, sample, path length)` (the BSDF half of direct light for photon mapping,
+/// a final gather for Jensen's method). With `through_specular` off, a camera ray that meets a
+/// mirror or glass first stops there. A dispersive glass leaves the hero wavelength alone; both
+/// closures are told whether that happened (photons that dispersed too must then not count the
+/// hero's weight twice, see [`crate::photon::DISPERSED`]).
 #[allow(clippy::too_many_arguments)]
 pub fn camera_chain<S, B>(
     scene: &Scene,
     ray: Ray,
     max_depth: u32,
     through_specular: bool,
+    wl: &Wavelengths,
     rng: &mut Rng,
     mut at_smooth: S,
     mut beyond: B,
-) -> Vec3
+) -> Spectrum
 where
-    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, &mut Rng) -> Vec3,
-    B: FnMut(&SurfaceHit, &BsdfSample, f32, &mut Rng) -> Vec3,
+    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, &mut Rng) -> Spectrum,
+    B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, &mut Rng) -> Spectrum,
 {
     let mut ray = ray;
-    let mut beta = Vec3::ONE;
-    let mut l = Vec3::ZERO;
+    let mut beta = wl.grey(1.0);
+    let mut terminated = false;
+    let mut l = Spectrum::ZERO;
     let mut path_length = 0.0f32;
     for depth in 0..=max_depth {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
             // Only the camera and specular chains get here: the sky counts in full.
-            l += beta * scene.lights().escaped(ray.dir);
+            l += beta * scene.lights().escaped(ray.dir, wl);
             break;
         };
         let hit = scene.surface(&ray, &isect);
         path_length += isect.t;
         let wo = -ray.dir;
         // Only the camera and specular chains reach here: emission counts in full.
-        l += beta * super::direct::emitted(scene, &hit);
-        let bsdf = Bsdf::at(scene, &hit, wo);
+        l += beta * super::direct::emitted(scene, &hit, wl);
+        let bsdf = Bsdf::at(scene, &hit, wo, wl);
         if bsdf.is_black() {
             break;
         }
         if bsdf.is_smooth() {
-            l += beta * at_smooth(&hit, &bsdf, wo, path_length, rng);
+            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, rng);
         }
         if depth == max_depth {
             break;
@@ -54,13 +60,16 @@ where
             break;
         };
         if !sample.specular {
-            l += beta * beyond(&hit, &sample, path_length, rng);
+            l += beta * beyond(&hit, &sample, path_length, terminated, rng);
             break;
         }
         if depth == 0 && !through_specular {
             break;
         }
         beta *= sample.weight;
+        if sample.dispersive {
+            wl.terminate_secondary(&mut beta, &mut terminated);
+        }
         ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
     }
     l

@@ -18,6 +18,7 @@ use super::{spot_profile, Light, LightSet};
 use crate::math::{luminance, offset_origin, Aabb, Frame, Ray, Vec2, Vec3};
 use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, Rng};
 use crate::scene::{ObjectRef, Scene};
+use crate::spectrum::{Spectrum, Wavelengths};
 use std::f32::consts::PI;
 
 /// A bounding sphere that photons are aimed at.
@@ -216,11 +217,11 @@ impl Emitter {
 
     /// A photon from `light` (the light this emitter was made for) with its flux before
     /// division by the number of photons emitted.
-    pub fn sample(&self, light: &Light, scene: &Scene, rng: &mut Rng) -> Option<EmittedPhoton> {
+    pub fn sample(&self, light: &Light, scene: &Scene, wl: &Wavelengths, rng: &mut Rng) -> Option<EmittedPhoton> {
         if let (Kind::Area, Light::Area(area)) = (&self.kind, light) {
             let u_pick = rng.uniform();
             let (u, u_dir) = (rng.uniform2(), rng.uniform2());
-            return emit_from_area(area, scene, u_pick, u, u_dir);
+            return emit_from_area(area, scene, (u_pick, u, u_dir), wl);
         }
         let lobe = self.pick(rng.uniform());
         let u = rng.uniform2();
@@ -231,7 +232,8 @@ impl Emitter {
                 let profile = spot.map_or(1.0, |s| {
                     spot_profile(dir.dot(s.axis), s.cos_inner, s.cos_outer, s.exponent)
                 });
-                (pdf > 0.0 && profile > 0.0).then(|| (Ray::new(*position, dir), self.color * (profile / pdf)))?
+                (pdf > 0.0 && profile > 0.0)
+                    .then(|| (Ray::new(*position, dir), wl.unbounded(self.color) * (profile / pdf)))?
             }
             Kind::Directional {
                 direction,
@@ -252,7 +254,7 @@ impl Emitter {
                         (dir, 2.0 * dir.dot(*direction) / (2.0 - one_minus_cos))
                     }
                 };
-                (pdf > 0.0).then(|| (Ray::new(origin, dir), self.color * (spread / pdf)))?
+                (pdf > 0.0).then(|| (Ray::new(origin, dir), wl.unbounded(self.color) * (spread / pdf)))?
             }
             Kind::Environment { scene, discs } => {
                 let Light::Environment(env) = light else {
@@ -274,8 +276,10 @@ impl Emitter {
                 let p = disc.center + sample_uniform_disc(u) * disc.radius;
                 let pdf_area = self.disc_pdf(&lobes, p);
                 let origin = plane_origin + frame.x * p.x + frame.y * p.y;
-                (pdf_area > 0.0 && sky.pdf > 0.0)
-                    .then(|| (Ray::new(origin, dir), sky.radiance / (sky.pdf * pdf_area)))?
+                (pdf_area > 0.0 && sky.pdf > 0.0).then(|| {
+                    let radiance = wl.unbounded(sky.radiance);
+                    (Ray::new(origin, dir), radiance / (sky.pdf * pdf_area))
+                })?
             }
             Kind::Area => return None,
         };
@@ -356,17 +360,17 @@ pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
 pub struct EmittedPhoton {
     /// Origin and unit direction.
     pub ray: Ray,
-    /// Flux.
-    pub flux: Vec3,
+    /// Flux at the wavelengths it was emitted for (RGB in RGB mode).
+    pub flux: Spectrum,
 }
 
 impl LightSet {
     /// One photon from a light chosen by power, its flux divided by the probability of the
     /// choice; `None` if the sample carries nothing.
-    pub fn emit(&self, scene: &Scene, rng: &mut Rng) -> Option<EmittedPhoton> {
+    pub fn emit(&self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng) -> Option<EmittedPhoton> {
         let (index, p_pick) = self.pick(rng.uniform())?;
         let emitter = self.emitters[index].as_ref()?;
-        let photon = emitter.sample(&self.lights[index], scene, rng)?;
+        let photon = emitter.sample(&self.lights[index], scene, wl, rng)?;
         Some(EmittedPhoton {
             ray: photon.ray,
             flux: photon.flux / p_pick,
@@ -375,12 +379,19 @@ impl LightSet {
 }
 
 /// A photon from an emissive object: a point by area, a face, a cosine-weighted direction.
-fn emit_from_area(light: &AreaLight, scene: &Scene, u_pick: f32, u: Vec2, u_dir: Vec2) -> Option<EmittedPhoton> {
+fn emit_from_area(
+    light: &AreaLight,
+    scene: &Scene,
+    (u_pick, u, u_dir): (f32, Vec2, Vec2),
+    wl: &Wavelengths,
+) -> Option<EmittedPhoton> {
     let sample = light.sample(scene, u_pick, u)?;
-    let le = if light.uniform {
-        light.radiance
-    } else {
-        emission_at(scene, &sample)
+    let le = match (light.uniform, wl.is_spectral()) {
+        (true, false) => light.radiance.extend(0.0),
+        (true, true) => scene
+            .material_spectra(scene.object_material(light.object))
+            .emission(light.radiance, wl),
+        (false, _) => wl.unbounded(emission_at(scene, &sample)),
     };
     // A face at random (the outer one of a closed lamp that absorbs its own inward light), then
     // a cosine-weighted direction: pdf ½·cos/π, or cos/π.
@@ -454,7 +465,7 @@ mod tests {
             let n = 200_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                let photon = e.sample(&light, &empty, &mut rng).unwrap();
+                let photon = e.sample(&light, &empty, &Wavelengths::Rgb, &mut rng).unwrap();
                 let (ray, power) = (photon.ray, photon.flux);
                 let to = target.center - ray.origin;
                 if ray.dir.dot(to.normalize()) >= cos_max {
@@ -494,7 +505,7 @@ mod tests {
             let n = 2_000_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                let photon = e.sample(&light, &empty, &mut rng).unwrap();
+                let photon = e.sample(&light, &empty, &Wavelengths::Rgb, &mut rng).unwrap();
                 let (ray, power) = (photon.ray, photon.flux);
                 let p = ray.origin;
                 if p.x * p.x + p.y * p.y <= 1.0 {
@@ -534,7 +545,7 @@ mod tests {
             let n = 100_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                if let Some(p) = lights.emit(&s, &mut rng) {
+                if let Some(p) = lights.emit(&s, &Wavelengths::Rgb, &mut rng) {
                     sum += p.flux.x as f64;
                     let outside = (p.ray.origin - Vec3::ZERO).dot(p.ray.dir) > 0.0;
                     assert!(outside || !outward, "an outward-only lamp emitted inwards");
@@ -597,14 +608,14 @@ mod tests {
                 let n = 400_000;
                 let mut sum = 0.0f64;
                 for _ in 0..n {
-                    let Some(p) = e.sample(&light, &empty, &mut rng) else {
+                    let Some(p) = e.sample(&light, &empty, &Wavelengths::Rgb, &mut rng) else {
                         continue;
                     };
                     // Does the ray pass through the sphere?
                     let oc = target.center - p.ray.origin;
                     let t = oc.dot(p.ray.dir);
                     if t > 0.0 && (oc - p.ray.dir * t).length_squared() <= target.radius * target.radius {
-                        sum += crate::math::luminance(p.flux) as f64;
+                        sum += crate::math::luminance(p.flux.truncate()) as f64;
                     }
                 }
                 let estimate = sum / n as f64;

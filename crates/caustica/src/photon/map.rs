@@ -19,12 +19,13 @@
 
 use super::kd_tree::{KdTree, Neighbor};
 use super::trace::{trace_photons, PhotonSettings, PhotonStats};
-use super::Photon;
+use super::{Photon, DISPERSED};
 use crate::bsdf::Bsdf;
 use crate::material::SurfaceParams;
 use crate::math::Vec3;
 use crate::progress::Control;
 use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, SAMPLES};
 use std::cell::RefCell;
 use std::f32::consts::PI;
 
@@ -278,17 +279,18 @@ impl PhotonMap {
         self.radiance(scene, &hit, &white, n, n, settings)
     }
 
-    /// Reflected radiance at `point` towards `wo` from the photons within radius `r`.
-    pub fn radiance_within(&self, point: Vec3, bsdf: &Bsdf, wo: Vec3, r: f32) -> Vec3 {
+    /// Reflected radiance at `point` towards `wo` from the photons within radius `r` (physical
+    /// model); `dispersed` says the camera path left its secondary wavelengths behind.
+    pub fn radiance_within(&self, point: Vec3, bsdf: &Bsdf, wo: Vec3, r: f32, dispersed: bool) -> Spectrum {
         if self.photons.is_empty() || r.is_nan() || r <= 0.0 {
-            return Vec3::ZERO;
+            return Spectrum::ZERO;
         }
         let n = bsdf.normal();
-        let mut sum = Vec3::ZERO;
+        let mut sum = Spectrum::ZERO;
         self.tree.for_each_within(&self.photons, point, r * r, |slot, _| {
             let photon = &self.photons[slot as usize];
             if accepts(photon, point, n, r) {
-                sum += bsdf.eval(wo, -photon.direction()) * photon.power();
+                sum += bsdf.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
             }
         });
         sum / (PI * r * r)
@@ -296,9 +298,16 @@ impl PhotonMap {
 
     /// Reflected radiance at `point` towards `wo` from the `k` nearest photons within
     /// `max_radius`, the radius being the distance to the k-th.
-    pub fn radiance_nearest(&self, point: Vec3, bsdf: &Bsdf, wo: Vec3, k: usize, max_radius: f32) -> Vec3 {
+    pub fn radiance_nearest(
+        &self,
+        point: Vec3,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        (k, max_radius): (usize, f32),
+        dispersed: bool,
+    ) -> Spectrum {
         if self.photons.is_empty() || k == 0 || max_radius.is_nan() || max_radius <= 0.0 {
-            return Vec3::ZERO;
+            return Spectrum::ZERO;
         }
         let n = bsdf.normal();
         NEIGHBORS.with(|cell| {
@@ -307,17 +316,17 @@ impl PhotonMap {
                 .tree
                 .k_nearest(&self.photons, point, k, max_radius * max_radius, &mut neighbors);
             if neighbors.is_empty() || r2.is_nan() || r2 <= 0.0 {
-                return Vec3::ZERO;
+                return Spectrum::ZERO;
             }
             let r = r2.sqrt();
-            let mut sum = Vec3::ZERO;
+            let mut sum = Spectrum::ZERO;
             // The k-th photon only marks the radius: counting it too would bias the density by
             // k / (k − 1) (the k-th nearest lies on the disc's rim, not inside it).
             let skip = usize::from(neighbors.len() == k && k > 1);
             for nb in neighbors.iter().skip(skip) {
                 let photon = &self.photons[nb.slot as usize];
                 if accepts(photon, point, n, r) {
-                    sum += bsdf.eval(wo, -photon.direction()) * photon.power();
+                    sum += bsdf.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
                 }
             }
             sum / (PI * r2)
@@ -328,6 +337,18 @@ impl PhotonMap {
     /// through the map: a gather radius that holds about k photons where they are typical.
     pub fn typical_radius(&self, k: usize) -> f32 {
         2.0 * super::typical_knn_distance(&self.tree, &self.photons, k)
+    }
+}
+
+/// A photon's power as a camera path gathers it: a photon that dispersed carries its hero's
+/// weight for the whole path, which a camera path that dispersed too has already applied.
+#[inline]
+fn photon_power(photon: &Photon, camera_dispersed: bool) -> Spectrum {
+    let power = photon.spectrum();
+    if camera_dispersed && photon.flags & DISPERSED != 0 {
+        power / SAMPLES as f32
+    } else {
+        power
     }
 }
 

@@ -19,7 +19,7 @@
 //! deterministic whatever the thread count: photon `i` draws from its own random stream and
 //! batches are concatenated in order.
 
-use super::{Photon, DIFFUSE, REFLECTED, REFRACTED};
+use super::{Photon, DIFFUSE, DISPERSED, REFLECTED, REFRACTED};
 use crate::bsdf::{Bsdf, Transport};
 use crate::light::emission::{caustic_targets, Emitter, Target};
 use crate::light::{distance_attenuation, Light};
@@ -28,6 +28,7 @@ use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, Wavelengths};
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -206,10 +207,16 @@ fn trace_light(
                 let count = BATCH.min(cap - first.min(cap));
                 trace_batch(first..first + count, |i, out| {
                     let mut rng = Rng::new(settings.seed, stream | i);
-                    if let Some(photon) = emitter.sample(model.light, scene, &mut rng) {
-                        let light = light_index.min(255) as u8;
-                        let max_bounces = settings.max_bounces;
-                        trace_path(scene, model, photon.ray, photon.flux, light, max_bounces, &mut rng, out);
+                    if let Some(photon) = emitter.sample(model.light, scene, &Wavelengths::Rgb, &mut rng) {
+                        trace_path(
+                            scene,
+                            model,
+                            photon.ray,
+                            photon.flux,
+                            settings.max_bounces,
+                            &mut rng,
+                            out,
+                        );
                     }
                 })
             })
@@ -244,14 +251,15 @@ fn trace_light(
     }
 }
 
-/// Emits `count` photons from lights chosen by power, under the physical model, from stream
-/// `stream` of `seed`, and returns those stored, their flux already divided by `count`.
+/// Emits `count` photons from lights chosen by power, under the physical model at the
+/// wavelengths `wl`, from stream `stream` of `seed`, and returns those stored, their flux
+/// already divided by `count`.
 pub fn trace_count(
     scene: &Scene,
     count: u64,
-    seed: u64,
-    stream: u64,
+    (seed, stream): (u64, u64),
     max_bounces: u32,
+    wl: &Wavelengths,
     control: Control,
 ) -> Vec<Photon> {
     let lights = scene.lights();
@@ -268,9 +276,10 @@ pub fn trace_count(
             let first = b * BATCH;
             let (photons, _) = trace_batch(first..(first + BATCH).min(count), |i, out| {
                 let mut rng = Rng::new(seed, (stream << 40) ^ i);
-                if let Some(emitted) = lights.emit(scene, &mut rng) {
+                if let Some(emitted) = lights.emit(scene, wl, &mut rng) {
                     let flux = emitted.flux * scale;
-                    trace_path(scene, &PhysicalModel, emitted.ray, flux, 0, max_bounces, &mut rng, out);
+                    let model = PhysicalModel { wl: *wl };
+                    trace_path(scene, &model, emitted.ray, flux, max_bounces, &mut rng, out);
                 }
             });
             photons
@@ -297,14 +306,12 @@ fn trace_batch(
 /// A photon on its way: what it carries and what it has met.
 #[derive(Clone, Copy, Debug)]
 pub struct PhotonState {
-    /// Power (flux).
-    pub power: Vec3,
-    /// [`REFLECTED`], [`REFRACTED`] and [`DIFFUSE`] bounces so far.
+    /// Power (flux): RGB, or at the pass's wavelengths.
+    pub power: Spectrum,
+    /// [`REFLECTED`], [`REFRACTED`], [`DIFFUSE`] and [`DISPERSED`] so far.
     pub flags: u8,
     /// Length of the path so far.
     pub length: f32,
-    /// The light that emitted it.
-    pub light: u8,
 }
 
 /// What a shading model does with a photon at a surface.
@@ -323,13 +330,11 @@ pub trait PhotonModel: Sync {
 }
 
 /// Follows one photon from `ray` carrying `power`; pushes what it stores to `out`.
-#[allow(clippy::too_many_arguments)]
 pub fn trace_path<M: PhotonModel>(
     scene: &Scene,
     model: &M,
     mut ray: Ray,
-    power: Vec3,
-    light: u8,
+    power: Spectrum,
     max_bounces: u32,
     rng: &mut Rng,
     out: &mut Vec<Photon>,
@@ -338,7 +343,6 @@ pub fn trace_path<M: PhotonModel>(
         power,
         flags: 0,
         length: 0.0,
-        light,
     };
     for _ in 0..=max_bounces {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
@@ -381,8 +385,8 @@ impl PhotonModel for CourseModel<'_> {
         };
         let receives = p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO;
         if receives && (photon.flags != 0 || self.first_hit) {
-            let stored = photon.power * falloff_scale(self.light, photon.length);
-            out.push(Photon::new(hit.point, stored, d, facing, photon.flags, photon.light));
+            let stored = photon.power.truncate() * falloff_scale(self.light, photon.length);
+            out.push(Photon::new(hit.point, stored, d, facing, photon.flags));
         }
         if self.first_hit {
             return None;
@@ -393,11 +397,11 @@ impl PhotonModel for CourseModel<'_> {
         let (pr, pt) = (pr / norm, pt / norm);
         let u = rng.uniform();
         if u < pr {
-            photon.power *= p.reflective / pr;
+            photon.power *= (p.reflective / pr).extend(0.0);
             photon.flags |= REFLECTED;
             Some(reflect(d, facing))
         } else if u < pr + pt {
-            photon.power *= p.transmissive / pt;
+            photon.power *= (p.transmissive / pt).extend(0.0);
             photon.flags |= REFRACTED;
             let (eta, n_in) = refraction_geometry(p.index, entering, hit.shading_normal);
             Some(refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in)))
@@ -418,8 +422,11 @@ pub fn falloff_scale(light: &Light, path_length: f32) -> f32 {
     }
 }
 
-/// Photons under the physical model: every smooth surface stores them.
-pub struct PhysicalModel;
+/// Photons under the physical model at the wavelengths `wl`: every smooth surface stores them.
+pub struct PhysicalModel {
+    /// The wavelengths (or RGB channels) the photons carry.
+    pub wl: Wavelengths,
+}
 
 impl PhotonModel for PhysicalModel {
     fn interact(
@@ -432,15 +439,14 @@ impl PhotonModel for PhysicalModel {
         out: &mut Vec<Photon>,
     ) -> Option<Vec3> {
         let wo = -ray.dir;
-        let bsdf = Bsdf::at(scene, hit, wo);
+        let bsdf = Bsdf::at(scene, hit, wo, &self.wl);
         if bsdf.is_smooth() {
-            out.push(Photon::new(
+            out.push(Photon::with_spectrum(
                 hit.point,
                 photon.power,
                 ray.dir,
                 bsdf.normal(),
                 photon.flags,
-                photon.light,
             ));
         }
         let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)?;
@@ -450,6 +456,11 @@ impl PhotonModel for PhysicalModel {
             return None;
         }
         photon.power *= sample.weight / q;
+        if sample.dispersive && photon.flags & DISPERSED == 0 {
+            let mut terminated = false;
+            self.wl.terminate_secondary(&mut photon.power, &mut terminated);
+            photon.flags |= DISPERSED;
+        }
         photon.flags |= if !sample.specular {
             DIFFUSE
         } else if sample.transmitted {
