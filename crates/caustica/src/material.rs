@@ -1,7 +1,7 @@
 //! Materials of the `.ray` format (§6): constant or texture-mapped parameters, evaluated at a hit.
 
 use crate::math::{luminance, Vec2, Vec3, Vec4};
-use crate::spectrum::{fit_reflectance, SigmoidPolynomial, Spectrum, Wavelengths};
+use crate::spectrum::{cauchy_index, fit_reflectance, SigmoidPolynomial, Spectrum, Wavelengths, CHANNEL_WAVELENGTHS};
 use crate::texture::Texture;
 
 /// A parameter: a constant or an index into the scene's textures.
@@ -243,6 +243,14 @@ pub fn refraction_geometry(index: f32, entering: bool, outward_normal: Vec3) -> 
     } else {
         (index, -outward_normal)
     }
+}
+
+/// Each colour channel's index of refraction: all `index`, or with an Abbe number each by
+/// Cauchy's law at the wavelength the channel stands for.
+pub fn channel_indices(index: f32, abbe: Option<f32>) -> Option<[f32; 3]> {
+    let abbe = abbe?;
+    let index = if index > 0.0 { index } else { 1.0 };
+    Some(CHANNEL_WAVELENGTHS.map(|l| cauchy_index(index, abbe, l)))
 }
 
 /// The smallest cosine divided by, so that grazing light does not blow the specular lobe up.

@@ -62,13 +62,21 @@ pub(crate) const PHOTON_SEED: u64 = 0x70_686f_746f_6e73;
 pub(crate) const WAVELENGTH_SEED: u64 = 0x7761_7665_6c65_6e67;
 
 /// The wavelengths every path of pass `pass` carries: photons and camera paths must agree, so
-/// one set serves the whole pass (RGB channels when not `spectral`).
+/// one set serves the whole pass (RGB channels when not `spectral`). Passes draw them from the
+/// van der Corput sequence (randomly shifted by the seed), so any run of consecutive passes
+/// covers the spectrum evenly and colour converges like 1/passes rather than its square root.
 pub(crate) fn pass_wavelengths(spectral: bool, seed: u64, pass: u64) -> Wavelengths {
-    if spectral {
-        Wavelengths::sample(Rng::new(seed ^ WAVELENGTH_SEED, pass).uniform())
-    } else {
-        Wavelengths::Rgb
+    if !spectral {
+        return Wavelengths::Rgb;
     }
+    let shift = Rng::new(seed ^ WAVELENGTH_SEED, 0).uniform() as f64;
+    let u = (radical_inverse(pass) + shift).fract();
+    Wavelengths::sample(u as f32)
+}
+
+/// The base-2 radical inverse of `i`: its bits mirrored about the binary point.
+fn radical_inverse(i: u64) -> f64 {
+    i.reverse_bits() as f64 * (1.0 / 18_446_744_073_709_551_616.0)
 }
 
 /// Whether a scene renders spectrally: as asked, or when it has a dispersive glass.

@@ -2,7 +2,7 @@
 //! attenuation and shadows filtered by each occluder's `transmissive`, recursive mirror
 //! reflection and refraction (no Fresnel), plus an optional caustic term from the photon map.
 
-use crate::material::{refraction_geometry, SurfaceParams};
+use crate::material::{channel_indices, refraction_geometry, SurfaceParams};
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
 use crate::scene::{Scene, SurfaceHit};
 
@@ -93,14 +93,41 @@ where
     if p.transmissive != Vec3::ZERO {
         let w = weight * p.transmissive;
         if w.max_element() >= MIN_PATH_WEIGHT {
-            let (eta, n_in) = refraction_geometry(p.index, entering, hit.shading_normal);
-            // Total internal reflection turns the transmitted ray back inside (as photons do).
-            let dir = refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in));
-            let origin = offset_origin(hit.point, hit.geometric_normal, dir);
-            color += p.transmissive * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w, caustic);
+            // A dispersive glass (caustica's `abbe`) gives each colour channel its own index:
+            // the ray splits into one per channel still carried.
+            let indices = channel_indices(p.index, scene.abbe(&hit));
+            for (mask, index) in channel_rays(weight, indices) {
+                let index = if index.is_nan() { p.index } else { index };
+                let (eta, n_in) = refraction_geometry(index, entering, hit.shading_normal);
+                // Total internal reflection turns the transmitted ray back inside (as photons do).
+                let dir = refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in));
+                let origin = offset_origin(hit.point, hit.geometric_normal, dir);
+                let kt = p.transmissive * mask;
+                color += kt * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w * mask, caustic);
+            }
         }
     }
     color
+}
+
+/// The refracted rays a path carrying `weight` splits into: one with every channel and `index`'s
+/// own index when not dispersive (or only one channel is left), else one per channel still
+/// carried, each masked to it.
+fn channel_rays(weight: Vec3, indices: Option<[f32; 3]>) -> impl Iterator<Item = (Vec3, f32)> {
+    let carried: Vec<usize> = (0..3).filter(|&c| weight[c] > 0.0).collect();
+    let rays: Vec<(Vec3, f32)> = match indices {
+        None => vec![(Vec3::ONE, f32::NAN)],
+        Some(n) if carried.len() == 1 => vec![(Vec3::ONE, n[carried[0]])],
+        Some(n) => carried
+            .iter()
+            .map(|&c| {
+                let mut mask = Vec3::ZERO;
+                mask[c] = 1.0;
+                (mask, n[c])
+            })
+            .collect(),
+    };
+    rays.into_iter()
 }
 
 /// Σ over lights of f(d)·S·I ⊙ [kd (N·L) + ks (V·R)^ns].

@@ -23,7 +23,7 @@ use super::{Photon, DIFFUSE, DISPERSED, REFLECTED, REFRACTED};
 use crate::bsdf::{Bsdf, Transport};
 use crate::light::emission::{caustic_targets, Emitter, Target};
 use crate::light::{distance_attenuation, Light};
-use crate::material::refraction_geometry;
+use crate::material::{channel_indices, refraction_geometry};
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::Rng;
@@ -403,7 +403,28 @@ impl PhotonModel for CourseModel<'_> {
         } else if u < pr + pt {
             photon.power *= (p.transmissive / pt).extend(0.0);
             photon.flags |= REFRACTED;
-            let (eta, n_in) = refraction_geometry(p.index, entering, hit.shading_normal);
+            let mut index = p.index;
+            if let Some(indices) = channel_indices(p.index, scene.abbe(hit)) {
+                // A dispersive glass: the photon goes on in one colour channel, chosen by its
+                // power (and divided by the probability), refracted by that channel's index.
+                let rgb = photon.power.truncate().max(Vec3::ZERO);
+                let total = rgb.x + rgb.y + rgb.z;
+                if total > 0.0 {
+                    let pick = rng.uniform() * total;
+                    let c = if pick < rgb.x {
+                        0
+                    } else if pick < rgb.x + rgb.y {
+                        1
+                    } else {
+                        2
+                    };
+                    let mut single = Vec3::ZERO;
+                    single[c] = total;
+                    photon.power = single.extend(0.0);
+                    index = indices[c];
+                }
+            }
+            let (eta, n_in) = refraction_geometry(index, entering, hit.shading_normal);
             Some(refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in)))
         } else {
             None
