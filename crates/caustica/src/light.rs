@@ -21,7 +21,7 @@ pub mod environment;
 pub use area::AreaLight;
 pub use environment::Environment;
 
-use emission::{Emitter, Target};
+use emission::{camera_targets, Aim, Emitter, Target};
 
 use crate::math::{luminance, offset_origin, Ray, Vec3};
 use crate::sampling::{sample_uniform_cone, Rng};
@@ -290,6 +290,10 @@ pub struct LightSet {
     scene_radius: f32,
 }
 
+/// The share of a sun's or the sky's photons sent over the whole scene rather than at the
+/// mirrors and glass in view.
+const FAR_LIGHT_SPREAD: f32 = 0.5;
+
 impl LightSet {
     /// The file's `lights` followed by the emissive objects of `scene`.
     pub fn new(scene: &Scene, mut lights: Vec<Light>) -> LightSet {
@@ -327,7 +331,20 @@ impl LightSet {
             center: scene_center,
             radius: scene_radius,
         };
-        let emitters = lights.iter().map(|light| Emitter::new(light, None, sphere)).collect();
+        // Far lights shine on everything: half their photons go to the mirrors and glass in
+        // view, where caustics come from, half everywhere for the rest of the light.
+        let in_view = camera_targets(scene);
+        let far_aim = Aim {
+            targets: &in_view,
+            spread: FAR_LIGHT_SPREAD,
+        };
+        let emitters = lights
+            .iter()
+            .map(|light| {
+                let aim = matches!(light, Light::Sun { .. } | Light::Environment(_)).then_some(far_aim);
+                Emitter::new(light, aim, sphere)
+            })
+            .collect();
         LightSet {
             lights,
             emitters,

@@ -45,7 +45,7 @@ pub struct TriangleRef {
 }
 
 /// One renderable object: an analytic shape or a mesh, with its material.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ObjectRef {
     /// Index into [`Scene::shapes`].
     Shape(u32),

@@ -96,24 +96,61 @@ pub struct Emitter {
     power: f32,
 }
 
+/// Where photons are aimed: a share `1 − spread` goes towards `targets` (each in proportion
+/// to its solid angle or cross-section), the share `spread` everywhere the light shines.
+#[derive(Clone, Copy, Debug)]
+pub struct Aim<'a> {
+    /// The bounding spheres of the objects that make caustics.
+    pub targets: &'a [Target],
+    /// The share of photons sent everywhere (0: only at the targets).
+    pub spread: f32,
+}
+
+/// Mixture weights: the target lobes' own weights scaled to `1 − spread`, then the uniform lobe
+/// with `spread` (left out when 0).
+fn mix(target_weights: Vec<f32>, spread: f32) -> Vec<f32> {
+    if spread <= 0.0 {
+        return target_weights;
+    }
+    let total: f32 = target_weights.iter().sum();
+    let mut weights: Vec<f32> = if total > 0.0 {
+        target_weights.iter().map(|w| w / total * (1.0 - spread)).collect()
+    } else {
+        Vec::new()
+    };
+    weights.push(spread);
+    weights
+}
+
 impl Emitter {
-    /// The emitter of `light`, aimed at `targets` (or uniform when `targets` is `None`; emissive
+    /// The emitter of `light`, aimed as `aim` says (or uniform when it is `None`; emissive
     /// objects are never aimed); `scene` is the sphere around the scene, across which directional
     /// light enters. `None` when the light cannot send a photon anywhere useful.
-    pub fn new(light: &Light, targets: Option<&[Target]>, scene: Target) -> Option<Emitter> {
+    pub fn new(light: &Light, aim: Option<Aim>, scene: Target) -> Option<Emitter> {
+        let spread = aim.map_or(1.0, |a| a.spread.clamp(0.0, 1.0));
+        let targets = aim.map(|a| a.targets).filter(|t| !t.is_empty() || spread <= 0.0);
         let point = |position: Vec3, color: Vec3, spot: Option<SpotCone>| {
-            let cones: Vec<ConeLobe> = match (targets, spot) {
-                (None, None) => vec![ConeLobe {
+            let everywhere = match spot {
+                None => ConeLobe {
                     axis: Vec3::Z,
                     cos_max: -1.0,
-                }],
-                (None, Some(spot)) => vec![ConeLobe {
+                },
+                Some(spot) => ConeLobe {
                     axis: spot.axis,
                     cos_max: spot.cos_outer,
-                }],
-                (Some(ts), _) => ts.iter().map(|t| cone_towards(position, t)).collect(),
+                },
             };
-            let weights: Vec<f32> = cones.iter().map(|c| 1.0 - c.cos_max).collect();
+            let (mut cones, weights): (Vec<ConeLobe>, Vec<f32>) = match targets {
+                None => (vec![everywhere.clone()], vec![1.0]),
+                Some(ts) => {
+                    let cones: Vec<ConeLobe> = ts.iter().map(|t| cone_towards(position, t)).collect();
+                    let weights = cones.iter().map(|c| 1.0 - c.cos_max).collect();
+                    (cones, mix(weights, spread))
+                }
+            };
+            if targets.is_some() && spread > 0.0 {
+                cones.push(everywhere);
+            }
             let power = light.power(scene.radius);
             Emitter::finish(Kind::Point { position, cones, spot }, color, weights, power)
         };
@@ -130,11 +167,17 @@ impl Emitter {
                     radius: t.radius + (local.z.max(0.0) + t.radius) * lean,
                 }
             };
-            let discs: Vec<DiscLobe> = match targets {
-                None => vec![to_disc(&scene)],
-                Some(ts) => ts.iter().map(to_disc).collect(),
+            let (discs, weights): (Vec<DiscLobe>, Vec<f32>) = match targets {
+                None => (vec![to_disc(&scene)], vec![1.0]),
+                Some(ts) => {
+                    let mut discs: Vec<DiscLobe> = ts.iter().map(to_disc).collect();
+                    let weights = mix(discs.iter().map(|d| d.radius * d.radius).collect(), spread);
+                    if spread > 0.0 {
+                        discs.push(to_disc(&scene));
+                    }
+                    (discs, weights)
+                }
             };
-            let weights: Vec<f32> = discs.iter().map(|d| d.radius * d.radius).collect();
             let power = luminance(color).max(0.0) * PI * scene.radius * scene.radius;
             let kind = Kind::Directional {
                 direction,
@@ -174,8 +217,17 @@ impl Emitter {
                 one_minus_cos,
             } => directional(direction, color, Some((cos_max, one_minus_cos))),
             Light::Environment(ref env) => {
-                let discs: Vec<Target> = targets.map_or_else(|| vec![scene], <[Target]>::to_vec);
-                let weights = discs.iter().map(|d| d.radius * d.radius).collect();
+                let (discs, weights): (Vec<Target>, Vec<f32>) = match targets {
+                    None => (vec![scene], vec![1.0]),
+                    Some(ts) => {
+                        let mut discs = ts.to_vec();
+                        let weights = mix(discs.iter().map(|d| d.radius * d.radius).collect(), spread);
+                        if spread > 0.0 {
+                            discs.push(scene);
+                        }
+                        (discs, weights)
+                    }
+                };
                 let kind = Kind::Environment { scene, discs };
                 Emitter::finish(
                     kind,
@@ -328,18 +380,57 @@ fn cone_towards(position: Vec3, target: &Target) -> ConeLobe {
     }
 }
 
-/// The bounding spheres photons are aimed at: one per reflective or transmissive object. For a
-/// shape, the smaller of the sphere around its world bounds and its own bounding sphere: a
-/// rotated ring's world box is much larger than the ring, and every photon aimed past the ring
-/// is traced for nothing.
+/// The bounding spheres photons are aimed at: one per reflective or transmissive object.
 pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
+    specular_targets(scene).into_iter().map(|(_, target)| target).collect()
+}
+
+/// The targets of the mirrors and glass the camera sees, directly or through other mirrors and
+/// glass (followed straight on, which is enough to find them): a sky or a sun lights the whole
+/// scene, and photons aimed at objects out of view make caustics nobody sees.
+pub fn camera_targets(scene: &Scene) -> Vec<Target> {
+    let targets = specular_targets(scene);
+    if targets.is_empty() {
+        return Vec::new();
+    }
+    const GRID: usize = 48;
+    const MAX_CHAIN: usize = 4;
+    let mut seen = std::collections::HashSet::new();
+    for j in 0..GRID {
+        for i in 0..GRID {
+            let (sx, sy) = ((i as f32 + 0.5) / GRID as f32, (j as f32 + 0.5) / GRID as f32);
+            let mut ray = scene.camera().generate_ray(sx, sy);
+            for _ in 0..MAX_CHAIN {
+                let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                    break;
+                };
+                let hit = scene.surface(&ray, &isect);
+                if !scene.object_is_specular(hit.object) {
+                    break;
+                }
+                seen.insert(hit.object);
+                ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, ray.dir), ray.dir);
+            }
+        }
+    }
+    targets
+        .into_iter()
+        .filter(|(object, _)| seen.contains(object))
+        .map(|(_, target)| target)
+        .collect()
+}
+
+/// Each reflective or transmissive object with its target: for a shape, the smaller of the
+/// sphere around its world bounds and its own bounding sphere (a rotated ring's world box is
+/// much larger than the ring, and every photon aimed past the ring is traced for nothing).
+fn specular_targets(scene: &Scene) -> Vec<(ObjectRef, Target)> {
     scene
         .objects()
         .filter(|(object, bounds)| scene.object_is_specular(*object) && !bounds.is_empty())
         .map(|(object, bounds)| {
             let around = Target::around(&bounds);
             let ObjectRef::Shape(i) = object else {
-                return around;
+                return (object, around);
             };
             let (center, radius) = scene.shapes()[i as usize].bounding_sphere();
             let own = Target {
@@ -347,9 +438,9 @@ pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
                 radius: radius * 1.001 + 1e-4,
             };
             if own.radius < around.radius && own.radius.is_finite() && center.is_finite() {
-                own
+                (object, own)
             } else {
-                around
+                (object, around)
             }
         })
         .collect()
@@ -426,6 +517,16 @@ fn emission_at(scene: &Scene, sample: &AreaSample) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Uniform, aimed only, and aimed with a third spread everywhere: each must carry the same
+    /// expected flux.
+    fn aims(targets: &[Target]) -> [Option<Aim<'_>>; 3] {
+        [
+            None,
+            Some(Aim { targets, spread: 0.0 }),
+            Some(Aim { targets, spread: 0.3 }),
+        ]
+    }
     use crate::scene::build::test_scene as scene;
 
     fn bounds() -> Aabb {
@@ -458,8 +559,8 @@ mod tests {
         let target = &targets[0];
         let cos_max = (1.0f32 - 1.0 / 25.0).sqrt();
         let exact = 2.0 * PI * (1.0 - cos_max); // intensity 1 × solid angle of the first sphere
-        for aimed in [true, false] {
-            let e = Emitter::new(&light, aimed.then_some(&targets[..]), Target::around(&bounds())).unwrap();
+        for aim in aims(&targets) {
+            let e = Emitter::new(&light, aim, Target::around(&bounds())).unwrap();
             let mut rng = Rng::new(1, 0);
             let empty = scene("");
             let n = 200_000;
@@ -475,7 +576,7 @@ mod tests {
             let estimate = sum / n as f64;
             assert!(
                 (estimate / exact as f64 - 1.0).abs() < 0.02,
-                "aimed {aimed}: {estimate} vs {exact}"
+                "aim {aim:?}: {estimate} vs {exact}"
             );
         }
     }
@@ -497,9 +598,9 @@ mod tests {
             },
         ];
         let exact = 2.0 * PI; // irradiance 2 through the unit disc across the beam
-        for aimed in [true, false] {
+        for aim in aims(&targets) {
             let small = Aabb::new(Vec3::splat(-3.0), Vec3::splat(3.0));
-            let e = Emitter::new(&light, aimed.then_some(&targets[..]), Target::around(&small)).unwrap();
+            let e = Emitter::new(&light, aim, Target::around(&small)).unwrap();
             let mut rng = Rng::new(2, 0);
             let empty = scene("");
             let n = 2_000_000;
@@ -515,7 +616,7 @@ mod tests {
             let estimate = sum / n as f64;
             assert!(
                 (estimate / exact as f64 - 1.0).abs() < 0.02,
-                "aimed {aimed}: {estimate} vs {exact}"
+                "aim {aim:?}: {estimate} vs {exact}"
             );
         }
     }
@@ -601,9 +702,9 @@ mod tests {
         ];
         let empty = scene("");
         for (light, exact) in lights {
-            for aimed in [false, true] {
-                let targets = [target];
-                let e = Emitter::new(&light, aimed.then_some(&targets[..]), scene_sphere).unwrap();
+            let targets = [target];
+            for aim in aims(&targets) {
+                let e = Emitter::new(&light, aim, scene_sphere).unwrap();
                 let mut rng = Rng::new(4, 0);
                 let n = 400_000;
                 let mut sum = 0.0f64;
@@ -621,7 +722,7 @@ mod tests {
                 let estimate = sum / n as f64;
                 assert!(
                     (estimate / exact as f64 - 1.0).abs() < 0.02,
-                    "{light:?} aimed {aimed}: {estimate} vs {exact}"
+                    "{light:?} aim {aim:?}: {estimate} vs {exact}"
                 );
             }
         }

@@ -21,7 +21,7 @@
 
 use super::{Photon, DIFFUSE, DISPERSED, REFLECTED, REFRACTED};
 use crate::bsdf::{Bsdf, Transport};
-use crate::light::emission::{caustic_targets, Emitter, Target};
+use crate::light::emission::{caustic_targets, Aim, Emitter, Target};
 use crate::light::{distance_attenuation, Light};
 use crate::material::{channel_indices, refraction_geometry};
 use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
@@ -118,7 +118,14 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
             if !settings.first_hit && targets.is_empty() {
                 return None;
             }
-            Emitter::new(light, aim.then_some(&targets[..]), Target::around(&bounds))
+            Emitter::new(
+                light,
+                aim.then_some(Aim {
+                    targets: &targets,
+                    spread: 0.0,
+                }),
+                Target::around(&bounds),
+            )
         })
         .collect();
     let total_power: f32 = emitters.iter().flatten().map(Emitter::power).sum();
