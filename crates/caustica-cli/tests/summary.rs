@@ -193,7 +193,8 @@ fn info_json_holds_what_the_text_shows() {
     }
     assert_eq!(materials[0]["diffuse"].as_array().map(Vec::len), Some(3));
     assert!(info["warnings"].is_array() && info["camera"]["eye"].is_array());
-    assert_eq!(info["lights"][0]["type"], "directional");
+    assert_eq!(info["lights"][0]["type"], "sun");
+    assert_eq!(info["lights"][1]["type"], "environment");
     assert_phases(&info, &["parse", "build"]);
     assert!(info["scene"].as_str().unwrap().ends_with("pool.ray"));
 }

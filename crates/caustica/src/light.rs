@@ -24,7 +24,7 @@ pub use environment::Environment;
 use emission::{camera_targets, Aim, Emitter, Target};
 
 use crate::math::{luminance, offset_origin, Ray, Vec3};
-use crate::sampling::{sample_uniform_cone, Rng};
+use crate::sampling::{power_heuristic, sample_uniform_cone, Rng};
 use crate::scene::{ObjectRef, Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 use std::f32::consts::PI;
@@ -290,6 +290,9 @@ pub struct LightSet {
     scene_radius: f32,
 }
 
+/// Scenes with at most this many lights sample each of them at every point.
+const SAMPLE_EVERY_LIGHT_UP_TO: usize = 8;
+
 /// The share of a sun's or the sky's photons sent over the whole scene rather than at the
 /// mirrors and glass in view.
 const FAR_LIGHT_SPREAD: f32 = 0.5;
@@ -331,8 +334,8 @@ impl LightSet {
             center: scene_center,
             radius: scene_radius,
         };
-        // Far lights shine on everything: half their photons go to the mirrors and glass in
-        // view, where caustics come from, half everywhere for the rest of the light.
+        // Far lights shine on the whole scene: half their photons go to the mirrors and glass
+        // in view, where caustics come from, half everywhere for the rest of the light.
         let in_view = camera_targets(scene);
         let far_aim = Aim {
             targets: &in_view,
@@ -341,8 +344,8 @@ impl LightSet {
         let emitters = lights
             .iter()
             .map(|light| {
-                let aim = matches!(light, Light::Sun { .. } | Light::Environment(_)).then_some(far_aim);
-                Emitter::new(light, aim, sphere)
+                let far = matches!(light, Light::Sun { .. } | Light::Environment(_));
+                Emitter::new(light, far.then_some(far_aim), sphere)
             })
             .collect();
         LightSet {
@@ -405,16 +408,57 @@ impl LightSet {
         (p > 0.0).then_some((i, p))
     }
 
-    /// Samples one light for the point `hit` (visibility included): `None` when the light
-    /// chosen sends nothing there.
+    /// Whether next-event estimation samples every light at each point (few lights) rather
+    /// than one chosen by power: a sun beside the sky, or two lamps, then add no noise by
+    /// taking turns.
+    pub fn samples_every_light(&self) -> bool {
+        self.lights.len() <= SAMPLE_EVERY_LIGHT_UP_TO
+    }
+
+    /// The probability that next-event estimation takes light `index` at a point.
+    fn direct_probability(&self, index: usize) -> f32 {
+        match self.probabilities[index] {
+            p if p > 0.0 && self.samples_every_light() => 1.0,
+            p => p,
+        }
+    }
+
+    /// Direct-light samples for the point `hit` (visibility included), each with its own pdf
+    /// for MIS: one per light when [`LightSet::samples_every_light`], otherwise one light
+    /// chosen by power; `add` receives each sample that carries light.
     pub fn sample_direct(
         &self,
         scene: &Scene,
         hit: &SurfaceHit,
         wl: &Wavelengths,
         rng: &mut Rng,
+        mut add: impl FnMut(DirectSample),
+    ) {
+        if self.samples_every_light() {
+            for index in 0..self.lights.len() {
+                if self.probabilities[index] > 0.0 {
+                    if let Some(sample) = self.sample_light(index, 1.0, scene, hit, wl, rng) {
+                        add(sample);
+                    }
+                }
+            }
+        } else if let Some((index, p_pick)) = self.pick(rng.uniform()) {
+            if let Some(sample) = self.sample_light(index, p_pick, scene, hit, wl, rng) {
+                add(sample);
+            }
+        }
+    }
+
+    /// Samples light `index`, taken with probability `p_pick`, for the point `hit`.
+    fn sample_light(
+        &self,
+        index: usize,
+        p_pick: f32,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        wl: &Wavelengths,
+        rng: &mut Rng,
     ) -> Option<DirectSample> {
-        let (index, p_pick) = self.pick(rng.uniform())?;
         let (u_pick, u) = (rng.uniform(), rng.uniform2());
         let p = hit.point;
         let ng = hit.geometric_normal;
@@ -498,33 +542,30 @@ impl LightSet {
     /// Radiance arriving along a ray that leaves the scene in direction `dir` (unit): the sky
     /// and any sun whose disc it points into (physical model), at the wavelengths `wl`.
     pub fn escaped(&self, dir: Vec3, wl: &Wavelengths) -> Spectrum {
+        self.escaped_weighted(dir, None, wl)
+    }
+
+    /// [`LightSet::escaped`] for a BSDF sample of solid-angle pdf `bsdf_pdf` (when given):
+    /// each light's radiance weighted against next-event estimation's chance of sampling it
+    /// there (power heuristic).
+    pub fn escaped_weighted(&self, dir: Vec3, bsdf_pdf: Option<f32>, wl: &Wavelengths) -> Spectrum {
         let mut l = Spectrum::ZERO;
-        for light in &self.lights {
-            match light {
-                Light::Environment(env) => l += wl.unbounded(env.radiance(dir)),
+        for (index, light) in self.lights.iter().enumerate() {
+            let (radiance, light_pdf) = match light {
+                Light::Environment(env) => (env.radiance(dir), env.pdf(dir)),
                 Light::Sun { direction, cos_max, .. } if -dir.dot(*direction) >= *cos_max => {
-                    l += wl.unbounded(light.sun_radiance())
+                    (light.sun_radiance(), self.sun_pdf(light))
                 }
-                _ => {}
+                _ => continue,
+            };
+            let weight = bsdf_pdf.map_or(1.0, |pdf| {
+                power_heuristic(pdf, self.direct_probability(index) * light_pdf)
+            });
+            if weight > 0.0 {
+                l += wl.unbounded(radiance) * weight;
             }
         }
         l
-    }
-
-    /// Solid-angle pdf with which [`LightSet::sample_direct`] would pick the escaping direction
-    /// `dir` (the sky's and suns' part), for weighting BSDF samples that escape.
-    pub fn pdf_escaped(&self, dir: Vec3) -> f32 {
-        let mut pdf = 0.0;
-        for (light, &p_pick) in self.lights.iter().zip(&self.probabilities) {
-            match light {
-                Light::Environment(env) => pdf += p_pick * env.pdf(dir),
-                Light::Sun { direction, cos_max, .. } if -dir.dot(*direction) >= *cos_max => {
-                    pdf += p_pick * self.sun_pdf(light)
-                }
-                _ => {}
-            }
-        }
-        pdf
     }
 
     /// What a course-model ray that leaves the scene sees: the environment's radiance, black
@@ -547,8 +588,9 @@ impl LightSet {
             .any(|l| matches!(l, Light::Environment(_) | Light::Sun { .. }))
     }
 
-    /// Solid-angle pdf with which [`LightSet::sample_direct`] from `from` would pick the
-    /// emissive point `hit`; 0 when the object hit is not a light.
+    /// Solid-angle pdf with which [`LightSet::sample_direct`] from `from` would sample the
+    /// emissive point `hit` (its light's), for weighting BSDF samples that hit it; 0 when the
+    /// object hit is not a light.
     pub fn pdf_direct(&self, from: Vec3, hit: &SurfaceHit) -> f32 {
         let number = match hit.object {
             ObjectRef::Shape(s) => self.shape_light[s as usize],
@@ -557,7 +599,7 @@ impl LightSet {
         let Some(Light::Area(light)) = self.lights.get(number as usize) else {
             return 0.0;
         };
-        self.probabilities[number as usize] * light.pdf_towards(from, hit.point, hit.geometric_normal)
+        self.direct_probability(number as usize) * light.pdf_towards(from, hit.point, hit.geometric_normal)
     }
 }
 

@@ -232,6 +232,19 @@ impl Distribution2D {
     }
 }
 
+/// Power heuristic (β = 2) weight of a strategy with pdf `a` against one with pdf `b`.
+#[inline]
+pub fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
+        a2 / (a2 + b2)
+    } else if a.is_infinite() {
+        1.0
+    } else {
+        0.0
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

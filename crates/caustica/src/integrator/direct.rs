@@ -8,18 +8,7 @@ use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 
-/// Power heuristic (β = 2) weight of a strategy with pdf `a` against one with pdf `b`.
-#[inline]
-pub fn power_heuristic(a: f32, b: f32) -> f32 {
-    let (a2, b2) = (a * a, b * b);
-    if a2 + b2 > 0.0 && (a2 + b2).is_finite() {
-        a2 / (a2 + b2)
-    } else if a.is_infinite() {
-        1.0
-    } else {
-        0.0
-    }
-}
+pub use crate::sampling::power_heuristic;
 
 /// Direct light at a smooth surface point by one light sample, weighted against BSDF sampling
 /// when `mis` is set (the caller then also counts emitters its BSDF samples hit).
@@ -32,20 +21,21 @@ pub fn direct_light(
     wl: &Wavelengths,
     rng: &mut Rng,
 ) -> Spectrum {
-    let Some(sample) = scene.lights().sample_direct(scene, hit, wl, rng) else {
-        return Spectrum::ZERO;
-    };
-    let f = bsdf.eval(wo, sample.wi);
-    if f == Spectrum::ZERO {
-        return Spectrum::ZERO;
-    }
-    let cos = bsdf.normal().dot(sample.wi).abs();
-    let weight = if mis && sample.pdf > 0.0 {
-        power_heuristic(sample.pdf, bsdf.pdf(wo, sample.wi))
-    } else {
-        1.0
-    };
-    f * sample.contribution * (cos * weight)
+    let mut l = Spectrum::ZERO;
+    scene.lights().sample_direct(scene, hit, wl, rng, |sample| {
+        let f = bsdf.eval(wo, sample.wi);
+        if f == Spectrum::ZERO {
+            return;
+        }
+        let cos = bsdf.normal().dot(sample.wi).abs();
+        let weight = if mis && sample.pdf > 0.0 {
+            power_heuristic(sample.pdf, bsdf.pdf(wo, sample.wi))
+        } else {
+            1.0
+        };
+        l += f * sample.contribution * (cos * weight);
+    });
+    l
 }
 
 /// Emitted radiance of a surface towards any direction (two-sided), at the wavelengths `wl`.
@@ -69,13 +59,7 @@ pub fn direct_by_bsdf(scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample, wl: 
     let lights = scene.lights();
     let ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
     match scene.intersect(&ray, f32::INFINITY) {
-        None => {
-            let le = lights.escaped(sample.wi, wl);
-            if le == Spectrum::ZERO {
-                return Spectrum::ZERO;
-            }
-            le * power_heuristic(sample.pdf, lights.pdf_escaped(sample.wi))
-        }
+        None => lights.escaped_weighted(sample.wi, Some(sample.pdf), wl),
         Some(isect) => {
             let reached = scene.surface(&ray, &isect);
             let le = emitted(scene, &reached, wl);

@@ -181,8 +181,7 @@ impl<'a> Gi<'a> {
         for _ in 0..=s.max_depth {
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
                 if let Some((_, pdf)) = direct_from {
-                    let le = lights.escaped(ray.dir, wl);
-                    return le * power_heuristic(pdf, lights.pdf_escaped(ray.dir));
+                    return lights.escaped_weighted(ray.dir, Some(pdf), wl);
                 }
                 break;
             };

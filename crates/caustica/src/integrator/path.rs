@@ -51,15 +51,7 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengt
     for depth in 0..=settings.max_depth {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
             // The sky and suns, weighted against having sampled them directly.
-            let le = lights.escaped(ray.dir, wl);
-            if le != Spectrum::ZERO {
-                let weight = if specular {
-                    1.0
-                } else {
-                    power_heuristic(last_pdf, lights.pdf_escaped(ray.dir))
-                };
-                l += beta * le * weight;
-            }
+            l += beta * lights.escaped_weighted(ray.dir, (!specular).then_some(last_pdf), wl);
             break;
         };
         let hit = scene.surface(&ray, &isect);
