@@ -488,7 +488,7 @@ impl LightSet {
                 });
             }
             Light::Area(light) => return sample_area_direct(scene, light, p, ng, p_pick, (u_pick, u), wl),
-                        // Rays never hit this light, so its sample takes no MIS weight (pdf 0, as a point light).
+            // Rays never hit this light, so its sample takes no MIS weight (pdf 0, as a point light).
             Light::Soft(light) => {
                 let (s, pdf) = light.sample_towards(p, u)?;
                 let to = s.point - p;

@@ -46,7 +46,10 @@ pub fn build_detected(
     }
     let mut options = settings.read.clone();
     options.ray.dialect = Some(crate::format::ray_file::ast::Dialect::Hkust);
-    let dir = source.path.parent().map_or_else(|| Path::new(".").to_path_buf(), Path::to_path_buf);
+    let dir = source
+        .path
+        .parent()
+        .map_or_else(|| Path::new(".").to_path_buf(), Path::to_path_buf);
     let Ok(mut again) = format::read_text(&source.path, source.text.clone(), &dir, &options, &NoProgress) else {
         return Ok((source, scene));
     };

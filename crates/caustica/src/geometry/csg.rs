@@ -281,10 +281,16 @@ mod tests {
         let close = |got: Vec<(f32, f32, u32)>, want: &[(f32, f32, u32)]| {
             assert_eq!(got.len(), want.len(), "{got:?}");
             for (g, w) in got.iter().zip(want) {
-                assert!((g.0 - w.0).abs() < 1e-4 && (g.1 - w.1).abs() < 1e-4 && g.2 == w.2, "{got:?} vs {want:?}");
+                assert!(
+                    (g.0 - w.0).abs() < 1e-4 && (g.1 - w.1).abs() < 1e-4 && g.2 == w.2,
+                    "{got:?} vs {want:?}"
+                );
             }
         };
-        close(all(&op(CsgOp::Union, ball(-0.5, 1.0, 7), ball(0.5, 1.0, 8))), &[(-1.5, -1.0, 0), (1.5, 1.0, 1)]);
+        close(
+            all(&op(CsgOp::Union, ball(-0.5, 1.0, 7), ball(0.5, 1.0, 8))),
+            &[(-1.5, -1.0, 0), (1.5, 1.0, 1)],
+        );
         close(
             all(&op(CsgOp::Intersection, ball(-0.5, 1.0, 7), ball(0.5, 1.0, 8))),
             &[(-0.5, -1.0, 1), (0.5, 1.0, 0)],
@@ -330,7 +336,11 @@ mod tests {
                 let before = inside(ray.at(c.t - 1e-3));
                 let after = inside(ray.at(c.t + 1e-3));
                 assert!(before != after || p.abs().max_element() > 0.999, "{p}");
-                assert_eq!(c.normal.dot(ray.dir) > 0.0, state, "leaving points along the ray at {p}");
+                assert_eq!(
+                    c.normal.dot(ray.dir) > 0.0,
+                    state,
+                    "leaving points along the ray at {p}"
+                );
                 state = !state;
                 count += 1;
             }

@@ -123,7 +123,13 @@ impl Metaballs {
                         (d, grad) = (b, gb);
                         continue;
                     }
-                    let h = if k > 0.0 { (0.5 + (d - b) / (2.0 * k)).clamp(0.0, 1.0) } else if d > b { 1.0 } else { 0.0 };
+                    let h = if k > 0.0 {
+                        (0.5 + (d - b) / (2.0 * k)).clamp(0.0, 1.0)
+                    } else if d > b {
+                        1.0
+                    } else {
+                        0.0
+                    };
                     d = d * (1.0 - h) + b * h - k * h * (1.0 - h);
                     grad = grad * (1.0 - h) + gb * h;
                 }
@@ -159,7 +165,11 @@ impl Metaballs {
         // Which side the ray is on just after it starts: by g, or by its gradient on the surface.
         let (g0, grad0) = at(t_lo);
         let tiny = 1e-6 * (1.0 + self.bounds.extent().max_element()) * self.lipschitz;
-        let mut inside = if g0.abs() > tiny { g0 > 0.0 } else { grad0.dot(ray.dir) > 0.0 };
+        let mut inside = if g0.abs() > tiny {
+            g0 > 0.0
+        } else {
+            grad0.dot(ray.dir) > 0.0
+        };
         let min_step = 1e-5 * self.bounds.extent().max_element() / len;
         let mut t = t_lo;
         let mut g = g0;

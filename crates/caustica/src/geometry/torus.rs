@@ -125,7 +125,10 @@ impl Torus {
 mod tests {
     use super::*;
 
-    const RING: Torus = Torus { major: 1.0, minor: 0.25 };
+    const RING: Torus = Torus {
+        major: 1.0,
+        minor: 0.25,
+    };
 
     #[test]
     fn hits_on_the_axis_plane_match_the_circle_radii() {
@@ -141,12 +144,22 @@ mod tests {
         assert!((hit.normal.normalize() - Vec3::X).length() < 1e-6);
         assert!(hit.uv.x.abs() < 1e-6 && hit.uv.y.abs() < 1e-6, "{:?}", hit.uv);
         // Down the axis: through the hole.
-        assert!(RING.intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z), f32::INFINITY, false).is_none());
+        assert!(RING
+            .intersect(&Ray::new(Vec3::new(0.0, 0.0, 5.0), -Vec3::Z), f32::INFINITY, false)
+            .is_none());
         // Down onto the top of the tube at x = 1: t = 5 − 0.25, normal +z.
         let top = RING
-            .intersect(&Ray::new(Vec3::new(1.0, 0.0, 5.0), -Vec3::Z * 2.0), f32::INFINITY, false)
+            .intersect(
+                &Ray::new(Vec3::new(1.0, 0.0, 5.0), -Vec3::Z * 2.0),
+                f32::INFINITY,
+                false,
+            )
             .unwrap();
-        assert!((top.t - 2.375).abs() < 1e-6, "t in units of the (non-unit) direction: {}", top.t);
+        assert!(
+            (top.t - 2.375).abs() < 1e-6,
+            "t in units of the (non-unit) direction: {}",
+            top.t
+        );
         assert!((top.normal.normalize() - Vec3::Z).length() < 1e-6);
     }
 

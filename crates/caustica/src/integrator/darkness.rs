@@ -57,9 +57,10 @@ fn probe(scene: &Scene) -> Option<(String, bool)> {
     }
     let black = "the image comes out black";
     if hits.is_empty() {
-        return Some((format!(
-            "{black}: the camera sees no object (every ray from it misses the scene)"
-        ), false));
+        return Some((
+            format!("{black}: the camera sees no object (every ray from it misses the scene)"),
+            false,
+        ));
     }
     // The brightest unshadowed direct light anywhere the camera looks, and the largest falloff.
     let (mut unshadowed, mut facing, mut best_falloff) = (0.0f32, false, 0.0f32);
@@ -85,12 +86,18 @@ fn probe(scene: &Scene) -> Option<(String, bool)> {
         }
     }
     if !receives {
-        return Some((format!(
+        return Some((
+            format!(
             "{black}: what the camera sees has no diffuse or specular colour (kd = ks = 0), so no light shows on it"
-        ), false));
+        ),
+            false,
+        ));
     }
     if lights.is_empty() {
-        return Some((format!("{black}: the scene has only ambient light, and what the camera sees has no ambient colour"), false));
+        return Some((
+            format!("{black}: the scene has only ambient light, and what the camera sees has no ambient colour"),
+            false,
+        ));
     }
     if unshadowed < VISIBLE {
         let falls_off = lights.iter().any(|l| {
@@ -108,15 +115,22 @@ fn probe(scene: &Scene) -> Option<(String, bool)> {
             return Some((why, true));
         }
         if !facing {
-            return Some((format!("{black}: every light is behind the surfaces the camera sees"), false));
+            return Some((
+                format!("{black}: every light is behind the surfaces the camera sees"),
+                false,
+            ));
         }
-        return Some((format!(
-            "{black}: the lights are too dim for what the camera sees (at most {unshadowed:.2e} before shadows)"
-        ), false));
+        return Some((
+            format!(
+                "{black}: the lights are too dim for what the camera sees (at most {unshadowed:.2e} before shadows)"
+            ),
+            false,
+        ));
     }
-    Some((format!(
-        "{black}: everything the camera sees is in shadow (opaque objects stand between it and every light)"
-    ), false))
+    Some((
+        format!("{black}: everything the camera sees is in shadow (opaque objects stand between it and every light)"),
+        false,
+    ))
 }
 
 #[cfg(test)]
@@ -128,7 +142,9 @@ mod tests {
 
     #[test]
     fn a_lit_scene_is_not_reported() {
-        let scene = test_scene(&format!("directional_light {{ direction = (0, 0, -1); color = (1,1,1); }} {FLOOR}"));
+        let scene = test_scene(&format!(
+            "directional_light {{ direction = (0, 0, -1); color = (1,1,1); }} {FLOOR}"
+        ));
         assert_eq!(diagnose(&scene), None);
     }
 
@@ -136,7 +152,9 @@ mod tests {
     /// names the falloff and the HKUST reading.
     #[test]
     fn far_point_lights_are_named() {
-        let scene = test_scene(&format!("point_light {{ position = (0, 0, 58); color = (1,1,1); }} {FLOOR}"));
+        let scene = test_scene(&format!(
+            "point_light {{ position = (0, 0, 58); color = (1,1,1); }} {FLOOR}"
+        ));
         let why = diagnose(&scene).expect("black");
         assert!(why.contains("falloff") && why.contains("--dialect hkust"), "{why}");
         let f = 1.0 / (60.0f32 * 60.0);
@@ -156,7 +174,9 @@ mod tests {
              translate(0, 0, 8, scale(100, 100, 0.1, box {{ material = {{ diffuse = (1,1,1); }} }}))"
         ));
         assert!(diagnose(&under).expect("black").contains("in shadow"));
-        let behind = test_scene(&format!("directional_light {{ direction = (0, 0, 1); color = (1,1,1); }} {FLOOR}"));
+        let behind = test_scene(&format!(
+            "directional_light {{ direction = (0, 0, 1); color = (1,1,1); }} {FLOOR}"
+        ));
         assert!(diagnose(&behind).expect("black").contains("behind"));
         let empty = test_scene("directional_light { direction = (0, 0, -1); color = (1,1,1); }");
         assert!(diagnose(&empty).expect("black").contains("sees no object"));

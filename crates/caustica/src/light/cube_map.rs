@@ -141,7 +141,11 @@ mod tests {
     #[test]
     fn the_lat_long_map_reproduces_the_faces() {
         let faces = faces();
-        let env = Environment::new(Vec3::ONE, Some(to_lat_long(&faces, SkyboxLayout::Inside)), Mat3::IDENTITY);
+        let env = Environment::new(
+            Vec3::ONE,
+            Some(to_lat_long(&faces, SkyboxLayout::Inside)),
+            Mat3::IDENTITY,
+        );
         let mut rng = crate::sampling::Rng::new(9, 0);
         for _ in 0..2000 {
             let d = crate::sampling::sample_uniform_sphere(rng.uniform2());
@@ -151,7 +155,10 @@ mod tests {
             // Off the cube's edges, one lat-long texel spans at most ~2 face texels.
             let near_edge = uv.min_element() < 0.05 || uv.max_element() > 0.95;
             if !near_edge {
-                assert!((seen - expected).abs().max_element() < 0.08, "{d}: {seen} vs {expected}");
+                assert!(
+                    (seen - expected).abs().max_element() < 0.08,
+                    "{d}: {seen} vs {expected}"
+                );
                 assert!((seen.z - expected.z).abs() < 1e-6, "{d}: the face's own grey");
             }
         }

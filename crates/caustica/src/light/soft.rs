@@ -122,9 +122,7 @@ impl SoftLight {
     /// The points the course model's shadow rays from `p` aim at.
     pub fn shadow_targets(&self, p: Vec3) -> ShadowTargets {
         // Cranley–Patterson shift of the strata, from the bits of the shaded point.
-        let h = mix64(
-            (u64::from(p.x.to_bits()) << 32 | u64::from(p.y.to_bits())) ^ mix64(u64::from(p.z.to_bits())),
-        );
+        let h = mix64((u64::from(p.x.to_bits()) << 32 | u64::from(p.y.to_bits())) ^ mix64(u64::from(p.z.to_bits())));
         let shift = Vec2::new(
             (h >> 40) as f32 / (1u64 << 24) as f32,
             ((h >> 16) & 0xff_ffff) as f32 / (1u64 << 24) as f32,
@@ -152,7 +150,13 @@ impl SoftLight {
                 let n = sample_uniform_sphere(u);
                 (center + n * radius, n)
             }
-            SoftShape::Parallelogram { corner, u: eu, v: ev, normal, .. } => (corner + eu * u.x + ev * u.y, normal),
+            SoftShape::Parallelogram {
+                corner,
+                u: eu,
+                v: ev,
+                normal,
+                ..
+            } => (corner + eu * u.x + ev * u.y, normal),
         };
         SoftPoint {
             point,
@@ -227,7 +231,9 @@ impl Iterator for ShadowTargets {
                 let d = sample_uniform_disc(u) * radius;
                 center + self.frame.x * d.x + self.frame.y * d.y
             }
-            SoftShape::Parallelogram { corner, u: eu, v: ev, .. } => corner + eu * u.x + ev * u.y,
+            SoftShape::Parallelogram {
+                corner, u: eu, v: ev, ..
+            } => corner + eu * u.x + ev * u.y,
         })
     }
 }
@@ -314,6 +320,11 @@ mod tests {
         // h = 10: within 0.35 % of L/h².
         let estimate = sum / count as f64;
         assert!((estimate / (2.0 / 100.0) - 1.0).abs() < 0.005, "{estimate}");
-        assert!(light.sample_towards(Vec3::new(0.0, 0.0, 20.0), Vec2::splat(0.5)).is_none(), "back face");
+        assert!(
+            light
+                .sample_towards(Vec3::new(0.0, 0.0, 20.0), Vec2::splat(0.5))
+                .is_none(),
+            "back face"
+        );
     }
 }

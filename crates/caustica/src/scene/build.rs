@@ -255,9 +255,8 @@ impl Builder {
     ) -> Result<(), ParseError> {
         if let ShapeDesc::Csg(csg) = &object.shape {
             let root = self.csg_node(csg, object, settings)?;
-            let leaves = crate::geometry::csg::Csg::new(root).ok_or_else(|| {
-                ParseError::new("CSG operands must be closed solids", object.span.clone())
-            })?;
+            let leaves = crate::geometry::csg::Csg::new(root)
+                .ok_or_else(|| ParseError::new("CSG operands must be closed solids", object.span.clone()))?;
             let first = leaves.materials()[0];
             if leaves
                 .materials()
@@ -524,7 +523,11 @@ fn shape_kind(object: &ObjectDesc, settings: &ShapeSettings) -> Result<ShapeKind
         }
         ShapeDesc::Metaballs(desc) => {
             use crate::geometry::metaballs::{Ball, BlobModel, Metaballs};
-            let balls = desc.balls.iter().map(|&(center, radius)| Ball { center, radius }).collect();
+            let balls = desc
+                .balls
+                .iter()
+                .map(|&(center, radius)| Ball { center, radius })
+                .collect();
             let model = match desc.model {
                 crate::description::BlobModelDesc::Field { threshold } => BlobModel::Field { threshold },
                 crate::description::BlobModelDesc::SmoothUnion { blend } => BlobModel::SmoothUnion { k: blend },

@@ -722,7 +722,10 @@ impl<'a> Reader<'a> {
             }
         }
         let operation = operation.ok_or_else(|| {
-            ParseError::new("`csg` needs an `operation` such as `(\"a\", \"sub\", \"b\")`", span.clone())
+            ParseError::new(
+                "`csg` needs an `operation` such as `(\"a\", \"sub\", \"b\")`",
+                span.clone(),
+            )
         })?;
         let object = self.csg_operation(operation, &named, 0)?;
         self.scene.objects.push(object);

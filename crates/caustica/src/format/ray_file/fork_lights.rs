@@ -93,17 +93,26 @@ impl LightFields {
         let key = *fields.iter().find(|f| **f == key).expect("a known field");
         let same = |k: &str| k == key || (matches!(k, "color" | "colour") && matches!(key, "color" | "colour"));
         if self.vectors.iter().any(|(k, ..)| same(k)) || self.numbers.iter().any(|(k, ..)| same(k)) {
-            return Err(ParseError::new(format!("this light has a second `{key}`"), span.clone()));
+            return Err(ParseError::new(
+                format!("this light has a second `{key}`"),
+                span.clone(),
+            ));
         }
         Ok(key)
     }
 
     fn vec(&self, key: &str) -> Option<(Vec3, Span)> {
-        self.vectors.iter().find(|(k, ..)| *k == key).map(|(_, v, s)| (*v, s.clone()))
+        self.vectors
+            .iter()
+            .find(|(k, ..)| *k == key)
+            .map(|(_, v, s)| (*v, s.clone()))
     }
 
     fn num(&self, key: &str) -> Option<(f32, Span)> {
-        self.numbers.iter().find(|(k, ..)| *k == key).map(|(_, v, s)| (*v, s.clone()))
+        self.numbers
+            .iter()
+            .find(|(k, ..)| *k == key)
+            .map(|(_, v, s)| (*v, s.clone()))
     }
 
     fn color(&self) -> Option<Vec3> {
@@ -140,12 +149,19 @@ impl LightFields {
     }
 
     /// The spot light these fields describe; `falloff` is the dialect's point-light default.
-    pub fn spot(self, block: Span, falloff: [f32; 3], hkust: bool) -> Result<(LightDesc, Vec<(String, Span)>), ParseError> {
+    pub fn spot(
+        self,
+        block: Span,
+        falloff: [f32; 3],
+        hkust: bool,
+    ) -> Result<(LightDesc, Vec<(String, Span)>), ParseError> {
         let position = self
             .vec("position")
             .ok_or_else(|| self.required("spot_light", "position", &block))?
             .0;
-        let color = self.color().ok_or_else(|| self.required("spot_light", "color", &block))?;
+        let color = self
+            .color()
+            .ok_or_else(|| self.required("spot_light", "color", &block))?;
         let aims: Vec<&str> = ["direction", "central_direction", "target"]
             .into_iter()
             .filter(|k| self.vec(k).is_some())
@@ -157,7 +173,10 @@ impl LightFields {
             [_, second, ..] => {
                 let span = self.vec(second).map(|(_, s)| s).unwrap_or(block);
                 return Err(ParseError::new(
-                    format!("give the spot light's aim once (`{}` and `{second}` are both given)", aims[0]),
+                    format!(
+                        "give the spot light's aim once (`{}` and `{second}` are both given)",
+                        aims[0]
+                    ),
                     span,
                 ));
             }
@@ -174,7 +193,10 @@ impl LightFields {
             .map(|(keys, _)| *keys)
             .collect();
         if used.len() > 1 {
-            let span = self.num(used[1][0]).or_else(|| self.num(used[1][1])).map_or(block.clone(), |(_, s)| s);
+            let span = self
+                .num(used[1][0])
+                .or_else(|| self.num(used[1][1]))
+                .map_or(block.clone(), |(_, s)| s);
             return Err(ParseError::new(
                 format!(
                     "give the spot light's cone in one spelling (`{}` and `{}` come from different course forks)",
@@ -202,15 +224,18 @@ impl LightFields {
                 let angle = self.num("angle").map(|(v, s)| (v, s)).expect("given");
                 if !(0.0..=std::f32::consts::PI).contains(&angle.0) {
                     return Err(ParseError::new(
-                        format!("`angle` is the spot's half-angle in radians, between 0 and π, not {}", angle.0),
+                        format!(
+                            "`angle` is the spot's half-angle in radians, between 0 and π, not {}",
+                            angle.0
+                        ),
                         angle.1,
                     ));
                 }
                 (angle.0.to_degrees(), angle.0.to_degrees())
             }
             Some("cone_angle") => {
-                let cone = degrees("cone_angle", 180.0)?
-                    .ok_or_else(|| self.required("spot_light", "cone_angle", &block))?;
+                let cone =
+                    degrees("cone_angle", 180.0)?.ok_or_else(|| self.required("spot_light", "cone_angle", &block))?;
                 let penumbra = degrees("penumbra", 180.0)?.unwrap_or(0.0);
                 ((cone - penumbra).max(0.0), cone)
             }
@@ -262,7 +287,9 @@ impl LightFields {
             .vec("position")
             .ok_or_else(|| self.required("area_light", "position", &block))?
             .0;
-        let color = self.color().ok_or_else(|| self.required("area_light", "color", &block))?;
+        let color = self
+            .color()
+            .ok_or_else(|| self.required("area_light", "color", &block))?;
         let radii: Vec<(f32, Span)> = ["light_radius", "bottom_radius", "radius"]
             .iter()
             .filter_map(|k| self.num(k))

@@ -66,17 +66,29 @@ impl MetaballFields {
                 }
                 if balls.len() > MAX_BALLS {
                     return Err(ParseError::new(
-                        format!("{} balls in one metaballs object; at most {MAX_BALLS} are read", balls.len()),
+                        format!(
+                            "{} balls in one metaballs object; at most {MAX_BALLS} are read",
+                            balls.len()
+                        ),
                         span,
                     ));
                 }
-                if let Some(&(_, Some(r))) = balls.iter().find(|(_, r)| r.is_some_and(|r| !(r > 0.0 && r.is_finite()))) {
-                    return Err(ParseError::new(format!("a ball's radius must be positive, not {r}"), span));
+                if let Some(&(_, Some(r))) = balls
+                    .iter()
+                    .find(|(_, r)| r.is_some_and(|r| !(r > 0.0 && r.is_finite())))
+                {
+                    return Err(ParseError::new(
+                        format!("a ball's radius must be positive, not {r}"),
+                        span,
+                    ));
                 }
                 balls.into_iter().map(|(c, r)| (c, r.unwrap_or(radius))).collect()
             }
             None if smooth => {
-                return Err(ParseError::new("`metaball` needs its balls: `ball = ((x, y, z), …);`", block.clone()))
+                return Err(ParseError::new(
+                    "`metaball` needs its balls: `ball = ((x, y, z), …);`",
+                    block.clone(),
+                ))
             }
             None => [Vec3::ZERO, Vec3::new(1.0, 0.5, 0.0), Vec3::new(0.0, 0.9, 0.0)]
                 .into_iter()
@@ -85,14 +97,20 @@ impl MetaballFields {
         };
         let model = if smooth {
             if let Some((_, span)) = self.threshold {
-                return Err(ParseError::new("`threshold` belongs to `metaballs`; `metaball` blends by `blend`", span));
+                return Err(ParseError::new(
+                    "`threshold` belongs to `metaballs`; `metaball` blends by `blend`",
+                    span,
+                ));
             }
             BlobModelDesc::SmoothUnion {
                 blend: self.blend.map_or(0.7, |(b, _)| b),
             }
         } else {
             if let Some((_, span)) = self.blend {
-                return Err(ParseError::new("`blend` belongs to `metaball`; `metaballs` sets its level by `threshold`", span));
+                return Err(ParseError::new(
+                    "`blend` belongs to `metaball`; `metaballs` sets its level by `threshold`",
+                    span,
+                ));
             }
             let threshold = self.threshold.map_or(0.25, |(t, _)| t);
             BlobModelDesc::Field { threshold }

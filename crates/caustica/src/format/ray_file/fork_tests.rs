@@ -40,7 +40,10 @@ const COMMENTED: &str = "// box_cyl_opaque_shadow.ray\n// Test opaque shadows\nc
 fn cr_only_files_read_like_their_lf_versions() {
     let lf = read(COMMENTED);
     let cr = read(&COMMENTED.replace('\n', "\r"));
-    assert_eq!(format!("{:?}", lf.into_description()), format!("{:?}", cr.into_description()));
+    assert_eq!(
+        format!("{:?}", lf.into_description()),
+        format!("{:?}", cr.into_description())
+    );
     let broken = format!("{HEADER}{}", COMMENTED.replace("(3, 0, 6)", "(3, 0 6)")).replace('\n', "\r");
     let err = parse(&broken, Path::new(""), &ParseOptions::default()).expect_err("a missing comma");
     assert_eq!(line_col(&broken, err.span.start).0, 9, "{}", err.message);
@@ -109,7 +112,14 @@ fn spot(scene: &RayScene) -> (Vec3, Vec3, [f32; 3], f32, f32, f32) {
             outer_degrees,
             exponent,
             ..
-        } => (*position, *direction, *attenuation, *inner_degrees, *outer_degrees, *exponent),
+        } => (
+            *position,
+            *direction,
+            *attenuation,
+            *inner_degrees,
+            *outer_degrees,
+            *exponent,
+        ),
         other => panic!("{other:?}"),
     }
 }
@@ -166,7 +176,10 @@ fn spot_light_errors_are_located() {
     );
     assert!(err.message.contains("aim once"), "{}", err.message);
     assert_eq!(covered, "target = (0,0,0)");
-    let (err, _) = fail("spot_light { position = (0,0,1); color = (1,1,1); }", Some(Dialect::Tokenizer));
+    let (err, _) = fail(
+        "spot_light { position = (0,0,1); color = (1,1,1); }",
+        Some(Dialect::Tokenizer),
+    );
     assert!(err.message.contains("needs a `direction`"));
     let (err, covered) = fail(
         "spot_light { position = (0,0,1); direction = (0,0,-1); angle = 7; color = (1,1,1); }",
@@ -187,9 +200,7 @@ fn spot_light_errors_are_located() {
 #[test]
 fn area_light_spellings() {
     let ball = |scene: &RayScene| match &scene.lights[0] {
-        LightDesc::Soft {
-            shape, attenuation, ..
-        } => (*shape, *attenuation),
+        LightDesc::Soft { shape, attenuation, .. } => (*shape, *attenuation),
         other => panic!("{other:?}"),
     };
     // UT 2018: light_radius; UT 2019: bottom_radius (and a missing `;` after the colour).
@@ -245,7 +256,9 @@ fn skybox_faces_and_their_files() {
          top = \"t.bmp\"; bottom = \"d.bmp\"; }",
     );
     match &scene.lights[0] {
-        LightDesc::Skybox { faces, layout, color, .. } => {
+        LightDesc::Skybox {
+            faces, layout, color, ..
+        } => {
             let names: Vec<String> = faces.iter().map(|f| f.display().to_string()).collect();
             assert_eq!(
                 names,
@@ -258,7 +271,10 @@ fn skybox_faces_and_their_files() {
     }
     let (err, _) = fail("skybox { front = \"f.bmp\"; }", Some(Dialect::Tokenizer));
     assert!(err.message.contains("`right (posx)`"), "{}", err.message);
-    let (err, covered) = fail("skybox { posx = \"a.png\"; right = \"b.png\"; }", Some(Dialect::Tokenizer));
+    let (err, covered) = fail(
+        "skybox { posx = \"a.png\"; right = \"b.png\"; }",
+        Some(Dialect::Tokenizer),
+    );
     assert!(err.message.contains("same face"));
     assert_eq!(covered, "\"b.png\"");
 }
@@ -285,7 +301,11 @@ fn skybox_paths_written_from_a_project_root_are_found() {
         other => panic!("{other:?}"),
     }
     assert_eq!(scene.warnings.len(), 6);
-    assert!(scene.warnings[0].0.contains("using `skybox/back.bmp`"), "{}", scene.warnings[0].0);
+    assert!(
+        scene.warnings[0].0.contains("using `skybox/back.bmp`"),
+        "{}",
+        scene.warnings[0].0
+    );
 }
 
 // ---------------------------------------------------------------- torus
@@ -300,11 +320,19 @@ fn torus_radii_in_each_fork() {
         ref other => panic!("{other:?}"),
     };
     // UT 2019: no fields, radii 1 and 0.3.
-    assert_eq!(radii(&read("scale(1.0, rotate(-.75,-.5,-.5,-.75, torus { material = { diffuse = (1,1,1); }; }))")), (1.0, 0.3));
+    assert_eq!(
+        radii(&read(
+            "scale(1.0, rotate(-.75,-.5,-.5,-.75, torus { material = { diffuse = (1,1,1); }; }))"
+        )),
+        (1.0, 0.3)
+    );
     // HKUST 2019: `a` and `b`, defaults 1 and 0.2 in its dictionary reader.
     let hkust = "translate(6, 0, 1, scale(2, 2, 2, torus { a = 1.5; material = { diffuse = (1,1,1); } }))";
     assert_eq!(radii(&read_as(hkust, Some(Dialect::Hkust)).unwrap()), (1.5, 0.2));
-    assert_eq!(radii(&read("torus { major_radius = 2; minor_radius = 0.5; }")), (2.0, 0.5));
+    assert_eq!(
+        radii(&read("torus { major_radius = 2; minor_radius = 0.5; }")),
+        (2.0, 0.5)
+    );
     let (err, covered) = fail("torus { b = -1; }", Some(Dialect::Tokenizer));
     assert!(err.message.contains("positive"));
     assert_eq!(covered, "-1");
@@ -323,7 +351,11 @@ fn metaballs_in_each_fork() {
     let m = blobs(&read("metaballs { material = { diffuse=( 1,0.3,0.3); }; }"));
     assert_eq!(
         m.balls,
-        vec![(Vec3::ZERO, 1.0), (Vec3::new(1.0, 0.5, 0.0), 1.0), (Vec3::new(0.0, 0.9, 0.0), 1.0)]
+        vec![
+            (Vec3::ZERO, 1.0),
+            (Vec3::new(1.0, 0.5, 0.0), 1.0),
+            (Vec3::new(0.0, 0.9, 0.0), 1.0)
+        ]
     );
     assert_eq!(m.model, BlobModelDesc::Field { threshold: 0.25 });
     // The team fork: spheres of radius `size`, smooth-unioned over 0.7.
@@ -334,7 +366,9 @@ fn metaballs_in_each_fork() {
     assert_eq!(m.balls[1], (Vec3::new(1.0, -1.0, 1.0), 3.0));
     assert_eq!(m.model, BlobModelDesc::SmoothUnion { blend: 0.7 });
     // caustica's spellings: per-ball radii and a threshold.
-    let m = blobs(&read("metaballs { balls = ((0,0,0,2), (1,0,0)); radius = 0.5; threshold = 0.4; }"));
+    let m = blobs(&read(
+        "metaballs { balls = ((0,0,0,2), (1,0,0)); radius = 0.5; threshold = 0.4; }",
+    ));
     assert_eq!(m.balls, vec![(Vec3::ZERO, 2.0), (Vec3::X, 0.5)]);
     let (err, _) = fail("metaball { size = 1; }", Some(Dialect::Tokenizer));
     assert!(err.message.contains("needs its balls"));

@@ -336,9 +336,16 @@ mod tests {
     #[test]
     fn a_lone_cr_ends_comments_and_strings_like_lf() {
         for text in ["a // x\rb", "a // x\nb", "a // x\r\nb"] {
-            assert_eq!(kinds(text, Dialect::Tokenizer), vec![Tok::Word, Tok::Word, Tok::Eof], "{text:?}");
+            assert_eq!(
+                kinds(text, Dialect::Tokenizer),
+                vec![Tok::Word, Tok::Word, Tok::Eof],
+                "{text:?}"
+            );
         }
-        assert!(lex("\"abc\r\"", Dialect::Dictionary).is_err(), "a string ends at a CR line end");
+        assert!(
+            lex("\"abc\r\"", Dialect::Dictionary).is_err(),
+            "a string ends at a CR line end"
+        );
     }
 
     #[test]

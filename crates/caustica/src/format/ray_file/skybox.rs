@@ -67,7 +67,14 @@ impl SkyboxFields {
 
     /// The skybox, once all six faces are named.
     pub fn finish(self, block: Span) -> Result<LightDesc, ParseError> {
-        let names = ["right (posx)", "left (negx)", "top (posy)", "bottom (negy)", "back (posz)", "front (negz)"];
+        let names = [
+            "right (posx)",
+            "left (negx)",
+            "top (posy)",
+            "bottom (negy)",
+            "back (posz)",
+            "front (negz)",
+        ];
         let mut faces = Vec::with_capacity(6);
         for (slot, name) in self.faces.into_iter().zip(names) {
             match slot {
@@ -104,7 +111,9 @@ fn resolve(scene_dir: &Path, file: &str) -> (PathBuf, Option<String>) {
         if candidate.is_file() {
             return (
                 candidate,
-                Some(format!("skybox image `{file}` is not beside the scene; using `{tail}`, which is")),
+                Some(format!(
+                    "skybox image `{file}` is not beside the scene; using `{tail}`, which is"
+                )),
             );
         }
     }

@@ -926,7 +926,10 @@ impl<'a> Parser<'a> {
                         p.key_equals()?;
                         let (value, span) = p.cur.number(&format!("for `{key}`"))?;
                         if !(value > 0.0 && value.is_finite()) {
-                            return Err(ParseError::new(format!("a torus radius must be positive, not {value}"), span));
+                            return Err(ParseError::new(
+                                format!("a torus radius must be positive, not {value}"),
+                                span,
+                            ));
                         }
                         if matches!(key, "major_radius" | "a") {
                             major = value;
@@ -993,7 +996,9 @@ impl<'a> Parser<'a> {
                         p.key_equals()?;
                         let mut balls = Vec::new();
                         let span = p.list(key, |p| {
-                            let open = p.cur.expect(Tok::LParen, "to start a ball `(x, y, z)` or `(x, y, z, radius)`")?;
+                            let open = p
+                                .cur
+                                .expect(Tok::LParen, "to start a ball `(x, y, z)` or `(x, y, z, radius)`")?;
                             let mut values = Vec::with_capacity(4);
                             loop {
                                 values.push(p.cur.number("in a ball")?.0);
@@ -1004,7 +1009,10 @@ impl<'a> Parser<'a> {
                             }
                             if !(3..=4).contains(&values.len()) {
                                 return Err(ParseError::new(
-                                    format!("a ball is `(x, y, z)` or `(x, y, z, radius)`, not {} numbers", values.len()),
+                                    format!(
+                                        "a ball is `(x, y, z)` or `(x, y, z, radius)`, not {} numbers",
+                                        values.len()
+                                    ),
                                     open.span.start..p.cur.prev_end(),
                                 ));
                             }
