@@ -106,8 +106,9 @@ pub struct SceneArgs {
     /// Reproduce the course skeleton's cone quirks (radius/slope clamps, doubled normal z).
     #[arg(long)]
     pub cone_quirks: bool,
-    /// Read the file as this dialect instead of detecting it.
-    #[arg(long, value_parser = ["tokenizer", "dictionary"])]
+    /// Read the file as this dialect instead of detecting it (hkust: the dictionary reader with
+    /// the HKUST COMP 4411 skeleton's defaults, e.g. point lights that do not fall off).
+    #[arg(long, value_parser = ["tokenizer", "dictionary", "hkust"])]
     pub dialect: Option<String>,
 }
 

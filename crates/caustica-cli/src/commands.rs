@@ -13,7 +13,7 @@ use caustica::format::ray_file::ast::Dialect;
 use caustica::format::ray_file::ParseOptions;
 use caustica::format::{self, ReadOptions};
 use caustica::integrator::RenderConfig;
-use caustica::loader::{build_source, scene_id, LoadSettings};
+use caustica::loader::{build_detected, scene_id, LoadSettings};
 use caustica::photon::PhotonSettings;
 use caustica::presets;
 use caustica::scene::Scene;
@@ -30,6 +30,7 @@ pub fn load_settings(args: &SceneArgs) -> LoadSettings {
             dialect: match args.dialect.as_deref() {
                 Some("tokenizer") => Some(Dialect::Tokenizer),
                 Some("dictionary") => Some(Dialect::Dictionary),
+                Some("hkust") => Some(Dialect::Hkust),
                 _ => None,
             },
         },
@@ -68,7 +69,7 @@ pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<
     let start = Instant::now();
     let source = source?;
     let scene_id = scene_id(&source, &settings);
-    let scene = build_source(source, &settings.build, bars)?;
+    let (_, scene) = build_detected(source, &settings, bars)?;
     Ok(Loaded {
         scene,
         scene_id,

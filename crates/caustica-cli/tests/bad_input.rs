@@ -123,8 +123,8 @@ fn catalogue() -> Vec<Case> {
         .at("2:26"),
         case(
             "student_extension",
-            staged("area_light { position = (0, 0, 0); color = (1, 1, 1); }\n"),
-            &["`area_light` is a student extension"],
+            staged("warn_light { position = (0, 0, 0); color = (1, 1, 1); }\n"),
+            &["`warn_light` is a student extension"],
         )
         .at("4:1"),
         // Meshes.

@@ -96,6 +96,32 @@ pub enum LightDesc {
         /// Where the block is.
         span: Span,
     },
+    /// A light with a size (the course forks' `area_light`): the course model shades with it as
+    /// a point light at its centre whose shadows are soft; the physical model samples its
+    /// surface and emits photons from it.
+    Soft {
+        /// Its shape and place.
+        shape: SoftShapeDesc,
+        /// A ball's colour is its intensity, as a point light's; a parallelogram's is the
+        /// radiance of its front face.
+        color: Vec3,
+        /// The course's (a, b, c) falloff with distance from the centre.
+        attenuation: [f32; 3],
+        /// Where the block is.
+        span: Span,
+    },
+    /// A cube map around the scene (six images, seen from inside), the background of both
+    /// models and the sky of the physical one.
+    Skybox {
+        /// The images looking along +x, −x, +y, −y, +z and −z, resolved against the scene's folder.
+        faces: [PathBuf; 6],
+        /// How each face is laid out.
+        layout: SkyboxLayout,
+        /// Radiance scale.
+        color: Vec3,
+        /// Where the block is (for errors reading the images).
+        span: Span,
+    },
     /// The sky around the scene: radiance `color` times an optional latitude–longitude image.
     Environment {
         /// Radiance scale.
@@ -108,6 +134,37 @@ pub enum LightDesc {
         /// Where the block is (and the map's file name in it, for errors reading it).
         span: Span,
     },
+}
+
+/// The shape of a [`LightDesc::Soft`] light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SoftShapeDesc {
+    /// A ball (radius 0 is a point light).
+    Sphere {
+        /// Centre.
+        center: Vec3,
+        /// Radius.
+        radius: f32,
+    },
+    /// A parallelogram `corner + s·u + t·v` (s, t in [0, 1]) lit on the side u × v points to.
+    Parallelogram {
+        /// One corner.
+        corner: Vec3,
+        /// First edge.
+        u: Vec3,
+        /// Second edge.
+        v: Vec3,
+    },
+}
+
+/// How the six images of a skybox are oriented.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SkyboxLayout {
+    /// Each face seen from inside the box, upright for the four sides (top face: its bottom
+    /// edge meets the front face; bottom face: its top edge meets the front).
+    Inside,
+    /// The UT course skeleton's cube map (its `CubeMap::getColor`), whose x axis is mirrored.
+    UtCubeMap,
 }
 
 /// A material parameter: a constant or a texture map.
@@ -214,6 +271,63 @@ pub enum ShapeDesc {
     },
     /// Triangle mesh (polygons already fan-triangulated, indices validated).
     Trimesh(Box<TrimeshDesc>),
+    /// Torus about +z: a tube of radius `minor_radius` around the circle of radius
+    /// `major_radius` in the z = 0 plane (a course-fork extension).
+    Torus {
+        /// Radius of the ring.
+        major_radius: f32,
+        /// Radius of the tube.
+        minor_radius: f32,
+    },
+    /// Metaballs (a course-fork extension).
+    Metaballs(Box<MetaballsDesc>),
+    /// Constructive solid geometry (a course-fork extension): its operands carry their own
+    /// world transforms and materials; the object's own transform and material are unused.
+    Csg(Box<CsgDesc>),
+}
+
+/// A CSG operation on two or more operands, applied from the left: `a − b − c` for a difference.
+#[derive(Clone, Debug)]
+pub struct CsgDesc {
+    /// Which operation.
+    pub op: CsgOpDesc,
+    /// The operands (closed shapes or other CSG objects), each placed in the world.
+    pub operands: Vec<ObjectDesc>,
+}
+
+/// The CSG operations.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CsgOpDesc {
+    /// Inside any operand.
+    Union,
+    /// Inside every operand.
+    Intersection,
+    /// Inside the first operand and none of the others.
+    Difference,
+}
+
+/// Metaballs: balls (centre, radius) blended into one surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MetaballsDesc {
+    /// Centre and radius of each ball.
+    pub balls: Vec<(Vec3, f32)>,
+    /// How they blend.
+    pub model: BlobModelDesc,
+}
+
+/// How metaballs blend.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum BlobModelDesc {
+    /// Σ K(|p − c|/R) = threshold, K(x) = 1 − x³(6x² − 15x + 10) for x < 1.
+    Field {
+        /// The level of the surface.
+        threshold: f32,
+    },
+    /// The polynomial smooth minimum (of width `blend`) of the balls' distances is zero.
+    SmoothUnion {
+        /// Width of the blend.
+        blend: f32,
+    },
 }
 
 /// A triangle mesh in object space.

@@ -37,8 +37,17 @@ impl ParseError {
 pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let offset = offset.min(text.len());
     let before = &text[..floor_char_boundary(text, offset)];
-    let line = before.matches('\n').count() + 1;
-    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    // Lines end at LF, CR LF or a lone CR (old Mac files).
+    let bytes = before.as_bytes();
+    let mut line = 1;
+    let mut line_start = 0;
+    for (i, &b) in bytes.iter().enumerate() {
+        let ends = b == b'\n' || (b == b'\r' && text.as_bytes().get(i + 1) != Some(&b'\n'));
+        if ends {
+            line += 1;
+            line_start = i + 1;
+        }
+    }
     let col = before[line_start..].chars().count() + 1;
     (line, col)
 }
@@ -111,5 +120,12 @@ mod tests {
         assert_eq!(line_col(text, 3), (2, 1));
         assert_eq!(line_col(text, text.find('x').unwrap()), (3, 1));
         assert_eq!(line_col(text, 5), (2, 3));
+    }
+
+    #[test]
+    fn a_lone_cr_ends_a_line_and_cr_lf_ends_one() {
+        let text = "ab\rcd\r\nx";
+        assert_eq!(line_col(text, 3), (2, 1));
+        assert_eq!(line_col(text, text.find('x').unwrap()), (3, 1));
     }
 }

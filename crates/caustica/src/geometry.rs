@@ -6,9 +6,13 @@
 
 pub mod box_shape;
 pub mod cone;
+pub mod csg;
+pub mod metaballs;
+pub mod roots;
 pub mod shape;
 pub mod sphere;
 pub mod square;
+pub mod torus;
 pub mod triangle;
 pub mod triangle_packet;
 

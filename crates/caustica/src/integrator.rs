@@ -9,6 +9,7 @@
 //!   gathering.
 
 pub mod config;
+pub mod darkness;
 pub mod direct;
 pub mod gi;
 pub mod partial;

@@ -15,11 +15,14 @@
 //! [`environment`].
 
 pub mod area;
+pub mod cube_map;
 pub mod emission;
 pub mod environment;
+pub mod soft;
 
 pub use area::AreaLight;
 pub use environment::Environment;
+pub use soft::SoftLight;
 
 use emission::{camera_targets, Aim, Emitter, Target};
 
@@ -83,6 +86,9 @@ pub enum Light {
     Environment(Environment),
     /// An emissive object (physical model only).
     Area(AreaLight),
+    /// A light with a size that is not an object (the course forks' `area_light`): soft shadows
+    /// in the course model, a sampled surface in the physical one ([`soft`]).
+    Soft(SoftLight),
 }
 
 /// What a light sends to a point under the course model: the unit direction towards the light,
@@ -145,6 +151,18 @@ impl Light {
                 distance: f32::INFINITY,
                 intensity: color,
             }),
+            Light::Soft(ref soft) => {
+                let to_light = soft.center() - p;
+                let distance = to_light.length();
+                if distance == 0.0 || !distance.is_finite() {
+                    return None;
+                }
+                Some(LightSample {
+                    wi: to_light / distance,
+                    distance,
+                    intensity: soft.color * distance_attenuation(soft.attenuation, distance),
+                })
+            }
             Light::Environment(_) | Light::Area(_) => None,
         }
     }
@@ -165,7 +183,7 @@ impl Light {
     }
 
     /// Whether the course model shades with this light and emits caustic photons from it
-    /// (point, spot, directional lights and suns).
+    /// (point, spot, directional lights, suns and lights with a size).
     pub fn is_course_light(&self) -> bool {
         !matches!(self, Light::Area(_) | Light::Environment(_))
     }
@@ -179,6 +197,16 @@ impl Light {
             | Light::Sun { color, .. } => *color,
             Light::Environment(env) => env.color,
             Light::Area(area) => area.radiance,
+            Light::Soft(soft) => soft.color,
+        }
+    }
+
+    /// The points a course-model shadow ray from `p` aims at when the light has a size (its
+    /// shadow is their average); `None` for a light with one shadow ray.
+    pub fn shadow_targets(&self, p: Vec3) -> Option<soft::ShadowTargets> {
+        match self {
+            Light::Soft(soft) => Some(soft.shadow_targets(p)),
+            _ => None,
         }
     }
 
@@ -198,6 +226,7 @@ impl Light {
             Light::Directional { color, .. } | Light::Sun { color, .. } => disc * luminance(*color).max(0.0),
             Light::Environment(env) => disc * env.luminance_integral(),
             Light::Area(area) => area.power(),
+            Light::Soft(soft) => soft.power(),
         }
     }
 
@@ -520,6 +549,16 @@ impl LightSet {
                 });
             }
             Light::Area(light) => return sample_area_direct(scene, light, p, ng, p_pick, (u_pick, u), wl),
+            // Rays never hit this light, so its sample takes no MIS weight (pdf 0, as a point light).
+            Light::Soft(light) => {
+                let (s, pdf) = light.sample_towards(p, u)?;
+                let to = s.point - p;
+                let d = to.length();
+                if !(d > 0.0) || pdf <= 0.0 {
+                    return None;
+                }
+                (to / d, d, s.radiance / pdf)
+            }
         };
         if !scene.unoccluded(p, ng, wi, distance) {
             return None;

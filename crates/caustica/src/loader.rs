@@ -19,7 +19,52 @@ pub struct LoadSettings {
 /// Reads and builds the scene file at `path`.
 pub fn load(path: &Path, settings: &LoadSettings) -> Result<Scene> {
     let source = format::read_file(path, &settings.read, &NoProgress)?;
-    build_source(source, &settings.build, &NoProgress)
+    build_detected(source, settings, &NoProgress).map(|(_, scene)| scene)
+}
+
+/// Builds a scene read with `settings`; when the dialect was detected rather than forced and
+/// the course render would come out black only because point or spot lights without
+/// coefficients fall off as 1/d² (the UT reading), the file is read again with the HKUST
+/// COMP 4411 defaults (no falloff), and that reading is kept if the file is valid there and it
+/// is not black. The same file can be a UT or an HKUST scene (stock samples are shared), so this
+/// is the one case where the text cannot choose; a warning says which reading was taken.
+/// Returns the source the scene was built from.
+pub fn build_detected(
+    source: SceneSource,
+    settings: &LoadSettings,
+    progress: &dyn Progress,
+) -> Result<(SceneSource, Scene)> {
+    let scene = build_source_ref(&source, &settings.build, progress)?;
+    if settings.read.ray.dialect.is_some() {
+        return Ok((source, scene));
+    }
+    let Some(dark) = crate::integrator::darkness::darkness(&scene) else {
+        return Ok((source, scene));
+    };
+    if !dark.falloff {
+        return Ok((source, scene));
+    }
+    let mut options = settings.read.clone();
+    options.ray.dialect = Some(crate::format::ray_file::ast::Dialect::Hkust);
+    let dir = source
+        .path
+        .parent()
+        .map_or_else(|| Path::new(".").to_path_buf(), Path::to_path_buf);
+    let Ok(mut again) = format::read_text(&source.path, source.text.clone(), &dir, &options, &NoProgress) else {
+        return Ok((source, scene));
+    };
+    again.description.warnings.push((
+        "read with the HKUST COMP 4411 defaults (point lights without attenuation coefficients do not fall off): with the UT falloff 1/d² the image would be black; --dialect tokenizer or dictionary keeps that reading".into(),
+        0..0,
+    ));
+    match build_source_ref(&again, &settings.build, &NoProgress) {
+        Ok(hkust) if crate::integrator::darkness::darkness(&hkust).is_none() => Ok((again, hkust)),
+        _ => Ok((source, scene)),
+    }
+}
+
+fn build_source_ref(source: &SceneSource, settings: &BuildSettings, progress: &dyn Progress) -> Result<Scene> {
+    crate::scene::build::build_reporting(&source.description, settings, progress).map_err(|e| source.error(e))
 }
 
 /// Builds a scene read from a file (reporting a "build" phase); errors point into its text.

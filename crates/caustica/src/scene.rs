@@ -135,6 +135,8 @@ pub struct Intersection {
     /// Unit normal for shapes; barycentric (u, v, 0) for triangles.
     normal_or_bary: Vec3,
     uv: Vec2,
+    /// The leaf of a CSG solid hit (0 otherwise).
+    part: u32,
 }
 
 /// Everything shading needs at a surface point.
@@ -373,6 +375,7 @@ impl Scene {
             prim: self.shapes.len() as u32 + h.prim,
             normal_or_bary: Vec3::new(h.u, h.v, 0.0),
             uv: Vec2::ZERO,
+            part: 0,
         }
     }
 
@@ -385,6 +388,7 @@ impl Scene {
             prim,
             normal_or_bary: hit.normal,
             uv: hit.uv,
+            part: hit.part,
         })
     }
 
@@ -405,13 +409,35 @@ impl Scene {
         }
     }
 
+    /// The material id of a part of shape `i`: a CSG solid's leaf, or the shape's own.
+    #[inline]
+    fn part_material(&self, i: usize, part: u32) -> u32 {
+        match &self.shapes[i].kind {
+            crate::geometry::ShapeKind::Csg(csg) => csg.materials()[part as usize],
+            _ => self.shape_materials[i],
+        }
+    }
+
+    /// Every material id of shape `i` (a CSG solid's leaves', or its own).
+    fn shape_material_ids(&self, i: usize) -> &[u32] {
+        match &self.shapes[i].kind {
+            crate::geometry::ShapeKind::Csg(csg) => csg.materials(),
+            _ => std::slice::from_ref(&self.shape_materials[i]),
+        }
+    }
+
     /// The primitive's `transmissive` colour when it is the same all over it (no texture, no
     /// per-vertex materials): shadow rays then need no surface evaluation.
     #[inline]
     pub fn uniform_transmissive(&self, prim: u32) -> Option<Vec3> {
         let n_shapes = self.shapes.len() as u32;
         let material = if prim < n_shapes {
-            self.shape_materials[prim as usize]
+            let ids = self.shape_material_ids(prim as usize);
+            let first = self.materials[ids[0] as usize].transmissive;
+            if ids.iter().any(|&id| self.materials[id as usize].transmissive != first) {
+                return None;
+            }
+            ids[0]
         } else {
             let mesh = &self.meshes[self.triangle_refs[(prim - n_shapes) as usize].mesh as usize];
             if mesh.vertex_materials.is_some() {
@@ -445,6 +471,7 @@ impl Scene {
             prim: hit.prim,
             normal_or_bary: next.normal,
             uv: next.uv,
+            part: next.part,
         })
     }
 
@@ -459,7 +486,7 @@ impl Scene {
                 geometric_normal: hit.normal_or_bary,
                 shading_normal: hit.normal_or_bary,
                 uv: hit.uv,
-                material: MaterialRef::One(self.shape_materials[hit.prim as usize]),
+                material: MaterialRef::One(self.part_material(hit.prim as usize, hit.part)),
                 object: ObjectRef::Shape(hit.prim),
                 prim: hit.prim,
             };
@@ -591,7 +618,10 @@ impl Scene {
                     None => self.materials[mesh.material as usize].is_specular(),
                 }
             }
-            ObjectRef::Shape(_) => self.materials[self.object_material(object) as usize].is_specular(),
+            ObjectRef::Shape(i) => self
+                .shape_material_ids(i as usize)
+                .iter()
+                .any(|&id| self.materials[id as usize].is_specular()),
         }
     }
 }

@@ -80,6 +80,15 @@ fn text(scene: &str, s: &SceneSummary) -> String {
                 "  environment  colour {color:?}{}",
                 if *mapped { " × map" } else { "" }
             ),
+            LightSummary::Soft {
+                shape,
+                center,
+                area,
+                color,
+                attenuation,
+            } => format!(
+                "  area         {shape} at {center:?}  area {area:.4}  colour {color:?}  attenuation {attenuation:?}"
+            ),
         });
     }
     if !s.area_lights.is_empty() {

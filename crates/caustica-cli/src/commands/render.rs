@@ -99,6 +99,11 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         for warning in scene.warnings() {
             eprintln!("warning: {warning}");
         }
+        if !progressive {
+            if let Some(why) = caustica::integrator::darkness::diagnose(scene) {
+                eprintln!("warning: {why}");
+            }
+        }
         if progressive {
             for note in physical_notes(scene) {
                 eprintln!("note: {note}");

@@ -7,14 +7,19 @@ pub mod ast;
 mod cursor;
 mod detect;
 mod dictionary_dialect;
+mod fork_lights;
+mod fork_shapes;
 mod keywords;
 mod lexer;
 mod named_materials;
+mod skybox;
 mod suggest;
 mod tokenizer_dialect;
 mod transform_stack;
 mod trimesh;
 
+#[cfg(test)]
+mod fork_tests;
 #[cfg(test)]
 mod tests;
 
@@ -46,7 +51,9 @@ pub fn parse_reporting(
     let reach = cursor::Reach::new(progress);
     let result = match options.dialect {
         Some(ast::Dialect::Tokenizer) => tokenizer_dialect::parse(text, scene_dir, &reach),
-        Some(ast::Dialect::Dictionary) => dictionary_dialect::parse(text, scene_dir, &reach),
+        Some(dialect @ (ast::Dialect::Dictionary | ast::Dialect::Hkust)) => {
+            dictionary_dialect::parse(text, scene_dir, &reach, dialect)
+        }
         None => detect::parse_auto(text, scene_dir, &reach),
     };
     if result.is_ok() {

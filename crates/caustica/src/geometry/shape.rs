@@ -1,10 +1,10 @@
 //! An analytic shape placed in the world by a transform.
 
-use super::{box_shape, cone::Cone, sphere, square, LocalHit};
+use super::{box_shape, cone::Cone, csg::Csg, metaballs::Metaballs, sphere, square, torus::Torus, LocalHit};
 use crate::math::{Aabb, Mat3, Mat4, Ray, Vec2, Vec3};
 
 /// The closed set of analytic shapes.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum ShapeKind {
     /// Unit sphere.
     Sphere,
@@ -14,6 +14,12 @@ pub enum ShapeKind {
     Square,
     /// Cone or cylinder about +z.
     Cone(Cone),
+    /// Torus about +z.
+    Torus(Torus),
+    /// Metaballs (shared: a shape is cloned cheaply).
+    Metaballs(std::sync::Arc<Metaballs>),
+    /// A CSG solid whose leaves carry their own transforms (the shape's own is the identity).
+    Csg(std::sync::Arc<Csg>),
 }
 
 /// Options for how shapes are built from a scene file.
@@ -53,6 +59,8 @@ pub struct ShapeHit {
     pub normal: Vec3,
     /// Texture coordinates; zero unless the shape [`needs_uv`](Shape::needs_uv).
     pub uv: Vec2,
+    /// Which leaf of a CSG solid was hit (0 for other shapes).
+    pub part: u32,
 }
 
 impl Shape {
@@ -88,6 +96,9 @@ impl Shape {
                 let r = cone.bottom_radius.max(cone.top_radius);
                 (Vec3::new(0.0, 0.0, h), (r * r + h * h).sqrt())
             }
+            ShapeKind::Torus(torus) => (Vec3::ZERO, torus.major + torus.minor),
+            ShapeKind::Metaballs(m) => (m.bounds().center(), 0.5 * m.bounds().extent().length()),
+            ShapeKind::Csg(c) => (c.bounds().center(), 0.5 * c.bounds().extent().length()),
         };
         let stretch = max_stretch(Mat3::from_mat4(self.world_from_object));
         (self.world_from_object.transform_point3(center), radius * stretch)
@@ -97,6 +108,9 @@ impl Shape {
     /// certainly does not (an object-space distance bound divided by the largest stretch).
     #[inline]
     pub fn may_come_within(&self, point: Vec3, r: f32) -> bool {
+        if let ShapeKind::Csg(csg) = &self.kind {
+            return csg.may_come_within(point, r);
+        }
         let p = self.object_from_world.transform_point3(point);
         let d = match &self.kind {
             ShapeKind::Sphere => (p.length() - 1.0).abs(),
@@ -110,6 +124,9 @@ impl Shape {
             }
             ShapeKind::Square => Vec3::new((p.x.abs() - 0.5).max(0.0), (p.y.abs() - 0.5).max(0.0), p.z).length(),
             ShapeKind::Cone(cone) => cone.distance_lower_bound(p),
+            ShapeKind::Torus(torus) => torus.distance(p),
+            ShapeKind::Metaballs(m) => m.distance_lower_bound(p),
+            ShapeKind::Csg(_) => 0.0,
         };
         // Rounding in the transform: a relative margin on the object-space distance.
         d * (1.0 - 1e-4) - 1e-6 * (1.0 + p.abs().max_element()) <= r * self.object_stretch
@@ -118,6 +135,15 @@ impl Shape {
     /// Nearest hit in `(0, t_max)` along the world ray.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        if let ShapeKind::Csg(csg) = &self.kind {
+            let c = csg.intersect(ray, t_max)?;
+            return Some(ShapeHit {
+                t: c.t,
+                normal: c.normal,
+                uv: c.uv,
+                part: c.part,
+            });
+        }
         let local = Ray::new(
             self.object_from_world.transform_point3(ray.origin),
             self.object_from_world.transform_vector3(ray.dir),
@@ -127,6 +153,9 @@ impl Shape {
             ShapeKind::Box => box_shape::intersect(&local, t_max),
             ShapeKind::Square => square::intersect(&local, t_max),
             ShapeKind::Cone(cone) => cone.intersect(&local, t_max, self.needs_uv),
+            ShapeKind::Torus(torus) => torus.intersect(&local, t_max, self.needs_uv),
+            ShapeKind::Metaballs(m) => m.intersect(&local, t_max),
+            ShapeKind::Csg(_) => return None,
         }?;
         let normal = (self.normal_to_world * hit.normal).normalize_or_zero();
         if normal == Vec3::ZERO {
@@ -136,6 +165,7 @@ impl Shape {
             t: hit.t,
             normal,
             uv: if self.needs_uv { hit.uv } else { Vec2::ZERO },
+            part: 0,
         })
     }
 }
@@ -167,6 +197,9 @@ impl ShapeKind {
             ShapeKind::Box => box_shape::bounds(),
             ShapeKind::Square => square::bounds(),
             ShapeKind::Cone(cone) => cone.bounds(),
+            ShapeKind::Torus(torus) => torus.bounds(),
+            ShapeKind::Metaballs(m) => m.bounds(),
+            ShapeKind::Csg(c) => c.bounds(),
         }
     }
 }
@@ -315,6 +348,7 @@ mod tests {
             ShapeKind::cylinder(true),
             ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
             ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
+            ShapeKind::Torus(Torus { major: 1.0, minor: 0.3 }),
         ];
         let transforms = [
             Mat4::IDENTITY,
@@ -329,7 +363,7 @@ mod tests {
         let mut pruned = 0;
         for kind in kinds {
             for m in transforms {
-                let s = Shape::new(kind, m).unwrap();
+                let s = Shape::new(kind.clone(), m).unwrap();
                 let (lo, hi) = (s.bounds.min, s.bounds.max);
                 let ext = (hi - lo).max_element();
                 for _ in 0..200 {
@@ -361,6 +395,7 @@ mod tests {
             ShapeKind::cylinder(true),
             ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
             ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
+            ShapeKind::Torus(Torus { major: 1.0, minor: 0.3 }),
         ];
         let transforms = [
             Mat4::from_scale(Vec3::new(20.0, 20.0, 0.5)),
@@ -374,7 +409,7 @@ mod tests {
         let mut rng = crate::sampling::Rng::new(3, 0);
         for kind in kinds {
             for m in transforms {
-                let s = Shape::new(kind, m).unwrap();
+                let s = Shape::new(kind.clone(), m).unwrap();
                 let (center, radius) = s.bounding_sphere();
                 let mut hits = 0;
                 // Rays start in or near the world bounds, where the object-space solve is precise.

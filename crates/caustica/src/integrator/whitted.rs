@@ -139,7 +139,22 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
         if cos <= 0.0 {
             continue;
         }
-        let shadow = transmittance(scene, hit.point, hit.geometric_normal, ls.wi, ls.distance);
+        let shadow = match light.shadow_targets(hit.point) {
+            None => transmittance(scene, hit.point, hit.geometric_normal, ls.wi, ls.distance),
+            // A light with a size: the mean over shadow rays to points spread over it.
+            Some(targets) => {
+                let (mut sum, mut n) = (Vec3::ZERO, 0.0f32);
+                for q in targets {
+                    let to = q - hit.point;
+                    let d = to.length();
+                    if d > 0.0 {
+                        sum += transmittance(scene, hit.point, hit.geometric_normal, to / d, d);
+                    }
+                    n += 1.0;
+                }
+                sum / n.max(1.0)
+            }
+        };
         if shadow == Vec3::ZERO {
             continue;
         }

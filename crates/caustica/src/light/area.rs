@@ -111,6 +111,7 @@ impl AreaLight {
                 ShapeKind::Sphere | ShapeKind::Box => true,
                 ShapeKind::Cone(cone) => cone.capped,
                 ShapeKind::Square => false,
+                ShapeKind::Torus(_) | ShapeKind::Metaballs(_) | ShapeKind::Csg(_) => true,
             };
             let absorbs = [
                 material.diffuse,
@@ -362,6 +363,8 @@ fn object_area(kind: &ShapeKind) -> f32 {
             let (side, bottom, top) = cone_areas(cone);
             side + bottom + top
         }
+        // Not sampled: an emissive torus glows without lighting (the builder warns).
+        ShapeKind::Torus(_) | ShapeKind::Metaballs(_) | ShapeKind::Csg(_) => 0.0,
     }
 }
 
@@ -422,6 +425,7 @@ fn sample_object(kind: &ShapeKind, u_pick: f32, u: Vec2) -> Option<(Vec3, Vec3)>
             Some((p, n))
         }
         ShapeKind::Square => Some((Vec3::new(u.x - 0.5, u.y - 0.5, 0.0), Vec3::Z)),
+        ShapeKind::Torus(_) | ShapeKind::Metaballs(_) | ShapeKind::Csg(_) => None,
         ShapeKind::Cone(cone) => {
             let (side, bottom, top) = cone_areas(cone);
             let total = side + bottom + top;

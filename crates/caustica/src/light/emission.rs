@@ -83,6 +83,9 @@ enum Kind {
     /// The sky: a direction by the environment's own sampling, then a point on a disc across
     /// it, the scene's or the targets' as seen along that direction.
     Environment { scene: Target, discs: Vec<Target> },
+    /// A light with a size: a point uniform on it, then a direction cosine-weighted about its
+    /// normal, or drawn from the cones from that point to the targets when aimed.
+    Soft { targets: Option<Vec<Target>> },
 }
 
 /// One light's photon source.
@@ -209,6 +212,14 @@ impl Emitter {
                 }),
             ),
             Light::Area(ref area) => Emitter::finish(Kind::Area, area.radiance, vec![1.0], area.power()),
+            Light::Soft(ref soft) => Emitter::finish(
+                Kind::Soft {
+                    targets: targets.map(<[Target]>::to_vec),
+                },
+                soft.color,
+                vec![1.0],
+                soft.power(),
+            ),
             Light::Directional { direction, color } => directional(direction, color, None),
             Light::Sun {
                 direction,
@@ -275,6 +286,9 @@ impl Emitter {
             let (u, u_dir) = (rng.uniform2(), rng.uniform2());
             return emit_from_area(area, scene, (u_pick, u, u_dir), wl);
         }
+        if let (Kind::Soft { targets }, Light::Soft(soft)) = (&self.kind, light) {
+            return emit_from_soft(soft, targets.as_deref(), wl, rng);
+        }
         let lobe = self.pick(rng.uniform());
         let u = rng.uniform2();
         let (ray, flux) = match &self.kind {
@@ -333,7 +347,7 @@ impl Emitter {
                     (Ray::new(origin, dir), radiance / (sky.pdf * pdf_area))
                 })?
             }
-            Kind::Area => return None,
+            Kind::Area | Kind::Soft { .. } => return None,
         };
         Some(EmittedPhoton { ray, flux })
     }
@@ -501,6 +515,57 @@ fn emit_from_area(
     Some(EmittedPhoton {
         ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
         flux: le * (faces * PI / sample.pdf_area),
+    })
+}
+
+/// A photon from a light with a size: a point uniform on it, then a direction cosine-weighted
+/// about its normal, or (aimed) from the mixture of the cones from that point to the targets;
+/// its flux is L·cos·A / pdf(direction).
+fn emit_from_soft(
+    light: &super::SoftLight,
+    targets: Option<&[Target]>,
+    wl: &Wavelengths,
+    rng: &mut Rng,
+) -> Option<EmittedPhoton> {
+    let s = light.sample_point(rng.uniform2());
+    let u = rng.uniform2();
+    let (dir, pdf) = match targets {
+        None => {
+            let dir = Frame::from_normal(s.normal).to_world(sample_cosine_hemisphere(u));
+            (dir, dir.dot(s.normal).max(0.0) / PI)
+        }
+        Some(targets) => {
+            let cones: Vec<ConeLobe> = targets.iter().map(|t| cone_towards(s.point, t)).collect();
+            let weights: Vec<f32> = cones.iter().map(|c| 1.0 - c.cos_max).collect();
+            let total: f32 = weights.iter().sum();
+            if !(total > 0.0) {
+                return None;
+            }
+            let mut pick = rng.uniform() * total;
+            let lobe = weights
+                .iter()
+                .position(|w| {
+                    pick -= w;
+                    pick < 0.0
+                })
+                .unwrap_or(cones.len() - 1);
+            let dir = sample_uniform_cone(u, cones[lobe].axis, cones[lobe].cos_max);
+            let pdf: f32 = cones
+                .iter()
+                .zip(&weights)
+                .filter(|(c, _)| c.cos_max <= -1.0 || dir.dot(c.axis) >= c.cos_max)
+                .map(|(c, w)| w / total / (2.0 * PI * (1.0 - c.cos_max)))
+                .sum();
+            (dir, pdf)
+        }
+    };
+    let cos = dir.dot(s.normal);
+    if !(cos > 0.0 && pdf > 0.0) {
+        return None;
+    }
+    Some(EmittedPhoton {
+        ray: Ray::new(s.point, dir),
+        flux: wl.unbounded(s.radiance) * (cos * light.area() / pdf),
     })
 }
 

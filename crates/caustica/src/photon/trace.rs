@@ -446,6 +446,7 @@ pub fn falloff_scale(light: &Light, path_length: f32) -> f32 {
         Light::Point { attenuation, .. } | Light::Spot { attenuation, .. } => {
             path_length * path_length * distance_attenuation(*attenuation, path_length)
         }
+        Light::Soft(soft) => path_length * path_length * distance_attenuation(soft.attenuation, path_length),
         _ => 1.0,
     }
 }

@@ -3,14 +3,16 @@
 
 use super::{Mesh, Scene, SceneParts, TriangleRef};
 use crate::camera::Camera;
-use crate::description::{LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, TrimeshDesc};
+use crate::description::{
+    LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc,
+};
 use crate::error::Span;
 use crate::error::{Error, ParseError};
 use crate::geometry::cone::Cone;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Shape, ShapeKind, ShapeSettings};
 use crate::image_io;
-use crate::light::{Environment, Light};
+use crate::light::{Environment, Light, SoftLight};
 use crate::material::{Channel, Material};
 use crate::math::{Aabb, Mat3, Vec3};
 use crate::progress::{NoProgress, Progress};
@@ -178,6 +180,52 @@ fn convert_light(light: &LightDesc, warnings: &mut Vec<String>) -> Result<Option
             };
             Some(Light::Environment(Environment::new(*color, texture, *rotation)))
         }
+        LightDesc::Soft {
+            shape,
+            color,
+            attenuation,
+            span,
+        } => match *shape {
+            // A ball of radius 0 is a point light.
+            SoftShapeDesc::Sphere { center, radius } if radius <= 0.0 => Some(Light::Point {
+                position: center,
+                color: *color,
+                attenuation: *attenuation,
+            }),
+            SoftShapeDesc::Sphere { center, radius } => Some(Light::Soft(SoftLight {
+                shape: crate::light::soft::SoftShape::Sphere { center, radius },
+                color: *color,
+                attenuation: *attenuation,
+            })),
+            SoftShapeDesc::Parallelogram { corner, u, v } => Some(Light::Soft(
+                SoftLight::parallelogram(corner, u, v, *color, *attenuation)
+                    .ok_or_else(|| ParseError::new("the area light's edges `u` and `v` span no area", span.clone()))?,
+            )),
+        },
+        LightDesc::Skybox {
+            faces,
+            layout,
+            color,
+            span,
+        } => {
+            let mut images = Vec::with_capacity(6);
+            for path in faces {
+                images.push(image_io::load_texture(path).map_err(|e| {
+                    let reason = match e {
+                        Error::Image { message, .. } => message,
+                        other => other.to_string(),
+                    };
+                    ParseError::new(
+                        format!("cannot read the skybox image `{}`: {reason}", path.display()),
+                        span.clone(),
+                    )
+                    .with_help("skybox images are resolved against the scene file's folder")
+                })?);
+            }
+            let faces: [crate::texture::Texture; 6] = images.try_into().expect("six faces");
+            let map = crate::light::cube_map::to_lat_long(&faces, *layout);
+            Some(Light::Environment(Environment::new(*color, Some(map), Mat3::IDENTITY)))
+        }
     })
 }
 
@@ -205,39 +253,102 @@ impl Builder {
         settings: &ShapeSettings,
         warnings: &mut Vec<String>,
     ) -> Result<(), ParseError> {
+        if let ShapeDesc::Csg(csg) = &object.shape {
+            let root = self.csg_node(csg, object, settings)?;
+            let leaves = crate::geometry::csg::Csg::new(root)
+                .ok_or_else(|| ParseError::new("CSG operands must be closed solids", object.span.clone()))?;
+            let first = leaves.materials()[0];
+            if leaves
+                .materials()
+                .iter()
+                .any(|&id| self.materials[id as usize].is_emissive())
+            {
+                warnings.push(
+                    "an emissive CSG solid glows but lights nothing in the physical model (only spheres, boxes, squares, cylinders, cones and meshes are sampled as area lights)".into(),
+                );
+            }
+            let kind = ShapeKind::Csg(std::sync::Arc::new(leaves));
+            let shape = Shape::new(kind, glam::Mat4::IDENTITY).ok_or_else(|| singular(&object.span))?;
+            self.shapes.push(shape);
+            // Its own material id is the first leaf's (what a whole-object query reads).
+            self.shape_materials.push(first);
+            return Ok(());
+        }
         let material = self.material(&object.material)?;
         let m = object.world_from_object;
         let kind = match &object.shape {
-            ShapeDesc::Sphere => ShapeKind::Sphere,
-            ShapeDesc::Box => ShapeKind::Box,
-            ShapeDesc::Square => ShapeKind::Square,
-            ShapeDesc::Cylinder { capped } => ShapeKind::cylinder(*capped),
-            ShapeDesc::Cone {
-                height,
-                bottom_radius,
-                top_radius,
-                capped,
-            } => {
-                if !(*height > 0.0 && height.is_finite()) {
-                    return Err(ParseError::new(
-                        format!("a cone needs a positive height, not {height}"),
-                        object.span.clone(),
-                    ));
-                }
-                ShapeKind::Cone(Cone::new(
-                    *height,
-                    *bottom_radius,
-                    *top_radius,
-                    *capped,
-                    settings.cone_quirks,
-                ))
-            }
             ShapeDesc::Trimesh(mesh) => return self.add_mesh(object, mesh, material, warnings),
+            _ => shape_kind(object, settings)?,
         };
+        if !matches!(
+            kind,
+            ShapeKind::Sphere | ShapeKind::Box | ShapeKind::Square | ShapeKind::Cone(_)
+        ) && material_is_emissive(&object.material)
+        {
+            warnings.push(format!(
+                "an emissive {} glows but lights nothing in the physical model (only spheres, boxes, squares, cylinders, cones and meshes are sampled as area lights)",
+                crate::scene::summary::shape_name(&kind)
+            ));
+        }
         let shape = Shape::new(kind, m).ok_or_else(|| singular(&object.span))?;
         self.shapes.push(shape);
         self.shape_materials.push(material);
         Ok(())
+    }
+
+    /// The CSG tree of `desc` (operands folded from the left), each leaf placed and given its
+    /// material.
+    fn csg_node(
+        &mut self,
+        desc: &crate::description::CsgDesc,
+        object: &ObjectDesc,
+        settings: &ShapeSettings,
+    ) -> Result<crate::geometry::csg::CsgNode, ParseError> {
+        use crate::geometry::csg::{is_closed, CsgNode, CsgOp};
+        let op = match desc.op {
+            crate::description::CsgOpDesc::Union => CsgOp::Union,
+            crate::description::CsgOpDesc::Intersection => CsgOp::Intersection,
+            crate::description::CsgOpDesc::Difference => CsgOp::Difference,
+        };
+        let mut nodes = Vec::with_capacity(desc.operands.len());
+        for operand in &desc.operands {
+            let node = match &operand.shape {
+                ShapeDesc::Csg(inner) => self.csg_node(inner, operand, settings)?,
+                ShapeDesc::Trimesh(_) => {
+                    return Err(ParseError::new(
+                        "CSG operands must be closed shapes (sphere, box, capped cylinder or cone, torus, metaballs): a mesh is not supported",
+                        operand.span.clone(),
+                    ))
+                }
+                _ => {
+                    let kind = shape_kind(operand, settings)?;
+                    if !is_closed(&kind) {
+                        return Err(ParseError::new(
+                            format!(
+                                "CSG operands must be closed solids, and an open {} is not",
+                                crate::scene::summary::shape_name(&kind)
+                            ),
+                            operand.span.clone(),
+                        )
+                        .with_help("use a box for a slab, and capped cylinders and cones"));
+                    }
+                    let material = self.material(&operand.material)?;
+                    let mut shape = Shape::new(kind, operand.world_from_object).ok_or_else(|| singular(&operand.span))?;
+                    shape.needs_uv = self.materials[material as usize].is_textured();
+                    CsgNode::Leaf { shape, material }
+                }
+            };
+            nodes.push(node);
+        }
+        let mut nodes = nodes.into_iter();
+        let first = nodes
+            .next()
+            .ok_or_else(|| ParseError::new("a CSG operation needs operands", object.span.clone()))?;
+        Ok(nodes.fold(first, |a, b| CsgNode::Op {
+            op,
+            a: Box::new(a),
+            b: Box::new(b),
+        }))
     }
 
     fn add_mesh(
@@ -366,6 +477,67 @@ impl Builder {
             }
         }
     }
+}
+
+/// The analytic shape of an object that is neither a mesh nor a CSG solid.
+fn shape_kind(object: &ObjectDesc, settings: &ShapeSettings) -> Result<ShapeKind, ParseError> {
+    Ok(match &object.shape {
+        ShapeDesc::Sphere => ShapeKind::Sphere,
+        ShapeDesc::Box => ShapeKind::Box,
+        ShapeDesc::Square => ShapeKind::Square,
+        ShapeDesc::Cylinder { capped } => ShapeKind::cylinder(*capped),
+        ShapeDesc::Cone {
+            height,
+            bottom_radius,
+            top_radius,
+            capped,
+        } => {
+            if !(*height > 0.0 && height.is_finite()) {
+                return Err(ParseError::new(
+                    format!("a cone needs a positive height, not {height}"),
+                    object.span.clone(),
+                ));
+            }
+            ShapeKind::Cone(Cone::new(
+                *height,
+                *bottom_radius,
+                *top_radius,
+                *capped,
+                settings.cone_quirks,
+            ))
+        }
+        ShapeDesc::Torus {
+            major_radius,
+            minor_radius,
+        } => {
+            if !(*major_radius > 0.0 && *minor_radius > 0.0 && major_radius.is_finite() && minor_radius.is_finite()) {
+                return Err(ParseError::new(
+                    format!("a torus needs positive radii, not {major_radius} and {minor_radius}"),
+                    object.span.clone(),
+                ));
+            }
+            ShapeKind::Torus(crate::geometry::torus::Torus {
+                major: *major_radius,
+                minor: *minor_radius,
+            })
+        }
+        ShapeDesc::Metaballs(desc) => {
+            use crate::geometry::metaballs::{Ball, BlobModel, Metaballs};
+            let balls = desc
+                .balls
+                .iter()
+                .map(|&(center, radius)| Ball { center, radius })
+                .collect();
+            let model = match desc.model {
+                crate::description::BlobModelDesc::Field { threshold } => BlobModel::Field { threshold },
+                crate::description::BlobModelDesc::SmoothUnion { blend } => BlobModel::SmoothUnion { k: blend },
+            };
+            let metaballs = Metaballs::new(balls, model)
+                .ok_or_else(|| ParseError::new("metaballs need balls of positive radius", object.span.clone()))?;
+            ShapeKind::Metaballs(std::sync::Arc::new(metaballs))
+        }
+        ShapeDesc::Trimesh(_) | ShapeDesc::Csg(_) => unreachable!("meshes and CSG solids are built apart"),
+    })
 }
 
 fn singular(span: &Span) -> ParseError {

@@ -105,6 +105,19 @@ pub enum LightSummary {
         /// Whether an image map modulates it.
         mapped: bool,
     },
+    /// A light with a size (`area_light`).
+    Soft {
+        /// "ball" or "parallelogram".
+        shape: &'static str,
+        /// Centre.
+        center: [f32; 3],
+        /// Emitting area.
+        area: f32,
+        /// A ball's intensity or a parallelogram's radiance.
+        color: [f32; 3],
+        /// The course's (a, b, c) falloff.
+        attenuation: [f32; 3],
+    },
 }
 
 /// An emissive object.
@@ -208,12 +221,20 @@ impl BoundsSummary {
     }
 }
 
+/// A shape kind's name in words ("sphere", "torus", …).
+pub fn shape_name(kind: &ShapeKind) -> String {
+    describe(kind).0
+}
+
 /// A shape's kind and its parameters in words.
 fn describe(kind: &ShapeKind) -> (String, String) {
     match kind {
         ShapeKind::Sphere => ("sphere".into(), String::new()),
         ShapeKind::Box => ("box".into(), String::new()),
         ShapeKind::Square => ("square".into(), String::new()),
+        ShapeKind::Torus(t) => ("torus".into(), format!("radii {} and {}", t.major, t.minor)),
+        ShapeKind::Metaballs(m) => ("metaballs".into(), format!("{} balls", m.balls().len())),
+        ShapeKind::Csg(c) => ("csg".into(), format!("{} solids", c.materials().len())),
         ShapeKind::Cone(c) => {
             let caps = if c.capped { "capped" } else { "open" };
             if c.bottom_radius == c.top_radius && c.height == 1.0 && c.bottom_radius == 1.0 {
@@ -282,6 +303,16 @@ impl Scene {
                 Light::Environment(env) => Some(LightSummary::Environment {
                     color: env.color.to_array(),
                     mapped: env.has_map(),
+                }),
+                Light::Soft(soft) => Some(LightSummary::Soft {
+                    shape: match soft.shape {
+                        crate::light::soft::SoftShape::Sphere { .. } => "ball",
+                        crate::light::soft::SoftShape::Parallelogram { .. } => "parallelogram",
+                    },
+                    center: soft.center().to_array(),
+                    area: soft.area(),
+                    color: soft.color.to_array(),
+                    attenuation: soft.attenuation,
                 }),
                 Light::Area(_) => None,
             })

@@ -18,6 +18,18 @@ pub enum Dialect {
     Tokenizer,
     /// The older object/dictionary reader (UW ≤ 2008, UT ≤ 2010, HKUST), §10.
     Dictionary,
+    /// The dictionary reader as the HKUST COMP 4411 skeleton and its forks use it: a point light
+    /// without attenuation coefficients does not fall off (the skeleton reads only its position
+    /// and colour), and `texture = "file"` in a material is its diffuse map. Files with
+    /// dialect-O markers are read this way unless a dialect is forced.
+    Hkust,
+}
+
+impl Dialect {
+    /// Whether the file is read by the object/dictionary reader (dialect O).
+    pub fn is_dictionary(self) -> bool {
+        matches!(self, Dialect::Dictionary | Dialect::Hkust)
+    }
 }
 
 /// Everything a `.ray` file describes.

@@ -12,7 +12,8 @@ use std::path::Path;
 /// Counts of constructs that only one dialect accepts.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub(crate) struct Markers {
-    /// Dialect-O-only constructs (top-level `material {`, `quaternion`, `E` exponents, …).
+    /// Dialect-O-only constructs (top-level `material {`, `quaternion`, `E` exponents, …) and
+    /// spellings of the HKUST forks.
     pub dictionary: usize,
     /// Dialect-T-only constructs (`.5` numbers, groups, bare `gennormals;`, top-level `material =`).
     pub tokenizer: usize,
@@ -39,7 +40,14 @@ pub(crate) fn markers(text: &str) -> Markers {
                 }
             }
             Tok::Word => match (source, next) {
-                ("quaternion" | "focaldistance", _) => found.dictionary += 1,
+                // Spellings only HKUST forks use (their spot and Warn lights, metaballs).
+                ("quaternion" | "focaldistance" | "central_direction" | "warn_light" | "metaballs", _) => {
+                    found.dictionary += 1
+                }
+                ("blend", Some(Tok::Equals)) => found.dictionary += 1,
+                ("texture", Some(Tok::Equals)) if tokens.get(i + 2).map(|t| t.tok) == Some(Tok::Quoted) => {
+                    found.dictionary += 1
+                }
                 ("quaternian", _) => found.tokenizer += 1,
                 ("gennormals", Some(Tok::Equals)) => found.dictionary += 1,
                 ("gennormals", Some(Tok::Semicolon)) => found.tokenizer += 1,
@@ -80,7 +88,7 @@ pub(crate) fn parse_auto(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Res
     let found = markers(text);
     let o_first = found.dictionary > 0 && found.tokenizer == 0;
     if o_first {
-        let o_error = match dictionary_dialect::parse(text, scene_dir, reach) {
+        let o_error = match dictionary_dialect::parse(text, scene_dir, reach, Dialect::Hkust) {
             Ok(scene) => return Ok(scene),
             Err(error) => error,
         };
@@ -94,7 +102,7 @@ pub(crate) fn parse_auto(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Res
         Ok(scene) => return Ok(scene),
         Err(error) => error,
     };
-    match dictionary_dialect::parse(text, scene_dir, reach) {
+    match dictionary_dialect::parse(text, scene_dir, reach, Dialect::Hkust) {
         Ok(scene) => {
             // A key close to any keyword of the format is a misspelling in a T file, not an
             // old modeller's extra key: report it rather than reading the file as dialect O.

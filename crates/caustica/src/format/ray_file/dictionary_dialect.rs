@@ -8,9 +8,12 @@ use super::ast::{
     CameraBasis, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, RayCamera, RayScene, ShapeDesc, Span,
 };
 use super::cursor::{Cursor, Reach};
+use super::fork_lights::{self, LightFields};
+use super::fork_shapes::{self, MetaballFields};
 use super::keywords::{extension_error, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok};
 use super::named_materials::NamedMaterials;
+use super::skybox::{SkyboxFields, SKYBOX_FIELDS};
 use super::suggest;
 use super::tokenizer_dialect::field_mut;
 use super::transform_stack;
@@ -19,12 +22,15 @@ use crate::ParseError;
 use glam::{Mat4, Vec3, Vec4};
 use std::path::Path;
 
+/// How deep CSG operations may nest (each level is a recursion of the reader).
+const MAX_CSG_DEPTH: usize = 64;
+
 /// Prefix of the warning for an ignored dictionary key (detection looks for it).
 pub(crate) const IGNORED_KEY: &str = "ignored unknown key";
 
-/// Parses a whole dialect-O file.
-pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<RayScene, ParseError> {
-    let tokens = lexer::lex(text, Dialect::Dictionary)?;
+/// Parses a whole dialect-O file, with the defaults of `dialect` (`Dictionary` or `Hkust`).
+pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>, dialect: Dialect) -> Result<RayScene, ParseError> {
+    let tokens = lexer::lex(text, dialect)?;
     let mut cur = Cursor::new(text, tokens, reach);
     if !cur.at_word("SBT-raytracer") {
         return Err(cur
@@ -44,8 +50,9 @@ pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<R
         tree: Vec::new(),
         scene_dir,
         named: NamedMaterials::default(),
+        hkust: dialect == Dialect::Hkust,
         scene: RayScene {
-            dialect: Dialect::Dictionary,
+            dialect,
             camera: None,
             lights: Vec::new(),
             ambient: Vec3::ZERO,
@@ -224,6 +231,8 @@ struct Reader<'a> {
     tree: Vec<Node>,
     scene_dir: &'a Path,
     named: NamedMaterials,
+    /// HKUST defaults: point lights without coefficients keep f = 1; `texture` is a diffuse map.
+    hkust: bool,
     scene: RayScene,
 }
 
@@ -264,6 +273,10 @@ impl<'a> Reader<'a> {
             "camera" => self.camera(child, head),
             "point_light" => self.point_light(child, head),
             "directional_light" => self.directional_light(child, head),
+            "spot_light" => self.fork_light(child, head, fork_lights::SPOT_FIELDS),
+            "area_light" => self.fork_light(child, head, fork_lights::AREA_FIELDS),
+            "skybox" => self.skybox(child, head),
+            "csg" => self.csg_block(child, head),
             "ambient_light" => {
                 for (key, value) in self.entries(child, "ambient_light")? {
                     match self.word(&key) {
@@ -383,7 +396,9 @@ impl<'a> Reader<'a> {
 
     fn point_light(&mut self, id: usize, head: Span) -> Result<(), ParseError> {
         let (mut position, mut color) = (None, None);
-        let mut attenuation = [0.0, 0.0, 1.0];
+        // The HKUST skeleton reads no coefficients and its lights do not fall off; its forks
+        // that read them use them only when one is positive.
+        let mut attenuation = if self.hkust { [0.0; 3] } else { [0.0, 0.0, 1.0] };
         for (key, value) in self.entries(id, "point_light")? {
             match self.word(&key) {
                 "position" => position = Some(self.vec3(value, "for `position`")?),
@@ -399,6 +414,9 @@ impl<'a> Reader<'a> {
             let missing = if position.is_none() { "position" } else { "color" };
             return Err(ParseError::new(format!("`point_light` needs a `{missing}`"), span));
         };
+        if attenuation.iter().all(|&c| c <= 0.0) {
+            attenuation = [1.0, 0.0, 0.0];
+        }
         self.scene.lights.push(LightDesc::Point {
             position,
             color,
@@ -428,6 +446,66 @@ impl<'a> Reader<'a> {
         self.scene
             .lights
             .push(LightDesc::Directional { direction, color, span });
+        Ok(())
+    }
+
+    /// `spot_light { … }` or `area_light { … }` in any course fork's spelling; other keys are
+    /// ignored with a warning, as the dictionary reader does.
+    fn fork_light(&mut self, id: usize, head: Span, allowed: &'static [&'static str]) -> Result<(), ParseError> {
+        let owner = self.word(&head);
+        let mut fields = LightFields::default();
+        for (key, value) in self.entries(id, owner)? {
+            let word = self.word(&key);
+            if !allowed.contains(&word) {
+                self.ignore_key(&key, owner)?;
+                continue;
+            }
+            let span = key.start..self.tree[value].span.end;
+            if fork_lights::is_vector_field(word) {
+                let v = self.vec3(value, &format!("for `{word}`"))?;
+                fields.vector(allowed, word, v, span)?;
+            } else {
+                let v = self.number(value, &format!("for `{word}`"))?;
+                fields.number(allowed, word, v, span)?;
+            }
+        }
+        let span = head.start..self.tree[id].span.end;
+        let falloff = if self.hkust { [1.0, 0.0, 0.0] } else { [0.0, 0.0, 1.0] };
+        let light = if owner == "spot_light" {
+            let (light, warnings) = fields.spot(span, falloff, self.hkust)?;
+            self.scene.warnings.extend(warnings);
+            light
+        } else {
+            fields.area(span, falloff, self.hkust)?
+        };
+        self.scene.lights.push(light);
+        Ok(())
+    }
+
+    /// `skybox { front = "file"; … }` (skybox.rs); other keys are ignored with a warning.
+    fn skybox(&mut self, id: usize, head: Span) -> Result<(), ParseError> {
+        let mut fields = SkyboxFields::default();
+        for (key, value) in self.entries(id, "skybox")? {
+            let word = self.word(&key);
+            if !SKYBOX_FIELDS.contains(&word) {
+                self.ignore_key(&key, "skybox")?;
+                continue;
+            }
+            let span = self.tree[value].span.clone();
+            if matches!(word, "color" | "colour") {
+                let color = self.vec3(value, "for `color`")?;
+                fields.color(color, span)?;
+            } else {
+                let Kind::Str = self.tree[value].kind else {
+                    return Err(self.expected(&format!("the image file, in quotes, for `{word}`"), value));
+                };
+                let file = &self.text[span.start + 1..span.end - 1];
+                fields.face(word, file, self.scene_dir, span)?;
+            }
+        }
+        self.scene.warnings.append(&mut fields.warnings);
+        let light = fields.finish(head.start..self.tree[id].span.end)?;
+        self.scene.lights.push(light);
         Ok(())
     }
 
@@ -479,6 +557,11 @@ impl<'a> Reader<'a> {
                     has_reflective |= word == "reflective";
                     *field_mut(&mut material, word) = param;
                 }
+                // An HKUST fork's image texture: the diffuse colour read from a file.
+                "texture" if self.hkust => match self.tree[value].kind {
+                    Kind::Str => material.diffuse = self.texture(value, self.tree[value].span.clone()),
+                    _ => return Err(self.expected("a file name in quotes for `texture`", value)),
+                },
                 _ => self.ignore_key(&key, "material")?,
             }
         }
@@ -524,7 +607,11 @@ impl<'a> Reader<'a> {
 
     /// A transform chain ending in a primitive, walked iteratively.
     fn object(&mut self, id: usize) -> Result<(), ParseError> {
-        let mut world = Mat4::IDENTITY;
+        self.object_at(id, Mat4::IDENTITY, 0)
+    }
+
+    /// [`Reader::object`] under the transform `world`; `depth` counts enclosing CSG operations.
+    fn object_at(&mut self, id: usize, mut world: Mat4, depth: usize) -> Result<(), ParseError> {
         let mut node = id;
         loop {
             let Kind::Named(child) = self.tree[node].kind else {
@@ -564,8 +651,21 @@ impl<'a> Reader<'a> {
                     }
                     (transform_stack::from_rows(rows, &span)?, items[4])
                 }
-                "sphere" | "box" | "square" | "cylinder" | "cone" | "trimesh" | "polymesh" => {
+                "sphere" | "box" | "square" | "cylinder" | "cone" | "torus" | "metaballs" | "metaball" | "trimesh"
+                | "polymesh" => {
                     return self.primitive(word, head, child, world);
+                }
+                // `subtraction(a, b)`, `intersection(a, b)`, `union(a, b, …)` (HKUST 2019).
+                "union" | "intersection" | "difference" | "subtraction" => {
+                    let Kind::Tuple(items) = &self.tree[child].kind else {
+                        return Err(self.expected(&format!("`{word}(a, b, …)` with two or more objects"), child));
+                    };
+                    let items = items.clone();
+                    let operands = self.csg_operands(&items, world, depth, &span)?;
+                    let op = fork_shapes::csg_op(word).expect("a CSG keyword");
+                    let object = fork_shapes::csg_object(op, operands, span)?;
+                    self.scene.objects.push(object);
+                    return Ok(());
                 }
                 _ => {
                     if let Some(error) = extension_error(word, &head) {
@@ -580,6 +680,111 @@ impl<'a> Reader<'a> {
             };
             world = transform_stack::compose(world, local, &span)?;
             node = next;
+        }
+    }
+
+    /// The objects each of `items` makes under `world`, for a CSG operation at `span`.
+    fn csg_operands(
+        &mut self,
+        items: &[usize],
+        world: Mat4,
+        depth: usize,
+        span: &Span,
+    ) -> Result<Vec<Vec<ObjectDesc>>, ParseError> {
+        if depth >= MAX_CSG_DEPTH {
+            return Err(ParseError::new(
+                format!("CSG operations are nested more than {MAX_CSG_DEPTH} deep"),
+                span.clone(),
+            ));
+        }
+        let mut operands = Vec::with_capacity(items.len());
+        for &item in items {
+            let start = self.scene.objects.len();
+            self.object_at(item, world, depth + 1)?;
+            operands.push(self.scene.objects.drain(start..).collect());
+        }
+        Ok(operands)
+    }
+
+    /// `csg { primitives = ("a", "b"); a = object; b = object; operation = ("a", "sub", "b"); }`
+    /// (COMP4411-Team/Trace): named operands and an operation on them, `sub`, `and` or `or`,
+    /// whose operands may themselves be operations.
+    fn csg_block(&mut self, id: usize, head: Span) -> Result<(), ParseError> {
+        let span = head.start..self.tree[id].span.end;
+        let entries = self.entries(id, "csg")?;
+        let mut named: Vec<(&str, usize)> = Vec::new();
+        let mut operation = None;
+        for (key, value) in &entries {
+            match self.word(key) {
+                "primitives" => {}
+                "operation" => operation = Some(*value),
+                name => named.push((name, *value)),
+            }
+        }
+        let operation = operation.ok_or_else(|| {
+            ParseError::new(
+                "`csg` needs an `operation` such as `(\"a\", \"sub\", \"b\")`",
+                span.clone(),
+            )
+        })?;
+        let object = self.csg_operation(operation, &named, 0)?;
+        self.scene.objects.push(object);
+        Ok(())
+    }
+
+    /// One `(operand, op, operand)` of a `csg` block, or an operand's name.
+    fn csg_operation(&mut self, id: usize, named: &[(&str, usize)], depth: usize) -> Result<ObjectDesc, ParseError> {
+        let span = self.tree[id].span.clone();
+        if depth >= MAX_CSG_DEPTH {
+            return Err(ParseError::new(
+                format!("CSG operations are nested more than {MAX_CSG_DEPTH} deep"),
+                span,
+            ));
+        }
+        match &self.tree[id].kind {
+            Kind::Str | Kind::Word => {
+                let name = match self.tree[id].kind {
+                    Kind::Str => &self.text[span.start + 1..span.end - 1],
+                    _ => self.word(&span),
+                };
+                let Some(&(_, object)) = named.iter().find(|(n, _)| *n == name) else {
+                    return Err(ParseError::new(format!("`csg` has no operand named `{name}`"), span));
+                };
+                let start = self.scene.objects.len();
+                self.object_at(object, Mat4::IDENTITY, depth + 1)?;
+                let mut objects: Vec<ObjectDesc> = self.scene.objects.drain(start..).collect();
+                match objects.len() {
+                    1 => Ok(objects.pop().expect("one")),
+                    _ => fork_shapes::csg_object(
+                        crate::description::CsgOpDesc::Union,
+                        objects.into_iter().map(|o| vec![o]).collect(),
+                        span,
+                    ),
+                }
+            }
+            Kind::Tuple(items) if items.len() == 3 => {
+                let (a, op, b) = (items[0], items[1], items[2]);
+                let op_span = self.tree[op].span.clone();
+                let op_name = match self.tree[op].kind {
+                    Kind::Str => &self.text[op_span.start + 1..op_span.end - 1],
+                    _ => self.word(&op_span),
+                };
+                let op = match op_name {
+                    "sub" => crate::description::CsgOpDesc::Difference,
+                    "and" => crate::description::CsgOpDesc::Intersection,
+                    "or" => crate::description::CsgOpDesc::Union,
+                    other => {
+                        return Err(ParseError::new(
+                            format!("unknown CSG operation `{other}`: the `csg` block knows `sub`, `and` and `or`"),
+                            op_span,
+                        ))
+                    }
+                };
+                let a = self.csg_operation(a, named, depth + 1)?;
+                let b = self.csg_operation(b, named, depth + 1)?;
+                fork_shapes::csg_object(op, vec![vec![a], vec![b]], span)
+            }
+            _ => Err(self.expected("`(\"a\", \"sub\", \"b\")` or an operand's name", id)),
         }
     }
 
@@ -605,6 +810,10 @@ impl<'a> Reader<'a> {
     fn primitive(&mut self, kind: &str, head: Span, id: usize, world: Mat4) -> Result<(), ParseError> {
         let mut material = None;
         let (mut height, mut bottom, mut top, mut capped) = (1.0f32, 1.0f32, 0.0f32, true);
+        // The HKUST 2019 fork's torus: `a` = 1 and `b` = 0.2 unless given.
+        let (mut major, mut minor) = (1.0f32, 0.2f32);
+        let mut blobs = MetaballFields::default();
+        let blobby = kind.starts_with("metaball");
         let mut mesh = MeshInput::default();
         let is_mesh = kind == "trimesh" || kind == "polymesh";
         for (key, value) in self.entries(id, kind)? {
@@ -612,6 +821,39 @@ impl<'a> Reader<'a> {
             match word {
                 "material" => material = Some(self.material_value(value)?),
                 "name" => {}
+                "balls" | "ball" if blobby => {
+                    let mut balls = Vec::new();
+                    for item in self.list(value, word)? {
+                        let values = match &self.tree[item].kind {
+                            Kind::Tuple(items) if (3..=4).contains(&items.len()) => items
+                                .iter()
+                                .map(|&n| self.number(n, "in a ball"))
+                                .collect::<Result<Vec<f32>, ParseError>>()?,
+                            _ => return Err(self.expected("a ball `(x, y, z)` or `(x, y, z, radius)`", item)),
+                        };
+                        balls.push((Vec3::new(values[0], values[1], values[2]), values.get(3).copied()));
+                    }
+                    blobs.balls(balls, self.tree[value].span.clone())?;
+                }
+                "radius" | "size" | "threshold" | "blend" if blobby => {
+                    let number = self.number(value, &format!("for `{word}`"))?;
+                    blobs.number(word, number, key.start..self.tree[value].span.end)?;
+                }
+                "a" | "b" | "major_radius" | "minor_radius" if kind == "torus" => {
+                    let node = value;
+                    let value = self.number(node, &format!("for `{word}`"))?;
+                    if !(value > 0.0 && value.is_finite()) {
+                        return Err(ParseError::new(
+                            format!("a torus radius must be positive, not {value}"),
+                            self.tree[node].span.clone(),
+                        ));
+                    }
+                    if matches!(word, "a" | "major_radius") {
+                        major = value;
+                    } else {
+                        minor = value;
+                    }
+                }
                 "height" | "bottom_radius" | "top_radius" | "capped" if kind == "cone" => match word {
                     "height" => height = self.number(value, "for `height`")?,
                     "bottom_radius" => bottom = self.number(value, "for `bottom_radius`")?.abs(),
@@ -660,6 +902,11 @@ impl<'a> Reader<'a> {
             "box" => ShapeDesc::Box,
             "square" => ShapeDesc::Square,
             "cylinder" => ShapeDesc::Cylinder { capped: true },
+            "torus" => ShapeDesc::Torus {
+                major_radius: major,
+                minor_radius: minor,
+            },
+            "metaballs" | "metaball" => blobs.finish(kind, &(head.start..self.tree[id].span.end))?,
             "cone" => ShapeDesc::Cone {
                 height,
                 bottom_radius: bottom,

@@ -100,7 +100,8 @@ pub(crate) fn lex(text: &str, dialect: Dialect) -> Result<Vec<Token>, ParseError
             b'/' => i = skip_comment(text, i)?,
             b'"' => {
                 let rest = &bytes[i + 1..];
-                match rest.iter().position(|&b| b == b'"' || b == b'\n') {
+                // Old Mac files end lines with a lone CR: it ends a string's line too.
+                match rest.iter().position(|&b| b == b'"' || b == b'\n' || b == b'\r') {
                     Some(n) if rest[n] == b'"' => {
                         i += n + 2;
                         tokens.push(Token {
@@ -162,9 +163,11 @@ pub(crate) fn lex(text: &str, dialect: Dialect) -> Result<Vec<Token>, ParseError
 fn skip_comment(text: &str, i: usize) -> Result<usize, ParseError> {
     let bytes = text.as_bytes();
     match bytes.get(i + 1) {
+        // A line ends at LF, CR LF or a lone CR (old Mac files): otherwise the first comment of
+        // a CR-only file would swallow the rest of it.
         Some(b'/') => Ok(bytes[i..]
             .iter()
-            .position(|&b| b == b'\n')
+            .position(|&b| b == b'\n' || b == b'\r')
             .map_or(bytes.len(), |n| i + n + 1)),
         Some(b'*') => match text[i + 2..].find("*/") {
             Some(n) => Ok(i + 2 + n + 2),
@@ -187,8 +190,8 @@ fn number_end(bytes: &[u8], mut i: usize, dialect: Dialect) -> usize {
         let b = bytes[i];
         let ok = match b {
             b'0'..=b'9' | b'-' | b'.' | b'e' => true,
-            b'E' => dialect == Dialect::Dictionary,
-            b'+' => dialect == Dialect::Dictionary && i > start && matches!(bytes[i - 1], b'e' | b'E'),
+            b'E' => dialect != Dialect::Tokenizer,
+            b'+' => dialect != Dialect::Tokenizer && i > start && matches!(bytes[i - 1], b'e' | b'E'),
             _ => false,
         };
         if !ok {
@@ -328,6 +331,21 @@ mod tests {
         assert_eq!(err.span, 2..4);
         assert!(lex("a / b", Dialect::Tokenizer).is_err());
         assert_eq!(kinds("a //", Dialect::Tokenizer), vec![Tok::Word, Tok::Eof]);
+    }
+
+    #[test]
+    fn a_lone_cr_ends_comments_and_strings_like_lf() {
+        for text in ["a // x\rb", "a // x\nb", "a // x\r\nb"] {
+            assert_eq!(
+                kinds(text, Dialect::Tokenizer),
+                vec![Tok::Word, Tok::Word, Tok::Eof],
+                "{text:?}"
+            );
+        }
+        assert!(
+            lex("\"abc\r\"", Dialect::Dictionary).is_err(),
+            "a string ends at a CR line end"
+        );
     }
 
     #[test]

@@ -470,15 +470,14 @@ fn misspelled_keywords_get_suggestions() {
 #[test]
 fn student_extensions_are_named() {
     for (body, word) in [
-        ("area_light { position = (0,0,0); }", "area_light"),
-        ("translate(0,0,0, torus {})", "torus"),
+        ("translate(0,0,0, quadric {})", "quadric"),
         (
             "sphere { material = { diffuse = (1,1,1); bump_mapping = bump(\"x.png\"); } }",
             "bump_mapping",
         ),
         ("polymesh { objfile = \"x.obj\"; }", "objfile"),
-        ("spot_light { position = (0,0,0); }", "spot_light"),
-        ("csg { }", "csg"),
+        ("warn_light { position = (0,0,0); }", "warn_light"),
+        ("particles { }", "particles"),
     ] {
         let (err, covered) = fail(body);
         assert_eq!(covered, word);
@@ -560,8 +559,9 @@ const DIALECT_O: &str = "camera { position = (0, 0, 5); viewdir = (0, 0, -2); up
 
 #[test]
 fn dialect_o_reads_its_own_rules() {
+    // Detected dialect-O files are read with the HKUST skeleton's defaults.
     let scene = read(DIALECT_O);
-    assert_eq!(scene.dialect, Dialect::Dictionary);
+    assert_eq!(scene.dialect, Dialect::Hkust);
     let camera = scene.camera.as_ref().expect("camera");
     assert_eq!(camera.basis, CameraBasis::Normalized);
     assert_eq!(camera.quaternion, Some([0.0, 0.0, 0.0, 1.0]));
@@ -573,7 +573,7 @@ fn dialect_o_reads_its_own_rules() {
             position, attenuation, ..
         } => {
             assert_eq!(*position, Vec3::new(10.0, 0.0, 0.0));
-            assert_eq!(*attenuation, [0.0, 0.0, 1.0]);
+            assert_eq!(*attenuation, [1.0, 0.0, 0.0], "HKUST: no coefficients, no falloff");
         }
         other => panic!("{other:?}"),
     }
@@ -608,8 +608,8 @@ fn dialect_o_errors() {
     assert!(err.message.contains("needs a `name`"));
     let err = read_as("spher { material = {}; }", Dialect::Dictionary).expect_err("typo");
     assert_eq!(err.help.as_deref(), Some("did you mean `sphere`?"));
-    let err = read_as("torus { material = {}; }", Dialect::Dictionary).expect_err("extension");
-    assert!(err.message.starts_with("`torus` is a student extension"));
+    let err = read_as("quadric { material = {}; }", Dialect::Dictionary).expect_err("extension");
+    assert!(err.message.starts_with("`quadric` is a student extension"));
     let err = read_as("translate(1, 2, sphere { material = {}; })", Dialect::Dictionary).expect_err("arity");
     assert!(err.message.contains("`translate` with (x, y, z, object)"));
     let err = read_as(
@@ -649,7 +649,7 @@ fn detection_prefers_t_unless_o_is_marked() {
         Err(true)
     );
     let scene = read(&marked);
-    assert_eq!(scene.dialect, Dialect::Dictionary);
+    assert_eq!(scene.dialect, Dialect::Hkust);
     assert_eq!(scene.objects[0].material.shininess, Param::grey(64.0));
     // T-only syntax.
     assert_eq!(read("{ sphere {} }").dialect, Dialect::Tokenizer);

@@ -7,9 +7,12 @@ use super::ast::{
     CameraBasis, Dialect, LightDesc, MaterialDesc, ObjectDesc, Param, RayCamera, RayScene, ShapeDesc, Span,
 };
 use super::cursor::{Cursor, Reach};
+use super::fork_lights::{self, LightFields};
+use super::fork_shapes::{self, MetaballFields, METABALL_FIELDS};
 use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok, Token};
 use super::named_materials::NamedMaterials;
+use super::skybox::{SkyboxFields, SKYBOX_FIELDS};
 use super::suggest;
 use super::transform_stack::{self, TransformStack};
 use super::trimesh::{self, MeshInput};
@@ -23,12 +26,19 @@ const ELEMENTS: &[&str] = &[
     "square",
     "cylinder",
     "cone",
+    "torus",
+    "metaballs",
+    "metaball",
     "trimesh",
     "polymesh",
     "translate",
     "scale",
     "rotate",
     "transform",
+    "union",
+    "intersection",
+    "difference",
+    "subtraction",
 ];
 const MATERIAL_FIELDS: &[&str] = &[
     "emissive",
@@ -101,6 +111,13 @@ enum Frame {
     Transform { keyword: Token },
     /// A `{ … }` group; `}` closes it.
     Group,
+    /// A CSG operation `union(a, b, …)`: its operands are the objects pushed since `start`,
+    /// each ending where `splits` says; `)` closes it.
+    Csg {
+        keyword: Token,
+        start: usize,
+        splits: Vec<usize>,
+    },
 }
 
 struct Parser<'a> {
@@ -141,6 +158,15 @@ impl<'a> Parser<'a> {
                     "point_light" => self.point_light()?,
                     "directional_light" => self.directional_light()?,
                     "sun_light" => self.sun_light()?,
+                    "spot_light" => self.fork_light(fork_lights::SPOT_FIELDS)?,
+                    "area_light" => self.fork_light(fork_lights::AREA_FIELDS)?,
+                    "skybox" => self.skybox()?,
+                    "csg" => {
+                        return Err(ParseError::new(
+                            "a `csg { … }` block is read in dialect-O files (the HKUST team fork's spelling); in dialect T write `union(a, b)`, `intersection(a, b)` or `difference(a, b)`",
+                            token.span.clone(),
+                        ))
+                    }
                     "environment_light" => self.environment_light()?,
                     "ambient_light" => self.ambient_light()?,
                     "material" => {
@@ -195,13 +221,27 @@ impl<'a> Parser<'a> {
                     frames.push(Frame::Transform { keyword: token });
                     continue;
                 }
-                (Tok::Word, "sphere" | "box" | "square" | "cylinder" | "cone") => {
+                (Tok::Word, "sphere" | "box" | "square" | "cylinder" | "cone" | "torus") => {
                     self.cur.next();
                     self.simple_primitive(&token)?;
                 }
                 (Tok::Word, "trimesh" | "polymesh") => {
                     self.cur.next();
                     self.trimesh(&token)?;
+                }
+                (Tok::Word, "metaballs" | "metaball") => {
+                    self.cur.next();
+                    self.metaballs(&token)?;
+                }
+                (Tok::Word, "union" | "intersection" | "difference" | "subtraction") => {
+                    self.cur.next();
+                    self.cur.expect(Tok::LParen, &format!("after `{word}`"))?;
+                    frames.push(Frame::Csg {
+                        keyword: token,
+                        start: self.scene.objects.len(),
+                        splits: Vec::new(),
+                    });
+                    continue;
                 }
                 _ => {
                     let (what, allowed) = if frames.is_empty() && allowed.len() > ELEMENTS.len() {
@@ -227,6 +267,33 @@ impl<'a> Parser<'a> {
                         self.cur.eat(Tok::Semicolon);
                         self.transforms.pop();
                         frames.pop();
+                    }
+                    Some(Frame::Csg { .. }) => {
+                        // Another operand follows a comma; `)` ends the operation.
+                        if self.cur.eat(Tok::Comma) {
+                            let at = self.scene.objects.len();
+                            if let Some(Frame::Csg { splits, .. }) = frames.last_mut() {
+                                splits.push(at);
+                            }
+                            break;
+                        }
+                        let Some(Frame::Csg { keyword, start, splits }) = frames.pop() else {
+                            unreachable!("the top frame is a CSG operation")
+                        };
+                        let word = self.cur.text_of(&keyword);
+                        self.cur.expect(Tok::RParen, &format!("or `,` in `{word}`"))?;
+                        self.cur.eat(Tok::Semicolon);
+                        let mut objects: Vec<_> = self.scene.objects.drain(start..).collect();
+                        let mut operands = Vec::new();
+                        for &split in splits.iter().rev() {
+                            operands.push(objects.split_off(split - start));
+                        }
+                        operands.push(objects);
+                        operands.reverse();
+                        let op = fork_shapes::csg_op(word).expect("a CSG keyword");
+                        let span = keyword.span.start..self.cur.prev_end();
+                        let object = fork_shapes::csg_object(op, operands, span)?;
+                        self.scene.objects.push(object);
                     }
                     Some(Frame::Group) => {
                         // Extension: `material = …` inside a group sets the default from here on.
@@ -538,6 +605,72 @@ impl<'a> Parser<'a> {
         Ok(())
     }
 
+    /// `spot_light { … }` or `area_light { … }` in any course fork's spelling (fork_lights.rs).
+    fn fork_light(&mut self, allowed: &'static [&'static str]) -> Result<(), ParseError> {
+        let keyword = self.cur.next();
+        let mut fields = LightFields::default();
+        self.block(
+            &keyword,
+            |p, token, key| {
+                if !allowed.contains(&key) {
+                    return Ok(false);
+                }
+                p.key_equals()?;
+                let start = token.span.start;
+                if fork_lights::is_vector_field(key) {
+                    let v = p.vec3(&format!("for `{key}`"))?;
+                    fields.vector(allowed, key, v, start..p.cur.prev_end())?;
+                } else {
+                    let (v, span) = p.cur.number(&format!("for `{key}`"))?;
+                    fields.number(allowed, key, v, start..span.end)?;
+                }
+                p.cur.eat(Tok::Semicolon);
+                Ok(true)
+            },
+            allowed,
+        )?;
+        let span = keyword.span.start..self.cur.prev_end();
+        let light = if self.cur.text_of(&keyword) == "spot_light" {
+            let (light, warnings) = fields.spot(span, [0.0, 0.0, 1.0], false)?;
+            self.scene.warnings.extend(warnings);
+            light
+        } else {
+            fields.area(span, [0.0, 0.0, 1.0], false)?
+        };
+        self.scene.lights.push(light);
+        Ok(())
+    }
+
+    /// `skybox { front = "file"; … }` (skybox.rs).
+    fn skybox(&mut self) -> Result<(), ParseError> {
+        let keyword = self.cur.next();
+        let mut fields = SkyboxFields::default();
+        let scene_dir = self.scene_dir;
+        self.block(
+            &keyword,
+            |p, token, key| {
+                if !SKYBOX_FIELDS.contains(&key) {
+                    return Ok(false);
+                }
+                p.key_equals()?;
+                if matches!(key, "color" | "colour") {
+                    let color = p.vec3("for `color`")?;
+                    fields.color(color, token.span.start..p.cur.prev_end())?;
+                } else {
+                    let (file, span) = p.identifier(&format!("(the image file, in quotes) for `{key}`"))?;
+                    fields.face(key, &file, scene_dir, span)?;
+                }
+                p.cur.eat(Tok::Semicolon);
+                Ok(true)
+            },
+            SKYBOX_FIELDS,
+        )?;
+        self.scene.warnings.append(&mut fields.warnings);
+        let light = fields.finish(keyword.span.start..self.cur.prev_end())?;
+        self.scene.lights.push(light);
+        Ok(())
+    }
+
     /// `sun_light { direction; color; angle }`: a caustica extension (docs/scene-format.md).
     fn sun_light(&mut self) -> Result<(), ParseError> {
         let keyword = self.cur.next();
@@ -766,9 +899,13 @@ impl<'a> Parser<'a> {
         let kind = self.cur.text_of(keyword);
         let mut material = None;
         let (mut height, mut bottom, mut top, mut capped) = (1.0f32, 1.0f32, 0.0f32, true);
+        // The UT 2019 fork's torus has radii 1 and 0.3 and no fields for them; the HKUST
+        // fork's `a` and `b` (or caustica's names) set them.
+        let (mut major, mut minor) = (1.0f32, 0.3f32);
         let allowed: &[&str] = match kind {
             "cone" => &["material", "name", "capped", "height", "bottom_radius", "top_radius"],
             "cylinder" => &["material", "name", "capped"],
+            "torus" => &["material", "name", "major_radius", "minor_radius", "a", "b"],
             _ => &["material", "name"],
         };
         self.block(
@@ -783,6 +920,22 @@ impl<'a> Parser<'a> {
                     "capped" if kind == "cone" || kind == "cylinder" => {
                         p.key_equals()?;
                         capped = p.boolean("after `capped =`")?;
+                        p.cur.eat(Tok::Semicolon);
+                    }
+                    "major_radius" | "minor_radius" | "a" | "b" if kind == "torus" => {
+                        p.key_equals()?;
+                        let (value, span) = p.cur.number(&format!("for `{key}`"))?;
+                        if !(value > 0.0 && value.is_finite()) {
+                            return Err(ParseError::new(
+                                format!("a torus radius must be positive, not {value}"),
+                                span,
+                            ));
+                        }
+                        if matches!(key, "major_radius" | "a") {
+                            major = value;
+                        } else {
+                            minor = value;
+                        }
                         p.cur.eat(Tok::Semicolon);
                     }
                     "height" | "bottom_radius" | "top_radius" if kind == "cone" => {
@@ -807,6 +960,10 @@ impl<'a> Parser<'a> {
             "box" => ShapeDesc::Box,
             "square" => ShapeDesc::Square,
             "cylinder" => ShapeDesc::Cylinder { capped },
+            "torus" => ShapeDesc::Torus {
+                major_radius: major,
+                minor_radius: minor,
+            },
             _ => ShapeDesc::Cone {
                 height,
                 bottom_radius: bottom,
@@ -814,6 +971,70 @@ impl<'a> Parser<'a> {
                 capped,
             },
         };
+        let material = material.unwrap_or_else(|| self.default_material.clone());
+        self.push_object(shape, material, keyword.span.clone());
+        Ok(())
+    }
+
+    /// `metaballs { … }` or `metaball { … }` (the keyword is consumed; fork_shapes.rs).
+    fn metaballs(&mut self, keyword: &Token) -> Result<(), ParseError> {
+        let kind = self.cur.text_of(keyword);
+        let mut material = None;
+        let mut fields = MetaballFields::default();
+        let mut allowed = vec!["material", "name"];
+        allowed.extend_from_slice(METABALL_FIELDS);
+        self.block(
+            keyword,
+            |p, token, key| {
+                match key {
+                    "material" => {
+                        let base = p.default_material.clone();
+                        material = Some(p.material_stmt(&base)?);
+                    }
+                    "name" => p.name_attr()?,
+                    "balls" | "ball" => {
+                        p.key_equals()?;
+                        let mut balls = Vec::new();
+                        let span = p.list(key, |p| {
+                            let open = p
+                                .cur
+                                .expect(Tok::LParen, "to start a ball `(x, y, z)` or `(x, y, z, radius)`")?;
+                            let mut values = Vec::with_capacity(4);
+                            loop {
+                                values.push(p.cur.number("in a ball")?.0);
+                                if p.cur.eat(Tok::RParen) {
+                                    break;
+                                }
+                                p.cur.expect(Tok::Comma, "or `)` in a ball")?;
+                            }
+                            if !(3..=4).contains(&values.len()) {
+                                return Err(ParseError::new(
+                                    format!(
+                                        "a ball is `(x, y, z)` or `(x, y, z, radius)`, not {} numbers",
+                                        values.len()
+                                    ),
+                                    open.span.start..p.cur.prev_end(),
+                                ));
+                            }
+                            balls.push((Vec3::new(values[0], values[1], values[2]), values.get(3).copied()));
+                            Ok(())
+                        })?;
+                        fields.balls(balls, span)?;
+                    }
+                    "radius" | "size" | "threshold" | "blend" => {
+                        p.key_equals()?;
+                        let (value, span) = p.cur.number(&format!("for `{key}`"))?;
+                        fields.number(key, value, token.span.start..span.end)?;
+                        p.cur.eat(Tok::Semicolon);
+                    }
+                    _ => return Ok(false),
+                }
+                Ok(true)
+            },
+            &allowed,
+        )?;
+        let block = keyword.span.start..self.cur.prev_end();
+        let shape = fields.finish(kind, &block)?;
         let material = material.unwrap_or_else(|| self.default_material.clone());
         self.push_object(shape, material, keyword.span.clone());
         Ok(())
