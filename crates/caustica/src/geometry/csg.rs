@@ -39,8 +39,8 @@ impl CsgOp {
 pub enum CsgNode {
     /// A closed shape with its material id; leaves are numbered in order (the hit's `part`).
     Leaf {
-        /// The shape, placed in the world.
-        shape: Shape,
+        /// The shape, placed in the world (boxed: a shape is much larger than an operation).
+        shape: Box<Shape>,
         /// Its material id.
         material: u32,
     },
@@ -130,9 +130,7 @@ impl Csg {
 
     /// The nearest crossing of the solid's surface in `(0, t_max)` along the world ray.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Crossing> {
-        if self.bounds.intersect(ray.origin, ray.dir.recip(), 0.0, t_max).is_none() {
-            return None;
-        }
+        self.bounds.intersect(ray.origin, ray.dir.recip(), 0.0, t_max)?;
         let mut next_part = 0;
         let (_, crossings) = node_crossings(&self.root, ray, &mut next_part);
         crossings.into_iter().find(|c| c.t > 0.0 && c.t < t_max)
@@ -252,7 +250,7 @@ mod tests {
     fn ball(x: f32, r: f32, material: u32) -> CsgNode {
         let m = Mat4::from_translation(Vec3::new(x, 0.0, 0.0)) * Mat4::from_scale(Vec3::splat(r));
         CsgNode::Leaf {
-            shape: Shape::new(ShapeKind::Sphere, m).unwrap(),
+            shape: Box::new(Shape::new(ShapeKind::Sphere, m).unwrap()),
             material,
         }
     }
@@ -316,7 +314,7 @@ mod tests {
     #[test]
     fn crossings_bound_the_solid_and_alternate() {
         let cube = CsgNode::Leaf {
-            shape: Shape::new(ShapeKind::Box, Mat4::from_scale(Vec3::splat(2.0))).unwrap(),
+            shape: Box::new(Shape::new(ShapeKind::Box, Mat4::from_scale(Vec3::splat(2.0))).unwrap()),
             material: 0,
         };
         let solid = op(CsgOp::Difference, cube, ball(0.0, 1.2, 1));

@@ -335,7 +335,7 @@ impl Builder {
                     let material = self.material(&operand.material)?;
                     let mut shape = Shape::new(kind, operand.world_from_object).ok_or_else(|| singular(&operand.span))?;
                     shape.needs_uv = self.materials[material as usize].is_textured();
-                    CsgNode::Leaf { shape, material }
+                    CsgNode::Leaf { shape: Box::new(shape), material }
                 }
             };
             nodes.push(node);
