@@ -34,8 +34,11 @@ pub fn build_detected(
     settings: &LoadSettings,
     progress: &dyn Progress,
 ) -> Result<(SceneSource, Scene)> {
+    let mut source = source;
+    locate_warnings(&mut source);
     let scene = build_source_ref(&source, &settings.build, progress)?;
-    if settings.read.ray.dialect.is_some() {
+    // The second reading is the .ray format's own question.
+    if settings.read.ray.dialect.is_some() || settings.read.format_of(&source.path) != format::Format::Ray {
         return Ok((source, scene));
     }
     let Some(dark) = crate::integrator::darkness::darkness(&scene) else {
@@ -57,6 +60,7 @@ pub fn build_detected(
         "read with the HKUST COMP 4411 defaults (point lights without attenuation coefficients do not fall off): with the UT falloff 1/d² the image would be black; --dialect tokenizer or dictionary keeps that reading".into(),
         0..0,
     ));
+    locate_warnings(&mut again);
     match build_source_ref(&again, &settings.build, &NoProgress) {
         Ok(hkust) if crate::integrator::darkness::darkness(&hkust).is_none() => Ok((again, hkust)),
         _ => Ok((source, scene)),
@@ -68,21 +72,26 @@ fn build_source_ref(source: &SceneSource, settings: &BuildSettings, progress: &d
 }
 
 /// Builds a scene read from a file (reporting a "build" phase); errors point into its text and
-/// the reader's warnings are prefixed with their `file:line:col`, as errors are.
+/// the reader's warnings start with their `file:line:col`, as errors do.
 pub fn build_source(mut source: SceneSource, settings: &BuildSettings, progress: &dyn Progress) -> Result<Scene> {
-    let mut warnings = std::mem::take(&mut source.description.warnings);
-    for (message, span) in &mut warnings {
+    locate_warnings(&mut source);
+    build_source_ref(&source, settings, progress)
+}
+
+/// Prefixes each of the reader's warnings with the `file:line:col` its span starts at (once per
+/// source read).
+fn locate_warnings(source: &mut SceneSource) {
+    let files = &source.files;
+    for (message, span) in &mut source.description.warnings {
         // An empty span at 0 is a remark about the whole scene, not a place in it.
         if *span == (0..0) {
             continue;
         }
-        if let Some((file, at)) = source.files.locate(span) {
+        if let Some((file, at)) = files.locate(span) {
             let (line, col) = crate::error::line_col(&file.text, at.start);
             *message = format!("{}:{line}:{col}: {message}", file.path.display());
         }
     }
-    source.description.warnings = warnings;
-    crate::scene::build::build_reporting(&source.description, settings, progress).map_err(|e| source.error(e))
 }
 
 /// What identifies a scene in a render's fingerprint, so that only parts of one run merge: a
