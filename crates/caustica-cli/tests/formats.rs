@@ -180,6 +180,17 @@ fn a_pbrt_scene_brings_its_film_sampler_and_integrator() {
         "{stderr}"
     );
     assert!(dir.join("o.png").exists(), "the render goes on");
+    // The course model takes the file's image size but not its samples (it has no passes).
+    let (code, stderr, stdout) = run(
+        &dir,
+        &["render", "s.pbrt", "--json", "--model", "course", "-o", "c.png"],
+    );
+    assert_eq!(code, Some(0), "{stderr}");
+    let json: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(
+        (json["width"].as_u64(), json["integrator"].as_str()),
+        (Some(24), Some("whitted"))
+    );
     // --format reads any extension.
     std::fs::write(dir.join("s.txt"), &scene).unwrap();
     let (code, stderr, _) = run(&dir, &["info", "s.txt", "--format", "pbrt"]);

@@ -99,20 +99,30 @@ fn the_pbrt_glass_ball_focuses_the_sun() {
     // Orientation: pbrt's LookAt puts up × (look − eye) on the image's right (its camera space
     // is left-handed), so the red box at (0.2, 0.15, −0.9) falls left of the image's centre
     // from the eye at (1.6, 1.3, 1.4); a right-handed reading would mirror it to the right.
+    let box_centre = Vec3::new(0.2, 0.15, -0.9);
+    let (sx, sy) = scene.camera().project(box_centre).expect("in front of the camera");
+    assert!(sx < 0.5, "the box projects to x = {sx}");
     let film = render(&scene, false);
-    let (mut left, mut right) = (0.0f32, 0.0f32);
-    for y in 0..film.height {
-        for x in 0..film.width {
-            let p = film.pixel(x, y);
-            let red = (p.x - p.y.max(p.z)).max(0.0);
-            if x < film.width / 2 {
-                left += red;
-            } else {
-                right += red;
-            }
-        }
-    }
-    assert!(left > 10.0 * right.max(1e-3), "red left {left}, right {right}");
+    // Red pixels within 4 of where a point projects (the box's faces away from the sun are dark).
+    let red = |sx: f32| {
+        let (cx, cy) = (
+            (sx * film.width as f32) as i64,
+            ((1.0 - sy) * film.height as f32) as i64,
+        );
+        (-4..=4)
+            .flat_map(|dy| (-4..=4).map(move |dx| (cx + dx, cy + dy)))
+            .any(|(x, y)| {
+                let p = film.pixel(
+                    x.clamp(0, film.width as i64 - 1) as usize,
+                    y.clamp(0, film.height as i64 - 1) as usize,
+                );
+                p.x > 0.05 && p.x > 3.0 * p.y.max(p.z)
+            })
+    };
+    assert!(
+        red(sx) && !red(1.0 - sx),
+        "the red box is drawn at x = {sx}, not mirrored"
+    );
 }
 
 /// A UV sphere as Blender triangulates one: rings × segments, smooth normals.

@@ -38,6 +38,8 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
     } else {
         None
     });
+    // The scene's samples per pixel are passes of a physical integrator; the course model has none.
+    let course = model == Some(Model::Course) || integrator == Some(IntegratorKind::Whitted);
     // With only --width, the height follows the camera rather than the scene's film.
     let height = args.height.or(if args.width.is_none() { scene.height } else { None });
     Ok(RenderConfig {
@@ -56,7 +58,11 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         radius: args.radius.or(scene.radius),
         cone_filter: args.cone_filter,
         no_estimate_reuse: args.no_estimate_reuse,
-        passes: p.passes.clone().or(if p.time.is_none() { scene.passes } else { None }),
+        passes: p.passes.clone().or(if p.time.is_none() && !course {
+            scene.passes
+        } else {
+            None
+        }),
         time: p.time,
         footprint: p.footprint,
         alpha: p.alpha,

@@ -447,10 +447,11 @@ impl Reader<'_, '_> {
         });
         if self.desc.lights.is_empty() && !emits && !self.desc.objects.is_empty() {
             // Many files leave lighting to the viewer; a viewer's neutral default.
-            self.warn(
-                "extensions",
-                "the scene has no lights: a uniform white sky of radiance 1 lights it",
-            );
+            // A remark on the whole file: no place in it (an empty span at 0).
+            self.desc.warnings.push((
+                "the scene has no lights: a uniform white sky of radiance 1 lights it".into(),
+                0..0,
+            ));
             self.desc.lights.push(LightDesc::Environment {
                 color: Vec3::ONE,
                 map: None,
