@@ -163,9 +163,7 @@ fn blender_glb() -> Vec<u8> {
     let mut views = Vec::new();
     let mut accessors = Vec::new();
     let mut push = |bin: &mut Vec<u8>, bytes: &[u8], target: u32| {
-        while bin.len() % 4 != 0 {
-            bin.push(0);
-        }
+        bin.resize(bin.len().next_multiple_of(4), 0);
         let start = bin.len();
         bin.extend_from_slice(bytes);
         views.push(format!(
@@ -217,9 +215,7 @@ fn blender_glb() -> Vec<u8> {
     let floor = mesh(&mut bin, &plane, &[Vec3::Y; 4], &[0, 1, 3, 0, 3, 2]);
     let (sp, sn, si) = uv_sphere(0.3, 32, 64);
     let ball = mesh(&mut bin, &sp, &sn, &si);
-    while bin.len() % 4 != 0 {
-        bin.push(0);
-    }
+    bin.resize(bin.len().next_multiple_of(4), 0);
     // Camera and sun as node rotations taking −z to where they look.
     let look = |dir: Vec3| {
         let dir = dir.normalize();
@@ -266,9 +262,7 @@ fn blender_glb() -> Vec<u8> {
         bin.len()
     );
     let mut json = json.into_bytes();
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
+    json.resize(json.len().next_multiple_of(4), b' ');
     let mut glb = Vec::new();
     glb.extend(b"glTF");
     glb.extend(2u32.to_le_bytes());

@@ -402,12 +402,8 @@ fn glb_seed() -> Vec<u8> {
         }
     }
     let mut json = format!("{}{}", &json[..start - 1], &json[end..]).into_bytes();
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
-    while bin.len() % 4 != 0 {
-        bin.push(0);
-    }
+    json.resize(json.len().next_multiple_of(4), b' ');
+    bin.resize(bin.len().next_multiple_of(4), 0);
     let total = 12 + 8 + json.len() + 8 + bin.len();
     let mut out = Vec::new();
     out.extend(b"glTF");
