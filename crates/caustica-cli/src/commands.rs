@@ -9,11 +9,13 @@ pub mod render;
 
 use crate::cli::{PhotonOptions, SceneArgs};
 use crate::progress::Bars;
+use caustica::description::LightDesc;
 use caustica::format::ray_file::ast::Dialect;
 use caustica::format::ray_file::ParseOptions;
-use caustica::format::{self, ReadOptions};
+use caustica::format::{self, obj, Format, ReadOptions};
 use caustica::integrator::RenderConfig;
 use caustica::loader::{build_detected, scene_id, LoadSettings};
+use caustica::math::Vec3;
 use caustica::photon::PhotonSettings;
 use caustica::presets;
 use caustica::scene::Scene;
@@ -22,7 +24,7 @@ use std::path::Path;
 use std::time::Instant;
 
 /// Load settings from the command line.
-pub fn load_settings(args: &SceneArgs) -> LoadSettings {
+pub fn load_settings(args: &SceneArgs) -> Result<LoadSettings> {
     let mut settings = LoadSettings::default();
     settings.build.shapes.cone_quirks = args.cone_quirks;
     settings.read = ReadOptions {
@@ -34,8 +36,75 @@ pub fn load_settings(args: &SceneArgs) -> LoadSettings {
                 _ => None,
             },
         },
+        format: args.format.as_deref().map(Format::from_name).transpose()?,
+        obj: obj_options(args)?,
     };
-    settings
+    Ok(settings)
+}
+
+/// Numbers separated by commas, exactly `n` of them.
+fn numbers(flag: &str, text: &str, n: usize) -> Result<Vec<f32>> {
+    let values: Vec<f32> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f32>())
+        .collect::<std::result::Result<_, _>>()
+        .map_err(|_| Error::InvalidSettings(format!("--{flag} {text}: expected {n} numbers separated by commas")))?;
+    if values.len() != n || values.iter().any(|v| !v.is_finite()) {
+        return Err(Error::InvalidSettings(format!(
+            "--{flag} {text}: expected {n} finite numbers separated by commas"
+        )));
+    }
+    Ok(values)
+}
+
+fn vec3(flag: &str, text: &str) -> Result<Vec3> {
+    let v = numbers(flag, text, 3)?;
+    Ok(Vec3::new(v[0], v[1], v[2]))
+}
+
+/// The camera and lights of an OBJ scene from the command line.
+fn obj_options(args: &SceneArgs) -> Result<obj::SceneOptions> {
+    let mut options = obj::SceneOptions::default();
+    if !(args.fov > 0.0 && args.fov < 180.0) {
+        return Err(Error::InvalidSettings(
+            "--fov must lie between 0 and 180 degrees".into(),
+        ));
+    }
+    let up = vec3("up", &args.up)?;
+    if args.look_from.is_some() || args.look_at.is_some() || args.fov != 40.0 || args.up != "0,1,0" {
+        let eye = args.look_from.as_deref().map(|t| vec3("look-from", t)).transpose()?;
+        let at = args.look_at.as_deref().map(|t| vec3("look-at", t)).transpose()?;
+        options.camera = Some(obj::CameraRequest {
+            eye,
+            target: at,
+            up,
+            fov_degrees: args.fov,
+        });
+    }
+    for text in &args.point_light {
+        let v = numbers("point-light", text, 6)?;
+        options.lights.push(LightDesc::Point {
+            position: Vec3::new(v[0], v[1], v[2]),
+            color: Vec3::new(v[3], v[4], v[5]),
+            attenuation: [0.0, 0.0, 1.0],
+            span: 0..0,
+        });
+    }
+    for text in &args.directional_light {
+        let v = numbers("directional-light", text, 6)?;
+        let direction = Vec3::new(v[0], v[1], v[2]);
+        if direction == Vec3::ZERO {
+            return Err(Error::InvalidSettings(
+                "--directional-light needs a non-zero direction".into(),
+            ));
+        }
+        options.lights.push(LightDesc::Directional {
+            direction,
+            color: Vec3::new(v[3], v[4], v[5]),
+            span: 0..0,
+        });
+    }
+    Ok(options)
 }
 
 /// A built scene and the seconds its two phases took.
@@ -53,7 +122,18 @@ pub struct Loaded {
 /// Reads and parses the scene file, or the built-in ring scene when no path is given, then
 /// builds it: two phases, each with its bar.
 pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<Loaded> {
-    let settings = load_settings(args);
+    let settings = load_settings(args)?;
+    if let Some(path) = path {
+        let obj_flags = args.look_from.is_some()
+            || args.look_at.is_some()
+            || !args.point_light.is_empty()
+            || !args.directional_light.is_empty();
+        if obj_flags && settings.read.format_of(path) != Format::Obj {
+            return Err(Error::InvalidSettings(
+                "--look-from, --look-at, --point-light and --directional-light set up OBJ scenes; this scene has its own camera and lights".into(),
+            ));
+        }
+    }
     let start = Instant::now();
     let source = match path {
         Some(path) => format::read_file(path, &settings.read, bars),
@@ -104,7 +184,7 @@ pub fn check_photon_memory(total: usize, max_memory: u64) -> Result<()> {
 /// Photon settings from the command line, checked.
 pub fn photon_settings(options: &PhotonOptions, seed: u64) -> Result<PhotonSettings> {
     let config = RenderConfig {
-        photons: options.photons,
+        photons: options.photons.unwrap_or(RenderConfig::default().photons),
         max_emitted: options.max_emitted,
         photons_per_light: options.photons_per_light.clone(),
         no_aim: options.no_aim,

@@ -29,7 +29,11 @@ impl Default for Camera {
 impl Camera {
     /// The camera a scene describes.
     pub fn from_desc(desc: &CameraDesc) -> Camera {
-        Camera::from_basis(desc.position, desc.view, desc.up, desc.height, desc.aspect_ratio)
+        let mut camera = Camera::from_basis(desc.position, desc.view, desc.up, desc.height, desc.aspect_ratio);
+        if let Some(right) = desc.right {
+            camera.u = right * desc.height * desc.aspect_ratio;
+        }
+        camera
     }
 
     /// A camera from a view and up vector used as given (§4).

@@ -21,6 +21,42 @@ pub struct SceneDescription {
     pub objects: Vec<ObjectDesc>,
     /// Non-fatal remarks made while reading, each with a span.
     pub warnings: Vec<(String, Span)>,
+    /// What the file says about how to render it (image size, integrator); a front end's own
+    /// options win over these.
+    pub hints: RenderHints,
+}
+
+/// Render settings a scene file asks for (pbrt-v4's `Film`, `Integrator` and `Sampler`,
+/// glTF's camera aspect). `RenderConfig` applies them unless a front end overrides them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RenderHints {
+    /// Image width in pixels.
+    pub width: Option<usize>,
+    /// Image height in pixels.
+    pub height: Option<usize>,
+    /// Whether the file is in radiometric units, so the physical model is its natural reading.
+    pub physical: bool,
+    /// The integrator the file names.
+    pub integrator: Option<IntegratorHint>,
+    /// Longest path in bounces (pbrt's `maxdepth`).
+    pub max_depth: Option<u32>,
+    /// Samples per pixel (pbrt's `pixelsamples`): passes of the physical integrators.
+    pub samples: Option<u32>,
+    /// Photons per pass (pbrt's sppm `photonsperiteration`).
+    pub photons_per_pass: Option<usize>,
+    /// Gather radius in scene units (pbrt's sppm `radius`).
+    pub radius: Option<f32>,
+    /// The output file the scene names (pbrt's `Film "filename"`), as written.
+    pub output: Option<PathBuf>,
+}
+
+/// An integrator a scene file asks for, in caustica's terms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorHint {
+    /// A path tracer.
+    Path,
+    /// Progressive photon mapping.
+    Ppm,
 }
 
 /// A pinhole camera: the eye and the image plane it looks through. The plane's centre lies at
@@ -39,6 +75,9 @@ pub struct CameraDesc {
     pub height: f32,
     /// Width / height.
     pub aspect_ratio: f32,
+    /// The image plane's rightward direction per unit, when it is not `up × −view` (a
+    /// left-handed camera such as pbrt's); `None` for the usual right-handed one.
+    pub right: Option<Vec3>,
     /// Where the camera is described.
     pub span: Span,
 }
@@ -131,6 +170,9 @@ pub enum LightDesc {
         /// The image's frame turned into the world's (a rotation; identity: +y up, the image's
         /// centre towards −z).
         rotation: glam::Mat3,
+        /// The image is pbrt-v4's equal-area octahedral square (its frame +z up) rather than
+        /// latitude–longitude; it is resampled to latitude–longitude when loaded.
+        equal_area: bool,
         /// Where the block is (and the map's file name in it, for errors reading it).
         span: Span,
     },
@@ -172,6 +214,16 @@ pub enum SkyboxLayout {
 pub enum Param {
     /// A constant colour (scalars are stored as grey triples).
     Constant(Vec3),
+    /// A checkerboard over the texture coordinates: `even` where ⌊u·su⌋ + ⌊v·sv⌋ is even
+    /// (pbrt-v4's `checkerboard` texture).
+    Checkerboard {
+        /// The colour of even cells (the one at the origin).
+        even: Vec3,
+        /// The colour of odd cells.
+        odd: Vec3,
+        /// Cells per unit of u and v.
+        scale: Vec2,
+    },
     /// `map("file")`: the path resolved against the scene file's directory.
     Texture {
         /// Resolved path of the image file.
@@ -211,6 +263,92 @@ pub struct MaterialDesc {
     pub abbe: Option<f32>,
     /// Name registered with `name`, if any.
     pub name: Option<String>,
+    /// The physical model's reading when the format describes one the course fields cannot
+    /// (metals, coated and translucent surfaces, thin glass); `None`: the course fields' own
+    /// physical reading (docs/radiometry.md). The course fields always hold the closest course
+    /// reading.
+    pub physical: Option<PhysicalMaterial>,
+}
+
+/// A physically based material beyond the course fields' reading, generic over how a colour is
+/// given (`Param` in the description, a scene channel once built). Roughness is the GGX α.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PhysicalMaterial<P = Param> {
+    /// A metal: Fresnel reflectance of the complex index η + ik per channel, or of the index
+    /// that gives `reflectance` at normal incidence (η = 1, k = 2√r/√(1 − r)).
+    Conductor {
+        /// Real part of the index (RGB).
+        eta: Vec3,
+        /// Imaginary part (RGB).
+        k: Vec3,
+        /// Reflectance at normal incidence instead of η and k.
+        reflectance: Option<P>,
+        /// GGX α; below 1e-3 a perfect mirror.
+        roughness: f32,
+    },
+    /// A Lambertian base under a clear dielectric coat of index `eta`.
+    CoatedDiffuse {
+        /// Albedo of the base.
+        reflectance: P,
+        /// Index of the coat.
+        eta: f32,
+        /// GGX α of the coat; below 1e-3 smooth.
+        roughness: f32,
+    },
+    /// Lambertian reflection and Lambertian transmission (leaves, paper, lampshades).
+    DiffuseTransmission {
+        /// Reflected albedo.
+        reflectance: P,
+        /// Transmitted albedo.
+        transmittance: P,
+    },
+    /// A thin-walled dielectric (glTF transmission without a volume): Fresnel reflection of
+    /// both faces, the rest passes straight through, tinted.
+    ThinDielectric {
+        /// Index of the sheet.
+        eta: f32,
+        /// Colour of the light that passes.
+        tint: P,
+    },
+}
+
+impl<P> PhysicalMaterial<P> {
+    /// The same material with each colour converted by `f`.
+    pub fn try_map<Q, E>(&self, mut f: impl FnMut(&P) -> Result<Q, E>) -> Result<PhysicalMaterial<Q>, E> {
+        Ok(match self {
+            PhysicalMaterial::Conductor {
+                eta,
+                k,
+                reflectance,
+                roughness,
+            } => PhysicalMaterial::Conductor {
+                eta: *eta,
+                k: *k,
+                reflectance: reflectance.as_ref().map(&mut f).transpose()?,
+                roughness: *roughness,
+            },
+            PhysicalMaterial::CoatedDiffuse {
+                reflectance,
+                eta,
+                roughness,
+            } => PhysicalMaterial::CoatedDiffuse {
+                reflectance: f(reflectance)?,
+                eta: *eta,
+                roughness: *roughness,
+            },
+            PhysicalMaterial::DiffuseTransmission {
+                reflectance,
+                transmittance,
+            } => PhysicalMaterial::DiffuseTransmission {
+                reflectance: f(reflectance)?,
+                transmittance: f(transmittance)?,
+            },
+            PhysicalMaterial::ThinDielectric { eta, tint } => PhysicalMaterial::ThinDielectric {
+                eta: *eta,
+                tint: f(tint)?,
+            },
+        })
+    }
 }
 
 impl Default for MaterialDesc {
@@ -227,6 +365,7 @@ impl Default for MaterialDesc {
             index: Param::grey(1.0),
             abbe: None,
             name: None,
+            physical: None,
         }
     }
 }
@@ -284,6 +423,12 @@ pub enum ShapeDesc {
     /// Constructive solid geometry (a course-fork extension): its operands carry their own
     /// world transforms and materials; the object's own transform and material are unused.
     Csg(Box<CsgDesc>),
+    /// Disc of radius 1 in the z = 0 plane about the origin, with a hole of radius `inner`
+    /// (0 ≤ inner < 1); its normal is +z.
+    Disk {
+        /// Radius of the hole.
+        inner: f32,
+    },
 }
 
 /// A CSG operation on two or more operands, applied from the left: `a − b − c` for a difference.

@@ -7,6 +7,7 @@
 pub mod box_shape;
 pub mod cone;
 pub mod csg;
+pub mod disk;
 pub mod metaballs;
 pub mod roots;
 pub mod shape;

@@ -34,8 +34,11 @@ pub fn build_detected(
     settings: &LoadSettings,
     progress: &dyn Progress,
 ) -> Result<(SceneSource, Scene)> {
+    let mut source = source;
+    locate_warnings(&mut source);
     let scene = build_source_ref(&source, &settings.build, progress)?;
-    if settings.read.ray.dialect.is_some() {
+    // The second reading is the .ray format's own question.
+    if settings.read.ray.dialect.is_some() || settings.read.format_of(&source.path) != format::Format::Ray {
         return Ok((source, scene));
     }
     let Some(dark) = crate::integrator::darkness::darkness(&scene) else {
@@ -57,6 +60,7 @@ pub fn build_detected(
         "read with the HKUST COMP 4411 defaults (point lights without attenuation coefficients do not fall off): with the UT falloff 1/d² the image would be black; --dialect tokenizer or dictionary keeps that reading".into(),
         0..0,
     ));
+    locate_warnings(&mut again);
     match build_source_ref(&again, &settings.build, &NoProgress) {
         Ok(hkust) if crate::integrator::darkness::darkness(&hkust).is_none() => Ok((again, hkust)),
         _ => Ok((source, scene)),
@@ -67,17 +71,40 @@ fn build_source_ref(source: &SceneSource, settings: &BuildSettings, progress: &d
     crate::scene::build::build_reporting(&source.description, settings, progress).map_err(|e| source.error(e))
 }
 
-/// Builds a scene read from a file (reporting a "build" phase); errors point into its text.
-pub fn build_source(source: SceneSource, settings: &BuildSettings, progress: &dyn Progress) -> Result<Scene> {
-    crate::scene::build::build_reporting(&source.description, settings, progress).map_err(|e| source.error(e))
+/// Builds a scene read from a file (reporting a "build" phase); errors point into its text and
+/// the reader's warnings start with their `file:line:col`, as errors do.
+pub fn build_source(mut source: SceneSource, settings: &BuildSettings, progress: &dyn Progress) -> Result<Scene> {
+    locate_warnings(&mut source);
+    build_source_ref(&source, settings, progress)
+}
+
+/// Prefixes each of the reader's warnings with the `file:line:col` its span starts at (once per
+/// source read).
+fn locate_warnings(source: &mut SceneSource) {
+    let files = &source.files;
+    for (message, span) in &mut source.description.warnings {
+        // An empty span at 0 is a remark about the whole scene, not a place in it.
+        if *span == (0..0) {
+            continue;
+        }
+        if let Some((file, at)) = files.locate(span) {
+            let (line, col) = crate::error::line_col(&file.text, at.start);
+            *message = format!("{}:{line}:{col}: {message}", file.path.display());
+        }
+    }
 }
 
 /// What identifies a scene in a render's fingerprint, so that only parts of one run merge: a
 /// hash of its text (the same on every machine) and how it was read and built.
 pub fn scene_id(source: &SceneSource, settings: &LoadSettings) -> String {
-    let hash = source.text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
-        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
-    });
+    // One file: the hash of its text alone, as before scenes could span several files.
+    let hash = if source.files.files().len() == 1 {
+        source.text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+            (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+        })
+    } else {
+        source.files.hash()
+    };
     format!(
         "{hash:016x} cone-quirks {} dialect {:?}",
         settings.build.shapes.cone_quirks, settings.read.ray.dialect
@@ -87,7 +114,8 @@ pub fn scene_id(source: &SceneSource, settings: &LoadSettings) -> String {
 /// Reads and builds scene text; files it refers to resolve against `scene_dir`.
 pub fn from_text(text: &str, scene_dir: &Path, settings: &LoadSettings) -> Result<Scene, ParseError> {
     let scene = format::ray_file::parse(text, scene_dir, &settings.read.ray)?;
-    crate::scene::build::build(&scene.into_description(), &settings.build)
+    let mut files = format::SourceFiles::new(Path::new("<text>"), text.to_string());
+    crate::scene::build::build(&scene.into_description(&mut files, scene_dir)?, &settings.build)
 }
 
 #[cfg(test)]
@@ -159,6 +187,7 @@ polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1
             let settings = LoadSettings {
                 read: ReadOptions {
                     ray: ParseOptions { dialect },
+                    ..ReadOptions::default()
                 },
                 ..settings.clone()
             };

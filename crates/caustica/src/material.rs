@@ -1,5 +1,6 @@
 //! Materials of the `.ray` format (§6): constant or texture-mapped parameters, evaluated at a hit.
 
+pub use crate::description::PhysicalMaterial;
 use crate::math::{luminance, Vec2, Vec3, Vec4};
 use crate::spectrum::{cauchy_index, fit_reflectance, SigmoidPolynomial, Spectrum, Wavelengths, CHANNEL_WAVELENGTHS};
 use crate::texture::Texture;
@@ -68,6 +69,9 @@ pub struct Material {
     pub index: Channel,
     /// Abbe number V_d of a dispersive glass.
     pub abbe: Option<f32>,
+    /// The physical model's reading when it is not the course fields' own (a metal, a coated
+    /// or translucent surface, thin glass).
+    pub physical: Option<PhysicalMaterial<Channel>>,
 }
 
 /// A material's constant colours as fitted smooth spectra (for spectral transport); `None`
@@ -184,6 +188,13 @@ impl Material {
     /// Whether the emission is read from a texture.
     pub fn emissive_is_textured(&self) -> bool {
         matches!(self.emissive, Channel::Texture(_))
+    }
+
+    /// The physical reading's values at texture coordinates `uv`, if it has its own.
+    #[inline]
+    pub fn physical_at(&self, textures: &[Texture], uv: Vec2) -> Option<PhysicalMaterial<Vec3>> {
+        let physical = self.physical.as_ref()?;
+        physical.try_map(|c| Ok::<Vec3, ()>(c.eval(textures, uv))).ok()
     }
 
     /// Whether any emissive value is non-zero.

@@ -104,6 +104,8 @@ pub struct Scene {
     /// The mesh and index of each triangle.
     triangle_refs: Vec<TriangleRef>,
     warnings: Vec<String>,
+    /// What the scene file asks for about rendering.
+    hints: crate::description::RenderHints,
     /// Hierarchy over the analytic shapes (primitive ids `0..shapes.len()`).
     shape_bvh: Bvh,
     /// Hierarchy over the triangles, tested four at a time (primitive id `shapes.len() + i`).
@@ -123,6 +125,7 @@ pub(crate) struct SceneParts {
     pub triangles: Vec<Triangle>,
     pub triangle_refs: Vec<TriangleRef>,
     pub warnings: Vec<String>,
+    pub hints: crate::description::RenderHints,
 }
 
 /// The minimal record of a closest hit: enough to build a [`SurfaceHit`] when needed.
@@ -175,6 +178,7 @@ impl Scene {
             triangles,
             triangle_refs,
             warnings,
+            hints,
         } = parts;
         for (shape, &material) in shapes.iter_mut().zip(&shape_materials) {
             shape.needs_uv = materials[material as usize].is_textured();
@@ -195,6 +199,7 @@ impl Scene {
             triangles,
             triangle_refs,
             warnings,
+            hints,
             shape_bvh,
             triangle_bvh,
         };
@@ -262,6 +267,12 @@ impl Scene {
         (self.shapes.len() + t) as u32
     }
 
+    /// The render settings the scene file asks for (image size, integrator …), which
+    /// [`RenderConfig::for_scene`](crate::integrator::RenderConfig::for_scene) applies.
+    pub fn hints(&self) -> &crate::description::RenderHints {
+        &self.hints
+    }
+
     /// Remarks made while reading and building (dropped triangles, ignored keys, …).
     pub fn warnings(&self) -> &[String] {
         &self.warnings
@@ -307,6 +318,17 @@ impl Scene {
             }
             _ => wl.unbounded(le),
         }
+    }
+
+    /// The physical reading's values at a surface point, when its material has its own (a
+    /// blend of per-vertex materials reads the first vertex's).
+    #[inline]
+    pub fn physical(&self, hit: &SurfaceHit) -> Option<crate::material::PhysicalMaterial<Vec3>> {
+        let id = match hit.material {
+            MaterialRef::One(id) => id,
+            MaterialRef::Blend { ids, .. } => ids[0],
+        };
+        self.materials[id as usize].physical_at(&self.textures, hit.uv)
     }
 
     /// The emitted radiance (`emissive`) at a surface point.

@@ -89,7 +89,8 @@ camera { position = (0, 6, 0.001); viewdir = (0, -1, 0); updir = (0, 0, -1); fov
 rotate(1, 0, 0, -1.5707963, scale(40, square { material = { diffuse = (0.5, 0.5, 0.5); } }))";
     let mut desc = ray_file::parse(text, Path::new("."), &ParseOptions::default())
         .unwrap()
-        .into_description();
+        .into_description(&mut caustica::format::SourceFiles::default(), Path::new("."))
+        .unwrap();
     desc.lights.push(LightDesc::Spot {
         position: Vec3::new(0.0, 2.0, 0.0),
         direction: Vec3::new(0.0, -1.0, 0.0),

@@ -5,7 +5,9 @@ use super::shown;
 use super::{check_photon_memory, load_scene, thread_pool};
 use crate::cli::RenderArgs;
 use crate::progress::Bars;
+use caustica::description::RenderHints;
 use caustica::film::ToneMap;
+use caustica::format::Format;
 use caustica::image_io::ImageFormat;
 use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
@@ -18,26 +20,49 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;
 
-/// The library's render options from the command line.
-pub fn config(args: &RenderArgs) -> Result<RenderConfig> {
+/// The library's render options: the scene's own settings (`hints`), then the command line's.
+pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
     let p = &args.progressive;
+    let scene = RenderConfig::for_scene(hints);
+    let model = p.model.as_deref().map(str::parse::<Model>).transpose()?;
+    let integrator = p.integrator.as_deref().map(str::parse).transpose()?;
+    // A model or integrator given on the command line replaces the scene's choice of both.
+    let (model, integrator) = if model.is_some() || integrator.is_some() {
+        (model, integrator)
+    } else {
+        (scene.model, scene.integrator)
+    };
+    // The scene's depth is for its own integrator; passes and photons for any physical one.
+    let depth = args.depth.or(if integrator == scene.integrator {
+        scene.depth
+    } else {
+        None
+    });
+    // The scene's samples per pixel are passes of a physical integrator; the course model has none.
+    let course = model == Some(Model::Course) || integrator == Some(IntegratorKind::Whitted);
+    // With only --width, the height follows the camera rather than the scene's film.
+    let height = args.height.or(if args.width.is_none() { scene.height } else { None });
     Ok(RenderConfig {
-        model: p.model.as_deref().map(str::parse::<Model>).transpose()?,
-        integrator: p.integrator.as_deref().map(str::parse).transpose()?,
-        width: args.width,
-        height: args.height,
+        model,
+        integrator,
+        width: args.width.unwrap_or(scene.width),
+        height,
         aa: args.aa,
-        depth: args.depth,
+        depth,
         seed: args.seed,
-        photons: args.photon.photons,
+        photons: args.photon.photons.unwrap_or(scene.photons),
         max_emitted: args.photon.max_emitted,
         photons_per_light: args.photon.photons_per_light.clone(),
         no_aim: args.photon.no_aim,
         k: args.k,
-        radius: args.radius,
+        radius: args.radius.or(scene.radius),
         cone_filter: args.cone_filter,
         no_estimate_reuse: args.no_estimate_reuse,
-        passes: p.passes.clone(),
+        passes: p.passes.clone().or(if p.time.is_none() && !course {
+            scene.passes
+        } else {
+            None
+        }),
         time: p.time,
         footprint: p.footprint,
         alpha: p.alpha,
@@ -53,19 +78,28 @@ pub fn config(args: &RenderArgs) -> Result<RenderConfig> {
 /// Runs the command; returns the exit code.
 pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let start = Instant::now();
-    let config = config(&args)?;
+    // Options are checked before the scene is read (physical formats assumed physical), then
+    // again with the scene's own settings.
+    let format = super::load_settings(&args.scene_args)?;
+    let physical_format = args
+        .scene
+        .as_deref()
+        .is_some_and(|p| matches!(format.read.format_of(p), Format::Pbrt | Format::Gltf));
+    let early = RenderHints {
+        physical: physical_format,
+        ..RenderHints::default()
+    };
+    let checked = config(&args, &early)?;
     let options = &args.progressive;
-    if config.integrator_kind()? != IntegratorKind::Path {
-        check_photon_memory(config.photon_total(), args.photon.max_memory)?;
+    if checked.integrator_kind()? != IntegratorKind::Path {
+        check_photon_memory(checked.photon_total(), args.photon.max_memory)?;
     }
-    let integrator = config.integrator()?;
-    let progressive = integrator.is_progressive();
-    let plan = config.plan()?;
-    if !progressive && options.partial.is_some() {
+    if !checked.integrator()?.is_progressive() && options.partial.is_some() {
         return Err(Error::InvalidSettings(
             "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
         ));
     }
+    checked.plan()?;
     if !options.exposure.is_finite() || options.exposure.abs() > 64.0 {
         return Err(Error::InvalidSettings(
             "--exposure must be a number of stops between -64 and 64".into(),
@@ -76,13 +110,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
             "--save-every must be a positive number of seconds".into(),
         ));
     }
-    // An image, unless only a partial file is asked for.
-    let output: Option<PathBuf> = match (&args.output, &options.partial) {
-        (Some(o), _) => Some(o.clone()),
-        (None, Some(_)) => None,
-        (None, None) => Some("caustica.png".into()),
-    };
-    if let Some(o) = &output {
+    if let Some(o) = &args.output {
         ImageFormat::from_path(o)?;
     }
     let pool = thread_pool(args.threads)?;
@@ -95,6 +123,25 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
 
     let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
     let scene = &loaded.scene;
+    let config = config(&args, scene.hints())?;
+    if config.integrator_kind()? != IntegratorKind::Path {
+        check_photon_memory(config.photon_total(), args.photon.max_memory)?;
+    }
+    let integrator = config.integrator()?;
+    let progressive = integrator.is_progressive();
+    let plan = config.plan()?;
+    if !progressive && options.partial.is_some() {
+        return Err(Error::InvalidSettings(
+            "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
+        ));
+    }
+    // An image, unless only a partial file is asked for; a pbrt-v4 scene may name its own.
+    let output: Option<PathBuf> = match (&args.output, &options.partial, &scene.hints().output) {
+        (Some(o), _, _) => Some(o.clone()),
+        (None, Some(_), _) => None,
+        (None, None, Some(named)) if ImageFormat::from_path(named).is_ok() => Some(named.clone()),
+        (None, None, _) => Some("caustica.png".into()),
+    };
     if !quiet {
         for warning in scene.warnings() {
             eprintln!("warning: {warning}");

@@ -91,7 +91,7 @@ pub fn is_closed(kind: &ShapeKind) -> bool {
     match kind {
         ShapeKind::Sphere | ShapeKind::Box | ShapeKind::Torus(_) | ShapeKind::Metaballs(_) | ShapeKind::Csg(_) => true,
         ShapeKind::Cone(cone) => cone.capped,
-        ShapeKind::Square => false,
+        ShapeKind::Square | ShapeKind::Disk { .. } => false,
     }
 }
 

@@ -1,6 +1,6 @@
 //! An analytic shape placed in the world by a transform.
 
-use super::{box_shape, cone::Cone, csg::Csg, metaballs::Metaballs, sphere, square, torus::Torus, LocalHit};
+use super::{box_shape, cone::Cone, csg::Csg, disk, metaballs::Metaballs, sphere, square, torus::Torus, LocalHit};
 use crate::math::{Aabb, Mat3, Mat4, Ray, Vec2, Vec3};
 
 /// The closed set of analytic shapes.
@@ -20,6 +20,11 @@ pub enum ShapeKind {
     Metaballs(std::sync::Arc<Metaballs>),
     /// A CSG solid whose leaves carry their own transforms (the shape's own is the identity).
     Csg(std::sync::Arc<Csg>),
+    /// The unit disc at z = 0 with a hole of radius `inner`.
+    Disk {
+        /// Radius of the hole (below 1).
+        inner: f32,
+    },
 }
 
 /// Options for how shapes are built from a scene file.
@@ -91,6 +96,7 @@ impl Shape {
             ShapeKind::Sphere => (Vec3::ZERO, 1.0),
             ShapeKind::Box => (Vec3::ZERO, 0.75f32.sqrt()),
             ShapeKind::Square => (Vec3::ZERO, 0.5f32.sqrt()),
+            ShapeKind::Disk { .. } => (Vec3::ZERO, 1.0),
             ShapeKind::Cone(cone) => {
                 let h = 0.5 * cone.height;
                 let r = cone.bottom_radius.max(cone.top_radius);
@@ -127,6 +133,7 @@ impl Shape {
             ShapeKind::Torus(torus) => torus.distance(p),
             ShapeKind::Metaballs(m) => m.distance_lower_bound(p),
             ShapeKind::Csg(_) => 0.0,
+            ShapeKind::Disk { inner } => disk::distance(p, *inner),
         };
         // Rounding in the transform: a relative margin on the object-space distance.
         d * (1.0 - 1e-4) - 1e-6 * (1.0 + p.abs().max_element()) <= r * self.object_stretch
@@ -156,6 +163,7 @@ impl Shape {
             ShapeKind::Torus(torus) => torus.intersect(&local, t_max, self.needs_uv),
             ShapeKind::Metaballs(m) => m.intersect(&local, t_max),
             ShapeKind::Csg(_) => return None,
+            ShapeKind::Disk { inner } => disk::intersect(&local, t_max, *inner),
         }?;
         let normal = (self.normal_to_world * hit.normal).normalize_or_zero();
         if normal == Vec3::ZERO {
@@ -200,6 +208,7 @@ impl ShapeKind {
             ShapeKind::Torus(torus) => torus.bounds(),
             ShapeKind::Metaballs(m) => m.bounds(),
             ShapeKind::Csg(c) => c.bounds(),
+            ShapeKind::Disk { .. } => disk::bounds(),
         }
     }
 }
@@ -349,6 +358,7 @@ mod tests {
             ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
             ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
             ShapeKind::Torus(Torus { major: 1.0, minor: 0.3 }),
+            ShapeKind::Disk { inner: 0.4 },
         ];
         let transforms = [
             Mat4::IDENTITY,
@@ -396,6 +406,7 @@ mod tests {
             ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
             ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
             ShapeKind::Torus(Torus { major: 1.0, minor: 0.3 }),
+            ShapeKind::Disk { inner: 0.0 },
         ];
         let transforms = [
             Mat4::from_scale(Vec3::new(20.0, 20.0, 0.5)),

@@ -10,6 +10,7 @@ use super::radius::InitialRadius;
 use super::session::{PassPlan, RenderOptions};
 use super::whitted::WhittedSettings;
 use super::{Integrator, WhittedOptions};
+use crate::description::{IntegratorHint, RenderHints};
 use crate::error::{Error, Result};
 use crate::photon::{EstimateSettings, PhotonSettings};
 use std::str::FromStr;
@@ -155,6 +156,41 @@ impl Default for RenderConfig {
 }
 
 impl RenderConfig {
+    /// The defaults with a scene file's own settings applied (pbrt-v4's `Film`, `Sampler` and
+    /// `Integrator`): a front end starts here and then sets the options its user gave.
+    ///
+    /// pbrt's `maxdepth` N counts scattering events, so its paths have N + 1 segments: `path`
+    /// gets depth N and `ppm` N − 1 (their depths count N + 1 and N + 2 segments,
+    /// docs/radiometry.md).
+    pub fn for_scene(hints: &RenderHints) -> RenderConfig {
+        let mut config = RenderConfig::default();
+        if let Some(w) = hints.width {
+            config.width = w;
+        }
+        config.height = hints.height;
+        if hints.physical {
+            config.model = Some(Model::Physical);
+            config.integrator = Some(match hints.integrator {
+                Some(IntegratorHint::Ppm) => IntegratorKind::Ppm,
+                Some(IntegratorHint::Path) | None => IntegratorKind::Path,
+            });
+        }
+        if let Some(n) = hints.max_depth {
+            config.depth = Some(match config.integrator {
+                Some(IntegratorKind::Path) => n,
+                _ => n.saturating_sub(1).max(1),
+            });
+        }
+        if let Some(n) = hints.samples.filter(|&n| n > 0) {
+            config.passes = Some(n.to_string());
+        }
+        if let Some(n) = hints.photons_per_pass {
+            config.photons = n;
+        }
+        config.radius = hints.radius;
+        config
+    }
+
     /// The integrator `--model` and `--integrator` ask for: whitted for the course model (the
     /// default), ppm for the physical model unless named.
     pub fn integrator_kind(&self) -> Result<IntegratorKind> {

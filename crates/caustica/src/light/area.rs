@@ -110,7 +110,7 @@ impl AreaLight {
             let closed = match shape.kind {
                 ShapeKind::Sphere | ShapeKind::Box => true,
                 ShapeKind::Cone(cone) => cone.capped,
-                ShapeKind::Square => false,
+                ShapeKind::Square | ShapeKind::Disk { .. } => false,
                 ShapeKind::Torus(_) | ShapeKind::Metaballs(_) | ShapeKind::Csg(_) => true,
             };
             let absorbs = [
@@ -359,6 +359,7 @@ fn object_area(kind: &ShapeKind) -> f32 {
         ShapeKind::Sphere => 4.0 * PI,
         ShapeKind::Box => 6.0,
         ShapeKind::Square => 1.0,
+        ShapeKind::Disk { inner } => PI * (1.0 - inner * inner),
         ShapeKind::Cone(cone) => {
             let (side, bottom, top) = cone_areas(cone);
             side + bottom + top
@@ -426,6 +427,12 @@ fn sample_object(kind: &ShapeKind, u_pick: f32, u: Vec2) -> Option<(Vec3, Vec3)>
         }
         ShapeKind::Square => Some((Vec3::new(u.x - 0.5, u.y - 0.5, 0.0), Vec3::Z)),
         ShapeKind::Torus(_) | ShapeKind::Metaballs(_) | ShapeKind::Csg(_) => None,
+        ShapeKind::Disk { inner } => {
+            // Radius with density ∝ r between the hole and the rim.
+            let r = (inner * inner + u.x * (1.0 - inner * inner)).sqrt();
+            let (s, c) = (2.0 * PI * u.y).sin_cos();
+            Some((Vec3::new(r * c, r * s, 0.0), Vec3::Z))
+        }
         ShapeKind::Cone(cone) => {
             let (side, bottom, top) = cone_areas(cone);
             let total = side + bottom + top;
@@ -468,6 +475,23 @@ mod tests {
     use super::*;
     use crate::scene::build::test_scene as scene;
 
+    fn disk_scene() -> crate::scene::Scene {
+        use crate::description::*;
+        let desc = SceneDescription {
+            objects: vec![ObjectDesc {
+                shape: ShapeDesc::Disk { inner: 0.5 },
+                world_from_object: glam::Mat4::from_scale(Vec3::new(2.0, 3.0, 1.0)),
+                material: MaterialDesc {
+                    emissive: Param::grey(1.0),
+                    ..MaterialDesc::default()
+                },
+                span: 0..0,
+            }],
+            ..SceneDescription::default()
+        };
+        crate::scene::build(&desc, &Default::default()).unwrap()
+    }
+
     /// Σ 1/pdf over samples estimates the area; it must match the closed form for each kind
     /// under a non-uniform scale (where a similarity-only formula would be wrong).
     #[test]
@@ -476,6 +500,7 @@ mod tests {
             ("scale(2, sphere { material = { emissive = (1,1,1); } })", 16.0 * PI),
             ("scale(2, 3, 1, box { material = { emissive = (1,1,1); } })", 2.0 * (6.0 + 2.0 + 3.0)),
             ("scale(2, 3, 1, square { material = { emissive = (1,1,1); } })", 6.0),
+            ("disk", 6.0 * PI * (1.0 - 0.25)),
             (
                 "scale(2, cylinder { capped = true; material = { emissive = (1,1,1); } })",
                 // radius 2, height 2: side 2π·2·2, caps 2·π·4
@@ -487,7 +512,12 @@ mod tests {
             ),
         ];
         for (object, exact) in cases {
-            let s = scene(object);
+            let s = if object == "disk" {
+                // Radius 1 with a hole of 0.5, stretched to 2 × 3.
+                disk_scene()
+            } else {
+                scene(object)
+            };
             let lights = AreaLight::collect(&s);
             assert_eq!(lights.len(), 1, "{object}");
             let light = &lights[0];

@@ -161,8 +161,110 @@ pub fn uv_to_direction(uv: Vec2) -> Vec3 {
     Vec3::new(sin_t * sin_p, cos_t, -sin_t * cos_p)
 }
 
+/// The direction in an equal-area octahedral square map's frame (+z up) at square coordinates
+/// `uv` ∈ [0, 1]² (Clarberg's equal-area mapping, the layout of pbrt-v4's sky maps).
+pub fn equal_area_square_to_direction(uv: Vec2) -> Vec3 {
+    let (u, v) = (2.0 * uv.x - 1.0, 2.0 * uv.y - 1.0);
+    let (up, vp) = (u.abs(), v.abs());
+    let signed = 1.0 - (up + vp);
+    let r = 1.0 - signed.abs();
+    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * PI / 4.0;
+    let z = (1.0 - r * r).copysign(signed);
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    Vec3::new(phi.cos().copysign(u) * s, phi.sin().copysign(v) * s, z)
+}
+
+/// The inverse of [`equal_area_square_to_direction`]: square coordinates of a unit direction.
+pub fn direction_to_equal_area_square(d: Vec3) -> Vec2 {
+    let r = (1.0 - d.z.abs().min(1.0)).sqrt();
+    let phi = d.y.abs().atan2(d.x.abs());
+    let diff = r * (4.0 * phi / PI - 1.0);
+    let sum = if d.z >= 0.0 { r } else { 2.0 - r };
+    let (vp, up) = ((sum + diff) * 0.5, (sum - diff) * 0.5);
+    Vec2::new((up.copysign(d.x) + 1.0) * 0.5, (vp.copysign(d.y) + 1.0) * 0.5)
+}
+
+/// The frame turn from a latitude–longitude map's frame (+y up, centre towards −z) to an
+/// equal-area map's (+z up, +x at the lat-long centre): what [`equal_area_to_lat_long`] resamples by.
+pub fn equal_area_from_lat_long() -> Mat3 {
+    Mat3::from_cols(
+        Vec3::new(0.0, -1.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+        Vec3::new(-1.0, 0.0, 0.0),
+    )
+}
+
+/// An equal-area octahedral square map resampled to latitude–longitude (twice as wide as
+/// tall, as many rows as the square has), bilinearly, with rows from the top as stored.
+pub fn equal_area_to_lat_long(square: &Texture) -> Texture {
+    let n = square.width().max(square.height()).clamp(1, 8192);
+    let (w, h) = (2 * n, n);
+    let frame = equal_area_from_lat_long();
+    let fetch = |x: f32, y: f32| {
+        let (sw, sh) = (square.width(), square.height());
+        let x = (x * sw as f32 - 0.5).clamp(0.0, (sw - 1) as f32);
+        let y = (y * sh as f32 - 0.5).clamp(0.0, (sh - 1) as f32);
+        let (x0, y0) = (x.floor() as usize, y.floor() as usize);
+        let (x1, y1) = ((x0 + 1).min(sw - 1), (y0 + 1).min(sh - 1));
+        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+        let top = square.texel(x0, y0).lerp(square.texel(x1, y0), fx);
+        let bottom = square.texel(x0, y1).lerp(square.texel(x1, y1), fx);
+        top.lerp(bottom, fy)
+    };
+    let mut texels = Vec::with_capacity(w * h);
+    for row in 0..h {
+        for column in 0..w {
+            let uv = Vec2::new((column as f32 + 0.5) / w as f32, (row as f32 + 0.5) / h as f32);
+            let st = direction_to_equal_area_square(frame * uv_to_direction(uv));
+            texels.push(fetch(st.x, st.y));
+        }
+    }
+    Texture::new(w, h, texels).expect("sizes match")
+}
+
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn equal_area_mapping_round_trips_and_keeps_areas() {
+        let mut rng = Rng::new(5, 0);
+        for _ in 0..2000 {
+            let d = sample_uniform_sphere(rng.uniform2());
+            let back = equal_area_square_to_direction(direction_to_equal_area_square(d));
+            assert!((back - d).length() < 1e-3, "{d:?} -> {back:?}");
+        }
+        // Equal area: uniform square points land uniformly on the sphere (mean z 0, mean z² 1/3).
+        let (mut z, mut z2) = (0.0f64, 0.0f64);
+        for _ in 0..20_000 {
+            let d = equal_area_square_to_direction(rng.uniform2());
+            z += d.z as f64;
+            z2 += (d.z * d.z) as f64;
+        }
+        assert!((z / 20_000.0).abs() < 0.01 && (z2 / 20_000.0 - 1.0 / 3.0).abs() < 0.01);
+        // The centre is +z, the corners −z.
+        assert!((equal_area_square_to_direction(Vec2::splat(0.5)) - Vec3::Z).length() < 1e-6);
+        assert!((equal_area_square_to_direction(Vec2::ZERO) + Vec3::Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn resampled_sky_keeps_its_bright_spot_where_it_was() {
+        // A square map bright only around the direction (1, 0, 0) of its frame.
+        let n = 64;
+        let texels = (0..n * n)
+            .map(|i| {
+                let uv = Vec2::new(((i % n) as f32 + 0.5) / n as f32, ((i / n) as f32 + 0.5) / n as f32);
+                let d = equal_area_square_to_direction(uv);
+                Vec3::splat(if d.x > 0.95 { 1.0 } else { 0.0 })
+            })
+            .collect();
+        let lat_long = equal_area_to_lat_long(&Texture::new(n, n, texels).unwrap());
+        // The lat-long map's frame sees that direction at frame⁻¹ · (1, 0, 0).
+        let d = equal_area_from_lat_long().transpose() * Vec3::X;
+        let uv = direction_to_uv(d);
+        let (x, y) = ((uv.x * 128.0) as usize, (uv.y * 64.0) as usize);
+        assert_eq!(lat_long.texel(x.min(127), y.min(63)), Vec3::ONE);
+        assert_eq!(lat_long.texel(0, 32), Vec3::ZERO);
+    }
     use super::*;
     use crate::sampling::Rng;
 

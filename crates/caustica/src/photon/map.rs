@@ -289,7 +289,7 @@ impl PhotonMap {
         let mut sum = Spectrum::ZERO;
         self.tree.for_each_within(&self.photons, point, r * r, |slot, _| {
             let photon = &self.photons[slot as usize];
-            if accepts(photon, point, n, r) {
+            if accepts(photon, point, n, r, bsdf.transmits_smoothly()) {
                 sum += bsdf.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
             }
         });
@@ -325,7 +325,7 @@ impl PhotonMap {
             let skip = usize::from(neighbors.len() == k && k > 1);
             for nb in neighbors.iter().skip(skip) {
                 let photon = &self.photons[nb.slot as usize];
-                if accepts(photon, point, n, r) {
+                if accepts(photon, point, n, r, bsdf.transmits_smoothly()) {
                     sum += bsdf.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
                 }
             }
@@ -352,7 +352,11 @@ fn photon_power(photon: &Photon, camera_dispersed: bool) -> Spectrum {
     }
 }
 
+/// Whether a photon counts at a receiver: near its tangent plane, on a surface facing its way —
+/// or, where light passes diffusely through (`both_faces`), facing either way.
 #[inline]
-fn accepts(photon: &Photon, point: Vec3, n: Vec3, r: f32) -> bool {
-    (photon.position - point).dot(n).abs() <= MAX_PLANE_DISTANCE * r && photon.normal().dot(n) >= MIN_NORMAL_COSINE
+fn accepts(photon: &Photon, point: Vec3, n: Vec3, r: f32, both_faces: bool) -> bool {
+    let cos = photon.normal().dot(n);
+    (photon.position - point).dot(n).abs() <= MAX_PLANE_DISTANCE * r
+        && (cos >= MIN_NORMAL_COSINE || both_faces && -cos >= MIN_NORMAL_COSINE)
 }

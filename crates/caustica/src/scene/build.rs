@@ -88,6 +88,7 @@ fn build_objects(
             triangles: builder.triangles,
             triangle_refs: builder.triangle_refs,
             warnings,
+            hints: desc.hints.clone(),
         },
         progress,
     ))
@@ -162,6 +163,7 @@ fn convert_light(light: &LightDesc, warnings: &mut Vec<String>) -> Result<Option
             color,
             map,
             rotation,
+            equal_area,
             span,
         } => {
             let texture = match map {
@@ -178,7 +180,14 @@ fn convert_light(light: &LightDesc, warnings: &mut Vec<String>) -> Result<Option
                     .with_help("environment maps are EXR or Radiance HDR images in latitude–longitude layout, resolved against the scene file's folder")
                 })?),
             };
-            Some(Light::Environment(Environment::new(*color, texture, *rotation)))
+            if *equal_area {
+                // pbrt-v4's equal-area square, resampled to the latitude–longitude layout.
+                let texture = texture.map(|t| crate::light::environment::equal_area_to_lat_long(&t));
+                let rotation = *rotation * crate::light::environment::equal_area_from_lat_long();
+                Some(Light::Environment(Environment::new(*color, texture, rotation)))
+            } else {
+                Some(Light::Environment(Environment::new(*color, texture, *rotation)))
+            }
         }
         LightDesc::Soft {
             shape,
@@ -264,7 +273,7 @@ impl Builder {
                 .any(|&id| self.materials[id as usize].is_emissive())
             {
                 warnings.push(
-                    "an emissive CSG solid glows but lights nothing in the physical model (only spheres, boxes, squares, cylinders, cones and meshes are sampled as area lights)".into(),
+                    "an emissive CSG solid glows but lights nothing in the physical model (only spheres, boxes, squares, discs, cylinders, cones and meshes are sampled as area lights)".into(),
                 );
             }
             let kind = ShapeKind::Csg(std::sync::Arc::new(leaves));
@@ -282,11 +291,11 @@ impl Builder {
         };
         if !matches!(
             kind,
-            ShapeKind::Sphere | ShapeKind::Box | ShapeKind::Square | ShapeKind::Cone(_)
+            ShapeKind::Sphere | ShapeKind::Box | ShapeKind::Square | ShapeKind::Cone(_) | ShapeKind::Disk { .. }
         ) && material_is_emissive(&object.material)
         {
             warnings.push(format!(
-                "an emissive {} glows but lights nothing in the physical model (only spheres, boxes, squares, cylinders, cones and meshes are sampled as area lights)",
+                "an emissive {} glows but lights nothing in the physical model (only spheres, boxes, squares, discs, cylinders, cones and meshes are sampled as area lights)",
                 crate::scene::summary::shape_name(&kind)
             ));
         }
@@ -423,6 +432,10 @@ impl Builder {
             shininess: self.channel(&desc.shininess)?,
             index: self.channel(&desc.index)?,
             abbe: desc.abbe,
+            physical: match &desc.physical {
+                Some(p) => Some(p.try_map(|param| self.channel(param))?),
+                None => None,
+            },
         };
         let key = MaterialKey(
             [
@@ -441,6 +454,7 @@ impl Builder {
                 Channel::Texture(i) => [1, *i, 0, 0],
             })
             .chain([material.abbe.map_or(0, f32::to_bits)])
+            .chain(format!("{:?}", material.physical).bytes().map(u32::from))
             .collect(),
         );
         if let Some(&id) = self.material_ids.get(&key) {
@@ -455,6 +469,11 @@ impl Builder {
     fn channel(&mut self, param: &Param) -> Result<Channel, ParseError> {
         match param {
             Param::Constant(c) => Ok(Channel::Constant(*c)),
+            Param::Checkerboard { even, odd, scale } => {
+                let id = self.textures.len() as u32;
+                self.textures.push(checkerboard(*even, *odd, *scale));
+                Ok(Channel::Texture(id))
+            }
             Param::Texture { path, span } => {
                 if let Some(&id) = self.texture_ids.get(path) {
                     return Ok(Channel::Texture(id));
@@ -486,6 +505,9 @@ fn shape_kind(object: &ObjectDesc, settings: &ShapeSettings) -> Result<ShapeKind
         ShapeDesc::Box => ShapeKind::Box,
         ShapeDesc::Square => ShapeKind::Square,
         ShapeDesc::Cylinder { capped } => ShapeKind::cylinder(*capped),
+        ShapeDesc::Disk { inner } => ShapeKind::Disk {
+            inner: inner.clamp(0.0, 0.999),
+        },
         ShapeDesc::Cone {
             height,
             bottom_radius,
@@ -538,6 +560,28 @@ fn shape_kind(object: &ObjectDesc, settings: &ShapeSettings) -> Result<ShapeKind
         }
         ShapeDesc::Trimesh(_) | ShapeDesc::Csg(_) => unreachable!("meshes and CSG solids are built apart"),
     })
+}
+
+/// A checkerboard as an image over [0, 1]² (texture lookups clamp there): eight texels a
+/// cell, at most 4096 a side, the cell at the origin `even`.
+fn checkerboard(even: Vec3, odd: Vec3, scale: glam::Vec2) -> Texture {
+    let cells = |s: f32| (s.abs().ceil() as usize).clamp(1, 512);
+    let (cu, cv) = (cells(scale.x), cells(scale.y));
+    let (w, h) = (cu * 8, cv * 8);
+    let texels = (0..h)
+        .flat_map(|row| (0..w).map(move |col| (col, row)))
+        .map(|(col, row)| {
+            // Rows are stored from the top; v grows upwards.
+            let u = (col as f32 + 0.5) / w as f32 * scale.x;
+            let v = (1.0 - (row as f32 + 0.5) / h as f32) * scale.y;
+            if (u.floor() as i64 + v.floor() as i64).rem_euclid(2) == 0 {
+                even
+            } else {
+                odd
+            }
+        })
+        .collect();
+    Texture::new(w, h, texels).expect("sizes match")
 }
 
 fn singular(span: &Span) -> ParseError {

@@ -235,6 +235,14 @@ fn describe(kind: &ShapeKind) -> (String, String) {
         ShapeKind::Torus(t) => ("torus".into(), format!("radii {} and {}", t.major, t.minor)),
         ShapeKind::Metaballs(m) => ("metaballs".into(), format!("{} balls", m.balls().len())),
         ShapeKind::Csg(c) => ("csg".into(), format!("{} solids", c.materials().len())),
+        ShapeKind::Disk { inner } => (
+            "disk".into(),
+            if *inner > 0.0 {
+                format!("hole {inner}")
+            } else {
+                String::new()
+            },
+        ),
         ShapeKind::Cone(c) => {
             let caps = if c.capped { "capped" } else { "open" };
             if c.bottom_radius == c.top_radius && c.height == 1.0 && c.bottom_radius == 1.0 {

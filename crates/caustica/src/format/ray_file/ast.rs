@@ -8,8 +8,12 @@
 
 use crate::description::{CameraDesc, SceneDescription};
 pub use crate::description::{LightDesc, MaterialDesc, ObjectDesc, Param, ShapeDesc, TrimeshDesc};
+use crate::error::ParseError;
 pub use crate::error::Span;
+use crate::format::obj::ObjMesh;
+use crate::format::{ply, SourceFiles};
 use glam::{Quat, Vec3};
+use std::path::Path;
 
 /// Which of the two course readers the file was written for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -47,6 +51,21 @@ pub struct RayScene {
     pub objects: Vec<ObjectDesc>,
     /// Non-fatal remarks (ignored dictionary keys, etc.), each with a span.
     pub warnings: Vec<(String, Span)>,
+    /// Meshes named by `file` (a caustica extension), read when the scene is lowered.
+    pub mesh_files: Vec<MeshFile>,
+}
+
+/// A `polymesh { file = "…"; }`: an OBJ or PLY file in place of the mesh's lists.
+#[derive(Clone, Debug)]
+pub struct MeshFile {
+    /// The placeholder object it replaces.
+    pub object: usize,
+    /// The file, resolved against the scene's folder.
+    pub path: std::path::PathBuf,
+    /// Where the file is named.
+    pub span: Span,
+    /// Whether the block gives its own material (otherwise an OBJ's MTL materials apply).
+    pub material_given: bool,
 }
 
 /// How the camera basis is formed from `viewdir` and `updir`.
@@ -84,15 +103,54 @@ pub struct RayCamera {
 }
 
 impl RayScene {
-    /// The format-neutral description of the file.
-    pub fn into_description(self) -> SceneDescription {
-        SceneDescription {
+    /// The format-neutral description of the file; meshes named by `file` are read now, each
+    /// added to `files` (their errors point into them).
+    pub fn into_description(self, files: &mut SourceFiles, scene_dir: &Path) -> Result<SceneDescription, ParseError> {
+        let mut objects = self.objects;
+        let mut warnings = self.warnings;
+        // From the last, so the earlier placeholders keep their places.
+        for mesh in self.mesh_files.iter().rev() {
+            let placeholder = objects[mesh.object].clone();
+            let is_ply = mesh.path.extension().is_some_and(|e| e.eq_ignore_ascii_case("ply"));
+            let replacement = if is_ply {
+                let ply = ply::read(files, &mesh.path, &mesh.span)?;
+                warnings.extend(ply.warnings);
+                let n = ply.points.len();
+                let desc = TrimeshDesc {
+                    points: ply.points,
+                    triangles: ply.triangles,
+                    normals: ply.normals.filter(|v| v.len() == n),
+                    materials: None,
+                    uvs: ply.uvs.filter(|v| v.len() == n),
+                };
+                vec![ObjectDesc {
+                    shape: ShapeDesc::Trimesh(Box::new(desc)),
+                    ..placeholder.clone()
+                }]
+            } else {
+                let (base, text) = files.read_text(&mesh.path, &mesh.span)?;
+                let text = text.to_string();
+                let dir = mesh.path.parent().unwrap_or(scene_dir).to_path_buf();
+                let obj = ObjMesh::parse(files, base, &text, &dir)?;
+                warnings.extend(obj.warnings.iter().cloned());
+                let material = mesh.material_given.then_some(&placeholder.material);
+                obj.objects(
+                    placeholder.world_from_object,
+                    material,
+                    &placeholder.span,
+                    &mut warnings,
+                )
+            };
+            objects.splice(mesh.object..mesh.object + 1, replacement);
+        }
+        Ok(SceneDescription {
             camera: self.camera.as_ref().map(RayCamera::lower),
             lights: self.lights,
             ambient: self.ambient,
-            objects: self.objects,
-            warnings: self.warnings,
-        }
+            objects,
+            warnings,
+            hints: Default::default(),
+        })
     }
 }
 
@@ -138,6 +196,7 @@ impl RayCamera {
             up,
             height: h,
             aspect_ratio: aspect,
+            right: None,
             span: self.span.clone(),
         }
     }

@@ -58,6 +58,7 @@ pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>, dialect: Di
             ambient: Vec3::ZERO,
             objects: Vec::new(),
             warnings: Vec::new(),
+            mesh_files: Vec::new(),
         },
     };
     loop {

@@ -5,6 +5,7 @@ use super::ast::*;
 use super::{parse, ParseOptions};
 use crate::description::{SkyboxLayout, SoftShapeDesc};
 use crate::error::line_col;
+use crate::format::SourceFiles;
 use crate::ParseError;
 use glam::Vec3;
 use std::path::{Path, PathBuf};
@@ -41,8 +42,14 @@ fn cr_only_files_read_like_their_lf_versions() {
     let lf = read(COMMENTED);
     let cr = read(&COMMENTED.replace('\n', "\r"));
     assert_eq!(
-        format!("{:?}", lf.into_description()),
-        format!("{:?}", cr.into_description())
+        format!(
+            "{:?}",
+            lf.into_description(&mut SourceFiles::default(), Path::new("")).unwrap()
+        ),
+        format!(
+            "{:?}",
+            cr.into_description(&mut SourceFiles::default(), Path::new("")).unwrap()
+        )
     );
     let broken = format!("{HEADER}{}", COMMENTED.replace("(3, 0, 6)", "(3, 0 6)")).replace('\n', "\r");
     let err = parse(&broken, Path::new(""), &ParseOptions::default()).expect_err("a missing comma");

@@ -81,6 +81,7 @@ const MESH_FIELDS: &[&str] = &[
     "materials",
     "gennormals",
     "texture_uv",
+    "file",
 ];
 
 /// Parses a whole dialect-T file.
@@ -99,6 +100,7 @@ pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<R
             ambient: Vec3::ZERO,
             objects: Vec::new(),
             warnings: Vec::new(),
+            mesh_files: Vec::new(),
         },
     };
     parser.file()?;
@@ -763,6 +765,7 @@ impl<'a> Parser<'a> {
             color: color.unwrap_or(Vec3::ONE),
             map,
             rotation: glam::Mat3::IDENTITY,
+            equal_area: false,
             span,
         });
         Ok(())
@@ -1078,10 +1081,18 @@ impl<'a> Parser<'a> {
     fn trimesh(&mut self, keyword: &Token) -> Result<(), ParseError> {
         let mut material: Option<MaterialDesc> = None;
         let mut mesh = MeshInput::default();
+        let mut file: Option<(std::path::PathBuf, Span)> = None;
+        let scene_dir = self.scene_dir;
         self.block(
             keyword,
             |p, _, key| {
                 match key {
+                    "file" => {
+                        p.key_equals()?;
+                        let (name, span) = p.identifier("(the OBJ or PLY file, in quotes) for `file`")?;
+                        file = Some((scene_dir.join(name), span));
+                        p.cur.eat(Tok::Semicolon);
+                    }
                     "material" => {
                         let base = p.default_material.clone();
                         material = Some(p.material_stmt(&base)?);
@@ -1158,6 +1169,24 @@ impl<'a> Parser<'a> {
         )?;
         let span = keyword.span.clone();
         let block_span = keyword.span.start..self.cur.prev_end();
+        if let Some((path, file_span)) = file {
+            if !mesh.points.is_empty() || !mesh.faces.is_empty() {
+                return Err(ParseError::new(
+                    "a mesh read from a `file` takes no `points` or `faces`",
+                    block_span,
+                ));
+            }
+            let given = material.is_some();
+            let material = material.unwrap_or_else(|| self.default_material.clone());
+            self.push_object(ShapeDesc::Trimesh(Box::default()), material, span);
+            self.scene.mesh_files.push(super::ast::MeshFile {
+                object: self.scene.objects.len() - 1,
+                path,
+                span: file_span,
+                material_given: given,
+            });
+            return Ok(());
+        }
         if let Some(desc) = trimesh::finish(mesh, &block_span, &mut self.scene.warnings)? {
             let material = material.unwrap_or_else(|| self.default_material.clone());
             self.push_object(ShapeDesc::Trimesh(Box::new(desc)), material, span);

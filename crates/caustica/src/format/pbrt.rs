@@ -1,0 +1,1624 @@
+//! A subset of pbrt-v4's scene format (docs/scene-formats.md says which): directives are read
+//! one by one into a graphics state (transform, material, area light) and every shape, light
+//! and the camera are lowered into the format-neutral description.
+//!
+//! pbrt's camera space is left-handed (x right, y up, +z forward): the camera is built from the
+//! columns of its world-from-camera matrix — right, up and forward as the file places them —
+//! rather than recomputing "right" with a cross product, so images are not mirrored. Everything
+//! else (points, matrices, rotations) reads the same in either convention.
+//!
+//! Directives and types caustica does not render give a warning naming file, line and column,
+//! and reading goes on; malformed input is an error.
+
+mod lexer;
+mod params;
+mod spectra;
+#[cfg(test)]
+mod tests;
+
+use self::lexer::{Kind, Lexer, Token};
+use self::params::{Params, Spectrum, Values};
+use super::{ply, SceneSource, SourceFiles};
+use crate::description::{
+    CameraDesc, IntegratorHint, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial, SceneDescription,
+    ShapeDesc, TrimeshDesc,
+};
+use crate::error::{ParseError, Result, Span};
+use crate::progress::Progress;
+use glam::{Mat3, Mat4, Vec2, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+/// Include and Import nest at most this deep (a file including itself is caught here).
+const MAX_INCLUDE_DEPTH: usize = 32;
+/// Attribute blocks nest at most this deep.
+const MAX_NESTING: usize = 10_000;
+/// Largest mesh (vertices or indices) accepted from a parameter list.
+const MAX_MESH_VALUES: usize = 1 << 28;
+
+/// Reads a pbrt-v4 file (and the files it includes) into a scene description.
+pub fn read(path: &Path, text: String, dir: &Path, progress: &dyn Progress) -> Result<SceneSource> {
+    progress.start("parse", text.len() as u64);
+    let len = text.len() as u64;
+    let mut files = SourceFiles::new(path, text.clone());
+    let result = Reader::new(&mut files, dir, text).and_then(|r| r.run());
+    progress.advance(len);
+    progress.finish();
+    match result {
+        Ok(description) => Ok(SceneSource::new(files, description)),
+        Err(e) => Err(files.error(e)),
+    }
+}
+
+/// A material as the graphics state holds it: the description, or a name to resolve.
+#[derive(Clone, Debug)]
+enum CurrentMaterial {
+    Desc(Box<MaterialDesc>),
+    /// No material (pbrt's `interface`): a boundary between media, not drawn.
+    Interface,
+}
+
+/// `AreaLightSource "diffuse"`: radiance and sides.
+#[derive(Clone, Debug)]
+struct AreaLight {
+    radiance: Vec3,
+    power: Option<f32>,
+    twosided: bool,
+}
+
+#[derive(Clone, Debug)]
+struct GraphicsState {
+    ctm: Mat4,
+    material: CurrentMaterial,
+    area_light: Option<AreaLight>,
+    reverse_orientation: bool,
+}
+
+/// One entry of the attribute stack.
+struct Saved {
+    state: GraphicsState,
+    /// Where the block opened, for an unclosed block's warning.
+    span: Span,
+    /// Only the transform (`TransformBegin`).
+    transform_only: bool,
+}
+
+/// A texture by name: what a material slot can refer to.
+#[derive(Clone, Debug)]
+enum TextureValue {
+    Param(Param),
+    Float(f32),
+}
+
+/// One open file: its tokens and, for `Import`, the state to restore at its end.
+struct Open {
+    lexer: Lexer,
+    restore: Option<(GraphicsState, usize)>,
+}
+
+struct Reader<'f> {
+    files: &'f mut SourceFiles,
+    dir: PathBuf,
+    open: Vec<Open>,
+    peeked: Option<Token>,
+    /// States to restore from Imports whose file has ended, applied before the next directive
+    /// (the last directive inside may have peeked past the end).
+    ended_imports: Vec<(GraphicsState, usize)>,
+    state: GraphicsState,
+    stack: Vec<Saved>,
+    named_systems: HashMap<String, Mat4>,
+    named_materials: HashMap<String, MaterialDesc>,
+    textures: HashMap<String, TextureValue>,
+    instances: HashMap<String, Vec<ObjectDesc>>,
+    defining: Option<(String, Vec<ObjectDesc>, Span)>,
+    in_world: bool,
+    camera: Option<(Params, Mat4, Span)>,
+    film: Option<Params>,
+    desc: SceneDescription,
+    /// Warnings given once per kind.
+    said: std::collections::HashSet<String>,
+}
+
+impl<'f> Reader<'f> {
+    fn new(files: &'f mut SourceFiles, dir: &Path, text: String) -> Result<Reader<'f>, ParseError> {
+        let lexer = Lexer::new(text, 0);
+        let state = GraphicsState {
+            ctm: Mat4::IDENTITY,
+            material: CurrentMaterial::Desc(Box::new(diffuse(Param::grey(0.5)))),
+            area_light: None,
+            reverse_orientation: false,
+        };
+        let mut desc = SceneDescription::default();
+        desc.hints.physical = true;
+        Ok(Reader {
+            files,
+            dir: dir.to_path_buf(),
+            open: vec![Open { lexer, restore: None }],
+            peeked: None,
+            ended_imports: Vec::new(),
+            state,
+            stack: Vec::new(),
+            named_systems: HashMap::new(),
+            named_materials: HashMap::new(),
+            textures: HashMap::new(),
+            instances: HashMap::new(),
+            defining: None,
+            in_world: false,
+            camera: None,
+            film: None,
+            desc,
+            said: Default::default(),
+        })
+    }
+
+    fn warn(&mut self, message: impl Into<String>, span: Span) {
+        self.desc.warnings.push((message.into(), span));
+    }
+
+    /// A warning given only the first time its `key` comes up.
+    fn warn_once(&mut self, key: &str, message: impl Into<String>, span: Span) {
+        if self.said.insert(key.to_string()) {
+            self.warn(message, span);
+        }
+    }
+
+    // ---- tokens ------------------------------------------------------------------------------
+
+    fn next(&mut self) -> Result<Option<Token>, ParseError> {
+        if let Some(t) = self.peeked.take() {
+            return Ok(Some(t));
+        }
+        loop {
+            let Some(top) = self.open.last_mut() else {
+                return Ok(None);
+            };
+            if let Some(t) = top.lexer.next()? {
+                return Ok(Some(t));
+            }
+            let done = self.open.pop().expect("checked above");
+            if self.open.is_empty() {
+                self.open.push(done);
+                return Ok(None);
+            }
+            if let Some(restore) = done.restore {
+                // The end of an Import: its state changes do not leak out.
+                self.ended_imports.push(restore);
+            }
+        }
+    }
+
+    fn peek(&mut self) -> Result<Option<&Token>, ParseError> {
+        if self.peeked.is_none() {
+            self.peeked = self.next()?;
+        }
+        Ok(self.peeked.as_ref())
+    }
+
+    fn end_span(&self) -> Span {
+        self.open.last().map_or(0..0, |o| o.lexer.end_span())
+    }
+
+    fn expect(&mut self, kind: Kind, what: &str, after: &Token) -> Result<Token, ParseError> {
+        match self.next()? {
+            Some(t) if t.kind == kind => Ok(t),
+            Some(t) => Err(ParseError::new(format!("`{}` expects {what} here", after.text), t.span)),
+            None => Err(ParseError::new(
+                format!("the file ends where `{}` expects {what}", after.text),
+                self.end_span(),
+            )),
+        }
+    }
+
+    fn string_arg(&mut self, after: &Token) -> Result<Token, ParseError> {
+        self.expect(Kind::Str, "a quoted string", after)
+    }
+
+    fn number(&mut self, after: &Token) -> Result<f32, ParseError> {
+        let t = self.expect(Kind::Word, "a number", after)?;
+        parse_number(&t)
+    }
+
+    fn numbers<const N: usize>(&mut self, after: &Token) -> Result<[f32; N], ParseError> {
+        let mut out = [0.0; N];
+        for v in &mut out {
+            *v = self.number(after)?;
+        }
+        Ok(out)
+    }
+
+    /// Numbers in brackets (`Transform [ … ]`); pbrt also takes them bare.
+    fn bracketed<const N: usize>(&mut self, after: &Token) -> Result<[f32; N], ParseError> {
+        let bracket = matches!(self.peek()?, Some(t) if t.kind == Kind::Open);
+        if bracket {
+            self.next()?;
+        }
+        let v = self.numbers::<N>(after)?;
+        if bracket {
+            self.expect(Kind::Close, &format!("`]` after {N} numbers"), after)?;
+        }
+        Ok(v)
+    }
+
+    /// A parameter list: pairs of a quoted declaration and values, up to the next directive.
+    fn params(&mut self) -> Result<Params, ParseError> {
+        let mut params = Params::default();
+        while let Some(t) = self.peek()? {
+            if t.kind != Kind::Str {
+                break;
+            }
+            let decl = self.next()?.expect("peeked");
+            let first = self.next()?.ok_or_else(|| {
+                ParseError::new(
+                    format!("the parameter \"{}\" has no value", decl.text),
+                    decl.span.clone(),
+                )
+            })?;
+            let mut tokens = Vec::new();
+            let end;
+            match first.kind {
+                Kind::Open => loop {
+                    match self.next()? {
+                        Some(t) if t.kind == Kind::Close => {
+                            end = t.span.end;
+                            break;
+                        }
+                        Some(t) if t.kind == Kind::Open => {
+                            return Err(ParseError::new("brackets do not nest in a parameter list", t.span))
+                        }
+                        Some(t) => tokens.push(t),
+                        None => {
+                            return Err(ParseError::new(
+                                "this `[` is not closed before the end of the file",
+                                first.span,
+                            ))
+                        }
+                    }
+                },
+                Kind::Close => return Err(ParseError::new("a `]` without its `[`", first.span)),
+                _ => {
+                    end = first.span.end;
+                    tokens.push(first);
+                }
+            }
+            let span = decl.span.start..end;
+            let values = if tokens.iter().all(|t| t.kind == Kind::Str) && !tokens.is_empty() {
+                Values::Strings(tokens.into_iter().map(|t| t.text).collect())
+            } else if tokens
+                .iter()
+                .all(|t| t.kind == Kind::Word && (t.text == "true" || t.text == "false"))
+                && !tokens.is_empty()
+            {
+                Values::Bools(tokens.iter().map(|t| t.text == "true").collect())
+            } else if tokens.iter().all(|t| t.kind == Kind::Word) {
+                if tokens.len() > MAX_MESH_VALUES {
+                    return Err(ParseError::new("too many values", span));
+                }
+                Values::Numbers(
+                    tokens
+                        .iter()
+                        .map(|t| parse_number(t).map(f64::from))
+                        .collect::<Result<_, _>>()?,
+                )
+            } else if tokens.len() == 1 && tokens[0].text == "true" || tokens.iter().any(|t| t.kind == Kind::Str) {
+                return Err(ParseError::new(
+                    "a parameter's values are all numbers, all strings or all true/false",
+                    span,
+                ));
+            } else {
+                Values::Numbers(Vec::new())
+            };
+            params.push(&decl.text, &decl.span, values, span)?;
+        }
+        Ok(params)
+    }
+
+    fn report_unused(&mut self, params: &Params, what: &str) {
+        for (name, span) in params.unused() {
+            self.warn(format!("`{name}` of {what} is not read"), span);
+        }
+    }
+
+    // ---- the directive loop ------------------------------------------------------------------
+
+    fn run(mut self) -> Result<SceneDescription, ParseError> {
+        while let Some(t) = self.next()? {
+            if t.kind != Kind::Word {
+                return Err(ParseError::new(
+                    match t.kind {
+                        Kind::Str => format!("\"{}\" is not a directive: a directive name comes first", t.text),
+                        _ => "a bracket where a directive is expected".into(),
+                    },
+                    t.span,
+                ));
+            }
+            for (state, depth) in std::mem::take(&mut self.ended_imports) {
+                self.stack.truncate(depth);
+                self.state = state;
+            }
+            self.directive(t)?;
+        }
+        if let Some((name, _, span)) = self.defining.take() {
+            self.warn(format!("`ObjectBegin \"{name}\"` is not closed"), span);
+        }
+        if !self.in_world {
+            return Err(ParseError::new(
+                "the file ends before `WorldBegin`: a pbrt-v4 scene describes its world after it",
+                self.end_span(),
+            ));
+        }
+        if let Some(open) = self.stack.last() {
+            let span = open.span.clone();
+            self.warn("an `AttributeBegin` is not closed", span);
+        }
+        self.finish_camera()?;
+        Ok(self.desc)
+    }
+
+    fn concat(&mut self, m: Mat4) {
+        self.state.ctm *= m;
+    }
+
+    fn directive(&mut self, t: Token) -> Result<(), ParseError> {
+        match t.text.as_str() {
+            "Identity" => self.state.ctm = Mat4::IDENTITY,
+            "Translate" => {
+                let [x, y, z] = self.numbers(&t)?;
+                self.concat(Mat4::from_translation(Vec3::new(x, y, z)));
+            }
+            "Scale" => {
+                let [x, y, z] = self.numbers(&t)?;
+                self.concat(Mat4::from_scale(Vec3::new(x, y, z)));
+            }
+            "Rotate" => {
+                let [angle, x, y, z] = self.numbers(&t)?;
+                let axis = Vec3::new(x, y, z);
+                if axis.length_squared() == 0.0 {
+                    return Err(ParseError::new("`Rotate` needs a non-zero axis", t.span));
+                }
+                self.concat(Mat4::from_axis_angle(axis.normalize(), angle.to_radians()));
+            }
+            "LookAt" => {
+                let [ex, ey, ez, lx, ly, lz, ux, uy, uz] = self.numbers(&t)?;
+                let (eye, look, up) = (Vec3::new(ex, ey, ez), Vec3::new(lx, ly, lz), Vec3::new(ux, uy, uz));
+                let dir = (look - eye).normalize_or_zero();
+                let right = up.normalize_or_zero().cross(dir);
+                if dir == Vec3::ZERO || right.length() < 1e-6 {
+                    return Err(ParseError::new(
+                        "`LookAt`: the eye and the target coincide, or the up vector lies along the view",
+                        t.span,
+                    ));
+                }
+                let right = right.normalize();
+                let new_up = dir.cross(right);
+                let world_from_camera =
+                    Mat4::from_cols(right.extend(0.0), new_up.extend(0.0), dir.extend(0.0), eye.extend(1.0));
+                self.concat(world_from_camera.inverse());
+            }
+            "Transform" | "ConcatTransform" => {
+                let m = Mat4::from_cols_array(&self.bracketed::<16>(&t)?);
+                if t.text == "Transform" {
+                    self.state.ctm = m;
+                } else {
+                    self.concat(m);
+                }
+            }
+            "CoordinateSystem" => {
+                let name = self.string_arg(&t)?;
+                self.named_systems.insert(name.text, self.state.ctm);
+            }
+            "CoordSysTransform" => {
+                let name = self.string_arg(&t)?;
+                match self.named_systems.get(&name.text) {
+                    Some(m) => self.state.ctm = *m,
+                    None => self.warn(format!("no coordinate system named \"{}\"", name.text), name.span),
+                }
+            }
+            "ReverseOrientation" => self.state.reverse_orientation = !self.state.reverse_orientation,
+            "TransformTimes" => {
+                self.numbers::<2>(&t)?;
+                self.warn_once(
+                    "motion",
+                    "motion blur is not rendered: the start transform is used",
+                    t.span,
+                );
+            }
+            "ActiveTransform" => {
+                let which = self.expect(Kind::Word, "StartTime, EndTime or All", &t)?;
+                self.warn_once(
+                    "motion",
+                    "motion blur is not rendered: the start transform is used",
+                    which.span,
+                );
+            }
+            "Option" | "Accelerator" => {
+                if t.text == "Accelerator" {
+                    self.string_arg(&t)?;
+                }
+                self.params()?;
+            }
+            "ColorSpace" => {
+                let name = self.string_arg(&t)?;
+                if name.text != "srgb" {
+                    self.warn(format!("colour space \"{}\" is read as sRGB", name.text), name.span);
+                }
+            }
+            "Camera" => {
+                let kind = self.string_arg(&t)?;
+                let params = self.params()?;
+                if kind.text != "perspective" {
+                    self.warn(
+                        format!(
+                            "the {} camera is not supported: a perspective camera is used",
+                            kind.text
+                        ),
+                        kind.span.clone(),
+                    );
+                }
+                let world_from_camera = self.state.ctm.inverse();
+                if !world_from_camera.is_finite() {
+                    return Err(ParseError::new("the camera's transform is singular", t.span));
+                }
+                self.named_systems.insert("camera".into(), world_from_camera);
+                self.camera = Some((params, world_from_camera, t.span.start..kind.span.end));
+            }
+            "Film" => {
+                let kind = self.string_arg(&t)?;
+                let params = self.params()?;
+                if !matches!(kind.text.as_str(), "rgb" | "gbuffer" | "spectral") {
+                    self.warn(format!("unknown film \"{}\": read as rgb", kind.text), kind.span);
+                }
+                self.film = Some(params);
+            }
+            "Sampler" => {
+                self.string_arg(&t)?;
+                let params = self.params()?;
+                let samples = params.int("pixelsamples")?;
+                let (x, y) = (params.int("xsamples")?, params.int("ysamples")?);
+                let samples = samples.or(x.zip(y).map(|(x, y)| x * y));
+                if let Some(n) = samples {
+                    if n > 0 {
+                        self.desc.hints.samples = Some(n.min(u32::MAX as i64) as u32);
+                    }
+                }
+            }
+            "PixelFilter" => {
+                self.string_arg(&t)?;
+                self.params()?;
+                self.warn_once(
+                    "filter",
+                    "pixel filters are not emulated: caustica averages the samples of each pixel",
+                    t.span,
+                );
+            }
+            "Integrator" => self.integrator(&t)?,
+            "MakeNamedMedium" => {
+                self.string_arg(&t)?;
+                self.params()?;
+                self.warn_once("medium", "participating media are not rendered", t.span);
+            }
+            "MediumInterface" => {
+                self.string_arg(&t)?;
+                if matches!(self.peek()?, Some(n) if n.kind == Kind::Str) {
+                    self.next()?;
+                }
+                self.warn_once("medium", "participating media are not rendered", t.span);
+            }
+            "WorldBegin" => {
+                self.in_world = true;
+                self.state.ctm = Mat4::IDENTITY;
+                self.named_systems.insert("world".into(), Mat4::IDENTITY);
+            }
+            "WorldEnd" => self.warn_once(
+                "worldend",
+                "`WorldEnd` is pbrt-v3 syntax; the scene ends at the end of the file",
+                t.span,
+            ),
+            "AttributeBegin" | "TransformBegin" => {
+                if self.stack.len() >= MAX_NESTING {
+                    return Err(ParseError::new("attribute blocks nest too deep", t.span));
+                }
+                let transform_only = t.text == "TransformBegin";
+                if transform_only {
+                    self.warn_once(
+                        "transformbegin",
+                        "`TransformBegin` is deprecated in pbrt-v4 (read as saving the transform)",
+                        t.span.clone(),
+                    );
+                }
+                self.stack.push(Saved {
+                    state: self.state.clone(),
+                    span: t.span,
+                    transform_only,
+                });
+            }
+            "AttributeEnd" | "TransformEnd" => match self.stack.pop() {
+                Some(saved) => {
+                    if saved.transform_only {
+                        self.state.ctm = saved.state.ctm;
+                    } else {
+                        self.state = saved.state;
+                    }
+                }
+                None => self.warn(format!("`{}` without a matching begin", t.text), t.span),
+            },
+            "Attribute" => {
+                self.string_arg(&t)?;
+                self.params()?;
+                self.warn(
+                    "`Attribute` defaults are not applied: give the parameters to each directive",
+                    t.span,
+                );
+            }
+            "Shape" => self.shape(&t)?,
+            "LightSource" => self.light(&t)?,
+            "AreaLightSource" => self.area_light(&t)?,
+            "Material" => {
+                let kind = self.string_arg(&t)?;
+                let params = self.params()?;
+                self.state.material = self.material(&kind.text, &params, &kind.span)?;
+                self.report_unused(&params, &format!("the {} material", kind.text));
+            }
+            "MakeNamedMaterial" => {
+                let name = self.string_arg(&t)?;
+                let params = self.params()?;
+                let kind = params.string("type")?.map(|s| s.0).unwrap_or_default();
+                let material = match self.material(&kind, &params, &name.span)? {
+                    CurrentMaterial::Desc(m) => *m,
+                    CurrentMaterial::Interface => MaterialDesc {
+                        name: Some("interface".into()),
+                        ..MaterialDesc::default()
+                    },
+                };
+                self.report_unused(&params, &format!("the material \"{}\"", name.text));
+                self.named_materials.insert(name.text, material);
+            }
+            "NamedMaterial" => {
+                let name = self.string_arg(&t)?;
+                match self.named_materials.get(&name.text) {
+                    Some(m) if m.name.as_deref() == Some("interface") => {
+                        self.state.material = CurrentMaterial::Interface
+                    }
+                    Some(m) => self.state.material = CurrentMaterial::Desc(Box::new(m.clone())),
+                    None => {
+                        return Err(ParseError::new(
+                            format!("no material named \"{}\" has been made", name.text),
+                            name.span,
+                        ))
+                    }
+                }
+            }
+            "Texture" => self.texture(&t)?,
+            "ObjectBegin" => {
+                let name = self.string_arg(&t)?;
+                if self.defining.is_some() {
+                    return Err(ParseError::new(
+                        "`ObjectBegin` inside another object definition",
+                        t.span,
+                    ));
+                }
+                self.stack.push(Saved {
+                    state: self.state.clone(),
+                    span: t.span.clone(),
+                    transform_only: false,
+                });
+                self.defining = Some((name.text, Vec::new(), t.span));
+            }
+            "ObjectEnd" => match self.defining.take() {
+                Some((name, objects, _)) => {
+                    self.instances.insert(name, objects);
+                    if let Some(saved) = self.stack.pop() {
+                        self.state = saved.state;
+                    }
+                }
+                None => self.warn("`ObjectEnd` without `ObjectBegin`", t.span),
+            },
+            "ObjectInstance" => {
+                let name = self.string_arg(&t)?;
+                if self.defining.is_some() {
+                    return Err(ParseError::new("`ObjectInstance` inside an object definition", t.span));
+                }
+                let Some(objects) = self.instances.get(&name.text) else {
+                    return Err(ParseError::new(format!("no object named \"{}\"", name.text), name.span));
+                };
+                let ctm = self.state.ctm;
+                let placed: Vec<ObjectDesc> = objects
+                    .iter()
+                    .map(|o| ObjectDesc {
+                        world_from_object: ctm * o.world_from_object,
+                        span: t.span.start..name.span.end,
+                        ..o.clone()
+                    })
+                    .collect();
+                self.desc.objects.extend(placed);
+            }
+            "Include" | "Import" => {
+                let name = self.string_arg(&t)?;
+                if self.open.len() >= MAX_INCLUDE_DEPTH {
+                    return Err(ParseError::new(
+                        "files include each other too deep (or include themselves)",
+                        name.span,
+                    ));
+                }
+                let path = self.dir.join(&name.text);
+                if path.extension().is_some_and(|e| e == "gz") {
+                    return Err(ParseError::new(
+                        "gzip-compressed files are not read: decompress it first",
+                        name.span,
+                    ));
+                }
+                let (base, text) = self.files.read_text(&path, &name.span)?;
+                let text = text.to_string();
+                let restore = (t.text == "Import").then(|| (self.state.clone(), self.stack.len()));
+                self.open.push(Open {
+                    lexer: Lexer::new(text, base),
+                    restore,
+                });
+            }
+            _ => {
+                self.warn(
+                    format!("unknown directive `{}`: skipped with its parameters", t.text),
+                    t.span,
+                );
+                // Skip its arguments: everything up to the next bare word that is not a value.
+                while let Some(next) = self.peek()? {
+                    let value = next.kind != Kind::Word
+                        || next.text == "true"
+                        || next.text == "false"
+                        || next.text.parse::<f64>().is_ok();
+                    if !value {
+                        break;
+                    }
+                    self.next()?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn integrator(&mut self, t: &Token) -> Result<(), ParseError> {
+        let kind = self.string_arg(t)?;
+        let params = self.params()?;
+        let hint = match kind.text.as_str() {
+            "sppm" => IntegratorHint::Ppm,
+            "path" | "volpath" | "simplepath" | "simplevolpath" => IntegratorHint::Path,
+            other => {
+                self.warn(
+                    format!(
+                        "the {other} integrator is not in caustica{}: rendered with path",
+                        if matches!(other, "bdpt" | "mlt") {
+                            " (vcm will stand for it when it exists)"
+                        } else {
+                            ""
+                        }
+                    ),
+                    kind.span.clone(),
+                );
+                IntegratorHint::Path
+            }
+        };
+        self.desc.hints.integrator = Some(hint);
+        if let Some(depth) = params.int("maxdepth")? {
+            self.desc.hints.max_depth = Some(depth.clamp(0, 10_000) as u32);
+        }
+        if let Some(n) = params.int("photonsperiteration")? {
+            if n > 0 {
+                self.desc.hints.photons_per_pass = Some(n as usize);
+            }
+        }
+        if let Some(r) = params.float("radius")? {
+            if r > 0.0 && r.is_finite() {
+                self.desc.hints.radius = Some(r);
+            }
+        }
+        if let Some(n) = params.int("iterations")?.or(params.int("numiterations")?) {
+            if n > 0 {
+                self.desc.hints.samples = Some(n.min(u32::MAX as i64) as u32);
+            }
+        }
+        self.report_unused(&params, &format!("the {} integrator", kind.text));
+        Ok(())
+    }
+
+    /// The camera, once the film's size is known (pbrt's fov spans the shorter image axis).
+    fn finish_camera(&mut self) -> Result<(), ParseError> {
+        let film = self.film.take().unwrap_or_default();
+        let xres = film.int("xresolution")?.unwrap_or(1280).clamp(1, 1 << 15) as usize;
+        let yres = film.int("yresolution")?.unwrap_or(720).clamp(1, 1 << 15) as usize;
+        self.desc.hints.width = Some(xres);
+        self.desc.hints.height = Some(yres);
+        if let Some((name, _)) = film.string("filename")? {
+            self.desc.hints.output = Some(PathBuf::from(name));
+        }
+        for (what, name) in [("cropwindow", "a crop window"), ("pixelbounds", "pixel bounds")] {
+            if let Some(span) = film.span_of(what) {
+                self.warn(format!("{name} is not applied: the whole image is rendered"), span);
+            }
+        }
+        // Sensor settings scale pbrt's image; left unread they are warned about.
+        film.float("diagonal")?;
+        film.float("maxcomponentvalue")?;
+        film.bool_or("savefp16", true)?;
+        self.report_unused(&film, "the film");
+        let Some((params, w, span)) = self.camera.take() else {
+            return Ok(());
+        };
+        let frame = params.float_or("frameaspectratio", xres as f32 / yres as f32)?;
+        let mut window = if frame > 1.0 {
+            [-frame, frame, -1.0, 1.0]
+        } else {
+            [-1.0, 1.0, -1.0 / frame, 1.0 / frame]
+        };
+        if let Some((v, s)) = params.list("screenwindow", &["float"], 4)? {
+            if v.len() != 4 || v[0] >= v[1] || v[2] >= v[3] {
+                return Err(ParseError::new("`screenwindow` takes xmin xmax ymin ymax", s));
+            }
+            window = [v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32];
+        }
+        let fov = params.float_or("fov", 90.0)?;
+        if !(fov > 0.0 && fov < 180.0) {
+            let s = params.span_of("fov").unwrap_or(span.clone());
+            return Err(ParseError::new("`fov` must lie between 0 and 180 degrees", s));
+        }
+        if params.float("lensradius")?.is_some_and(|r| r > 0.0) {
+            self.warn("depth of field is not rendered: a pinhole camera is used", span.clone());
+        }
+        params.float("focaldistance")?;
+        params.float("shutteropen")?;
+        params.float("shutterclose")?;
+        self.report_unused(&params, "the camera");
+        let t = (fov.to_radians() * 0.5).tan();
+        let eye = w.transform_point3(Vec3::ZERO);
+        let forward = w.transform_vector3(Vec3::Z);
+        let up = w.transform_vector3(Vec3::Y);
+        let right = w.transform_vector3(Vec3::X);
+        let (forward, up, right) = (
+            forward.normalize_or_zero(),
+            up.normalize_or_zero(),
+            right.normalize_or_zero(),
+        );
+        let centre = Vec2::new(window[0] + window[1], window[2] + window[3]) * 0.5 * t;
+        self.desc.camera = Some(CameraDesc {
+            position: eye,
+            view: forward + right * centre.x + up * centre.y,
+            up,
+            height: (window[3] - window[2]) * t,
+            aspect_ratio: (window[1] - window[0]) / (window[3] - window[2]),
+            right: Some(right),
+            span,
+        });
+        Ok(())
+    }
+
+    // ---- materials and textures ----------------------------------------------------------------
+
+    /// A colour slot: a constant, a named texture, or `default`.
+    fn colour(&mut self, params: &Params, name: &str, default: Vec3) -> Result<Param, ParseError> {
+        let Some((value, span)) = params.spectrum(name)? else {
+            return Ok(Param::Constant(default));
+        };
+        Ok(match value {
+            Spectrum::Rgb(c) => {
+                if c.min_element() < 0.0 {
+                    return Err(ParseError::new(format!("`{name}` cannot be negative"), span));
+                }
+                Param::Constant(c)
+            }
+            Spectrum::Texture(t) => match self.textures.get(&t) {
+                Some(TextureValue::Param(p)) => p.clone(),
+                Some(TextureValue::Float(f)) => Param::grey(*f),
+                None => return Err(ParseError::new(format!("no texture named \"{t}\""), span)),
+            },
+            Spectrum::Blackbody(k) => Param::Constant(spectra::blackbody(k)),
+            Spectrum::Sampled(pairs) => Param::Constant(spectra::sampled_to_rgb(&pairs)),
+            Spectrum::Named(n) => {
+                self.warn(
+                    format!("the spectrum \"{n}\" is not a reflectance caustica knows: grey 0.5"),
+                    span,
+                );
+                Param::grey(0.5)
+            }
+        })
+    }
+
+    /// A constant colour (textures are refused with a warning: `what` reads constants only).
+    fn constant_colour(&mut self, params: &Params, name: &str, default: Vec3) -> Result<Vec3, ParseError> {
+        match self.colour(params, name, default)? {
+            Param::Constant(c) => Ok(c),
+            _ => {
+                let span = params.span_of(name).unwrap_or(0..0);
+                self.warn(format!("`{name}` cannot be a texture here: its default is used"), span);
+                Ok(default)
+            }
+        }
+    }
+
+    /// A float slot (a texture reference to a constant float texture is read too).
+    fn float_slot(&mut self, params: &Params, name: &str, default: f32) -> Result<f32, ParseError> {
+        if let Some((Spectrum::Texture(t), span)) = params.spectrum(name)? {
+            return match self.textures.get(&t) {
+                Some(TextureValue::Float(f)) => Ok(*f),
+                Some(TextureValue::Param(Param::Constant(c))) => Ok(c.x),
+                _ => {
+                    self.warn(
+                        format!("`{name}` from an image texture is not read: {default} instead"),
+                        span,
+                    );
+                    Ok(default)
+                }
+            };
+        }
+        params.float_or(name, default)
+    }
+
+    /// GGX α from pbrt's `roughness` (or the mean of `uroughness`/`vroughness`).
+    fn roughness(&mut self, params: &Params, span: &Span) -> Result<f32, ParseError> {
+        let r = self.float_slot(params, "roughness", 0.0)?;
+        let u = self.float_slot(params, "uroughness", r)?;
+        let v = self.float_slot(params, "vroughness", r)?;
+        if (u - v).abs() > 1e-6 {
+            self.warn("anisotropic roughness is read as the mean of u and v", span.clone());
+        }
+        let r = (0.5 * (u + v)).max(0.0);
+        Ok(if params.bool_or("remaproughness", true)? {
+            r.sqrt()
+        } else {
+            r
+        })
+    }
+
+    fn material(&mut self, kind: &str, params: &Params, span: &Span) -> Result<CurrentMaterial, ParseError> {
+        let m = match kind {
+            "diffuse" => diffuse(self.colour(params, "reflectance", Vec3::splat(0.5))?),
+            "dielectric" | "thindielectric" => {
+                let (index, abbe) = self.eta(params)?;
+                let alpha = self.roughness(params, span)?;
+                if alpha >= 1e-3 {
+                    self.warn("rough glass is rendered smooth", span.clone());
+                }
+                let mut m = MaterialDesc {
+                    transmissive: Param::grey(1.0),
+                    index: Param::grey(index),
+                    abbe,
+                    ..MaterialDesc::default()
+                };
+                if kind == "thindielectric" {
+                    m.index = Param::grey(1.0);
+                    m.physical = Some(PhysicalMaterial::ThinDielectric {
+                        eta: index,
+                        tint: Param::grey(1.0),
+                    });
+                }
+                m
+            }
+            "conductor" => {
+                let alpha = self.roughness(params, span)?;
+                let reflectance = params.has("reflectance");
+                let (eta, k, r) = if reflectance {
+                    if params.has("eta") || params.has("k") {
+                        return Err(ParseError::new(
+                            "a conductor takes `reflectance` or `eta` and `k`, not both",
+                            span.clone(),
+                        ));
+                    }
+                    let r = self.colour(params, "reflectance", Vec3::ONE)?;
+                    (Vec3::ONE, Vec3::ZERO, Some(r))
+                } else {
+                    let (cu_eta, cu_k) = spectra::metal("metal-Cu").expect("copper is known");
+                    (
+                        self.index_rgb(params, "eta", cu_eta)?,
+                        self.index_rgb(params, "k", cu_k)?,
+                        None,
+                    )
+                };
+                let f0 = match &r {
+                    Some(Param::Constant(c)) => *c,
+                    Some(_) => Vec3::splat(0.8),
+                    None => ((eta - Vec3::ONE).powf(2.0) + k * k) / ((eta + Vec3::ONE).powf(2.0) + k * k),
+                };
+                let mut m = MaterialDesc {
+                    physical: Some(PhysicalMaterial::Conductor {
+                        eta,
+                        k,
+                        reflectance: r,
+                        roughness: alpha,
+                    }),
+                    ..MaterialDesc::default()
+                };
+                course_gloss(&mut m, f0, alpha);
+                m
+            }
+            "coateddiffuse" => {
+                let base = self.colour(params, "reflectance", Vec3::splat(0.5))?;
+                let alpha = self.roughness(params, span)?;
+                let eta = self.float_slot(params, "eta", 1.5)?.max(1.0);
+                let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+                let mut m = diffuse(base.clone());
+                m.physical = Some(PhysicalMaterial::CoatedDiffuse {
+                    reflectance: base,
+                    eta,
+                    roughness: alpha,
+                });
+                course_gloss(&mut m, Vec3::splat(f0), alpha);
+                m
+            }
+            "diffusetransmission" => {
+                let scale = params.float_or("scale", 1.0)?;
+                let r = self.colour(params, "reflectance", Vec3::splat(0.25))?;
+                let t = self.colour(params, "transmittance", Vec3::splat(0.25))?;
+                let (r, t) = (scaled(r, scale), scaled(t, scale));
+                MaterialDesc {
+                    diffuse: r.clone(),
+                    transmissive: t.clone(),
+                    index: Param::grey(1.0),
+                    physical: Some(PhysicalMaterial::DiffuseTransmission {
+                        reflectance: r,
+                        transmittance: t,
+                    }),
+                    ..MaterialDesc::default()
+                }
+            }
+            "interface" | "" | "none" => return Ok(CurrentMaterial::Interface),
+            "mix" => {
+                let amount = self.float_slot(params, "amount", 0.5)?;
+                let Some((names, s)) = params.strings("materials") else {
+                    return Err(ParseError::new("a mix material needs `string materials`", span.clone()));
+                };
+                if names.len() != 2 {
+                    return Err(ParseError::new("`materials` names two materials", s));
+                }
+                let chosen = &names[usize::from(amount >= 0.5)];
+                self.warn(
+                    format!("a mix material is read as its larger part, \"{chosen}\""),
+                    span.clone(),
+                );
+                match self.named_materials.get(chosen) {
+                    Some(m) => m.clone(),
+                    None => return Err(ParseError::new(format!("no material named \"{chosen}\""), s)),
+                }
+            }
+            other => {
+                self.warn(
+                    format!("the {other} material is not supported: grey diffuse instead"),
+                    span.clone(),
+                );
+                diffuse(Param::grey(0.5))
+            }
+        };
+        for unread in ["displacement", "normalmap"] {
+            if let Some(s) = params.span_of(unread) {
+                let _ = params.string(unread);
+                let _ = params.spectrum(unread);
+                self.warn(format!("`{unread}` is not applied"), s);
+            }
+        }
+        Ok(CurrentMaterial::Desc(Box::new(m)))
+    }
+
+    /// A dielectric's `eta`: n_d, and V_d for named or sampled glasses.
+    fn eta(&mut self, params: &Params) -> Result<(f32, Option<f32>), ParseError> {
+        let (eta, abbe) = match params.spectrum("eta")? {
+            None => (1.5, None),
+            Some((Spectrum::Rgb(c), _)) => (c.x, None),
+            Some((Spectrum::Named(name), span)) => match spectra::glass(&name) {
+                Some((n, v)) => (n, Some(v)),
+                None => return Err(ParseError::new(format!("unknown glass \"{name}\""), span)
+                    .with_help("pbrt-v4's glasses: glass-BK7, glass-BAF10, glass-FK51A, glass-LASF9, glass-F5, glass-F10, glass-F11")),
+            },
+            Some((Spectrum::Sampled(pairs), _)) => spectra::sampled_index(&pairs),
+            Some((Spectrum::Texture(t), span)) => match self.textures.get(&t) {
+                Some(TextureValue::Float(f)) => (*f, None),
+                _ => return Err(ParseError::new("`eta` must be a constant", span)),
+            },
+            Some((_, span)) => return Err(ParseError::new("`eta` must be a number or a spectrum", span)),
+        };
+        if !(eta > 0.0 && eta.is_finite()) {
+            let span = params.span_of("eta").unwrap_or(0..0);
+            return Err(ParseError::new("`eta` must be positive", span));
+        }
+        Ok((eta, abbe))
+    }
+
+    /// A conductor's `eta` or `k`: RGB, a named metal spectrum, or sampled.
+    fn index_rgb(&mut self, params: &Params, name: &str, default: Vec3) -> Result<Vec3, ParseError> {
+        Ok(match params.spectrum(name)? {
+            None => default,
+            Some((Spectrum::Rgb(c), _)) => c,
+            Some((Spectrum::Named(n), span)) => match spectra::metal_part(&n) {
+                Some(v) => v,
+                None => {
+                    return Err(ParseError::new(format!("unknown spectrum \"{n}\""), span)
+                        .with_help("pbrt-v4's metals: metal-{Ag,Al,Au,Cu,CuZn,MgO,TiO2}-{eta,k}"))
+                }
+            },
+            Some((Spectrum::Sampled(pairs), _)) => Vec3::new(
+                spectra::sample(&pairs, 650.0),
+                spectra::sample(&pairs, 550.0),
+                spectra::sample(&pairs, 450.0),
+            ),
+            Some((_, span)) => return Err(ParseError::new(format!("`{name}` must be a spectrum or rgb"), span)),
+        })
+    }
+
+    fn texture(&mut self, t: &Token) -> Result<(), ParseError> {
+        let name = self.string_arg(t)?;
+        let ty = self.string_arg(t)?;
+        let class = self.string_arg(t)?;
+        let params = self.params()?;
+        if !matches!(ty.text.as_str(), "spectrum" | "float" | "color") {
+            return Err(ParseError::new(
+                format!("a texture's type is \"spectrum\" or \"float\", not \"{}\"", ty.text),
+                ty.span,
+            ));
+        }
+        let float = ty.text == "float";
+        let value = match class.text.as_str() {
+            "imagemap" => {
+                let Some((file, span)) = params.string("filename")? else {
+                    return Err(ParseError::new("an imagemap needs `string filename`", class.span));
+                };
+                for (what, default) in [
+                    ("uscale", 1.0),
+                    ("vscale", 1.0),
+                    ("udelta", 0.0),
+                    ("vdelta", 0.0),
+                    ("scale", 1.0),
+                ] {
+                    if params.float(what)?.is_some_and(|v| v != default) {
+                        let s = params.span_of(what).unwrap_or(span.clone());
+                        self.warn(format!("`{what}` of an image texture is not applied"), s);
+                    }
+                }
+                if params.bool_or("invert", false)? {
+                    self.warn("`invert` of an image texture is not applied", class.span.clone());
+                }
+                let _ = params.string("filter");
+                let _ = params.string("wrap");
+                let _ = params.string("encoding");
+                let _ = params.float("maxanisotropy");
+                TextureValue::Param(Param::Texture {
+                    path: self.dir.join(file),
+                    span,
+                })
+            }
+            "checkerboard" => {
+                let (a, b) = if float {
+                    (
+                        Vec3::splat(self.float_slot(&params, "tex1", 1.0)?),
+                        Vec3::splat(self.float_slot(&params, "tex2", 0.0)?),
+                    )
+                } else {
+                    (
+                        self.constant_colour(&params, "tex1", Vec3::ONE)?,
+                        self.constant_colour(&params, "tex2", Vec3::ZERO)?,
+                    )
+                };
+                let us = params.float_or("uscale", 1.0)?;
+                let vs = params.float_or("vscale", 1.0)?;
+                if params.int("dimension")?.is_some_and(|d| d != 2) {
+                    self.warn("a 3D checkerboard is read as a 2D one", class.span.clone());
+                }
+                let _ = params.string("mapping");
+                TextureValue::Param(Param::Checkerboard {
+                    even: a,
+                    odd: b,
+                    scale: Vec2::new(us, vs),
+                })
+            }
+            "constant" => {
+                if float {
+                    TextureValue::Float(params.float_or("value", 1.0)?)
+                } else {
+                    TextureValue::Param(Param::Constant(self.constant_colour(&params, "value", Vec3::ONE)?))
+                }
+            }
+            "scale" => {
+                let s = self.float_slot(&params, "scale", 1.0)?;
+                if float {
+                    TextureValue::Float(self.float_slot(&params, "tex", 1.0)? * s)
+                } else {
+                    TextureValue::Param(scaled(self.colour(&params, "tex", Vec3::ONE)?, s))
+                }
+            }
+            other => {
+                self.warn(
+                    format!("the {other} texture is not supported: a constant 0.5 instead"),
+                    class.span,
+                );
+                if float {
+                    TextureValue::Float(0.5)
+                } else {
+                    TextureValue::Param(Param::grey(0.5))
+                }
+            }
+        };
+        self.report_unused(&params, &format!("the texture \"{}\"", name.text));
+        self.textures.insert(name.text, value);
+        Ok(())
+    }
+
+    // ---- lights ----------------------------------------------------------------------------------
+
+    /// A light's spectrum as RGB times `scale`: RGB values keep their size; black bodies and
+    /// other spectra are normalised to luminance 1 as pbrt-v4 does.
+    fn light_colour(&mut self, params: &Params, name: &str) -> Result<Vec3, ParseError> {
+        let scale = params.float_or("scale", 1.0)?;
+        let c = match params.spectrum(name)? {
+            None => Vec3::ONE,
+            Some((Spectrum::Rgb(c), span)) => {
+                if c.min_element() < 0.0 {
+                    return Err(ParseError::new("a light's colour cannot be negative", span));
+                }
+                c
+            }
+            Some((Spectrum::Blackbody(k), _)) => spectra::blackbody(k),
+            Some((Spectrum::Sampled(pairs), _)) => {
+                let c = spectra::sampled_to_rgb(&pairs);
+                c / luminance(c).max(1e-9)
+            }
+            Some((Spectrum::Named(n), span)) => {
+                if !n.starts_with("stdillum-") && !n.starts_with("illum-") {
+                    return Err(ParseError::new(format!("unknown spectrum \"{n}\" for a light"), span));
+                }
+                if n != "stdillum-D65" {
+                    self.warn(format!("the illuminant \"{n}\" is read as white (D65)"), span);
+                }
+                Vec3::ONE
+            }
+            Some((Spectrum::Texture(_), span)) => {
+                return Err(ParseError::new("a light's colour cannot be a texture", span))
+            }
+        };
+        Ok(c * scale)
+    }
+
+    fn light(&mut self, t: &Token) -> Result<(), ParseError> {
+        let kind = self.string_arg(t)?;
+        let params = self.params()?;
+        let span = t.span.start..kind.span.end;
+        let ctm = self.state.ctm;
+        let light = match kind.text.as_str() {
+            "point" => {
+                let mut color = self.light_colour(&params, "I")?;
+                if let Some(power) = params.float("power")?.filter(|p| *p > 0.0) {
+                    color *= power
+                        / (4.0 * std::f32::consts::PI)
+                        / luminance(color / params.float_or("scale", 1.0)?).max(1e-9);
+                }
+                let from = params.vec3("from", &["point3"])?.unwrap_or(Vec3::ZERO);
+                Some(LightDesc::Point {
+                    position: ctm.transform_point3(from),
+                    color,
+                    attenuation: [0.0, 0.0, 1.0],
+                    span: span.clone(),
+                })
+            }
+            "spot" => {
+                let mut color = self.light_colour(&params, "I")?;
+                let from = params.vec3("from", &["point3"])?.unwrap_or(Vec3::ZERO);
+                let to = params.vec3("to", &["point3"])?.unwrap_or(Vec3::Z);
+                let cone = params.float_or("coneangle", 30.0)?.clamp(0.0, 180.0);
+                let delta = params.float_or("conedeltaangle", 5.0)?.clamp(0.0, cone);
+                if let Some(power) = params.float("power")?.filter(|p| *p > 0.0) {
+                    let (c0, c1) = ((cone - delta).to_radians().cos(), cone.to_radians().cos());
+                    let k = 2.0 * std::f32::consts::PI * ((1.0 - c0) + (c0 - c1) / 2.0);
+                    color *= power / k.max(1e-9) / luminance(color / params.float_or("scale", 1.0)?).max(1e-9);
+                }
+                Some(LightDesc::Spot {
+                    position: ctm.transform_point3(from),
+                    direction: ctm.transform_vector3(to - from),
+                    color,
+                    attenuation: [0.0, 0.0, 1.0],
+                    inner_degrees: cone - delta,
+                    outer_degrees: cone,
+                    exponent: 0.0,
+                    span: span.clone(),
+                })
+            }
+            "distant" => {
+                let mut color = self.light_colour(&params, "L")?;
+                if let Some(e) = params.float("illuminance")?.filter(|e| *e > 0.0) {
+                    color *= e / luminance(color / params.float_or("scale", 1.0)?).max(1e-9);
+                }
+                let from = params.vec3("from", &["point3"])?.unwrap_or(Vec3::ZERO);
+                let to = params.vec3("to", &["point3"])?.unwrap_or(Vec3::Z);
+                Some(LightDesc::Directional {
+                    direction: ctm.transform_vector3(to - from),
+                    color,
+                    span: span.clone(),
+                })
+            }
+            "infinite" => {
+                let mut color = self.light_colour(&params, "L")?;
+                let file = params.string("filename")?;
+                if let Some(e) = params.float("illuminance")?.filter(|e| *e > 0.0) {
+                    if file.is_some() {
+                        self.warn("`illuminance` of an image sky is not applied", span.clone());
+                    } else {
+                        color *= e / std::f32::consts::PI / luminance(color / params.float_or("scale", 1.0)?).max(1e-9);
+                    }
+                }
+                if params.has("portal") {
+                    self.warn("portals are not used: the sky is sampled everywhere", span.clone());
+                    let _ = params.list("portal", &["point3"], 3);
+                }
+                let rotation = Mat3::from_mat4(ctm);
+                let map = file.map(|(name, s)| (self.dir.join(name), s));
+                Some(LightDesc::Environment {
+                    color,
+                    map: map.as_ref().map(|m| m.0.clone()),
+                    rotation: orthonormal(rotation),
+                    equal_area: map.is_some(),
+                    span: map.map_or(span.clone(), |m| m.1),
+                })
+            }
+            other => {
+                self.warn(
+                    format!("the {other} light is not supported: left out"),
+                    kind.span.clone(),
+                );
+                None
+            }
+        };
+        self.report_unused(&params, &format!("the {} light", kind.text));
+        if let Some(light) = light {
+            if self.defining.is_some() {
+                self.warn(
+                    "a light inside an object definition is placed once, where it is defined",
+                    span,
+                );
+            }
+            self.desc.lights.push(light);
+        }
+        Ok(())
+    }
+
+    fn area_light(&mut self, t: &Token) -> Result<(), ParseError> {
+        let kind = self.string_arg(t)?;
+        let params = self.params()?;
+        if kind.text != "diffuse" {
+            self.warn(
+                format!("the {} area light is not supported", kind.text),
+                kind.span.clone(),
+            );
+            self.report_unused(&params, "the area light");
+            return Ok(());
+        }
+        let radiance = self.light_colour(&params, "L")?;
+        let power = params.float("power")?.filter(|p| *p > 0.0);
+        let twosided = params.bool_or("twosided", false)?;
+        if params.has("filename") {
+            let _ = params.string("filename");
+            self.warn(
+                "an image on an area light is not applied: its colour is used",
+                kind.span.clone(),
+            );
+        }
+        self.report_unused(&params, "the area light");
+        self.state.area_light = Some(AreaLight {
+            radiance,
+            power,
+            twosided,
+        });
+        Ok(())
+    }
+
+    // ---- shapes ----------------------------------------------------------------------------------
+
+    fn shape(&mut self, t: &Token) -> Result<(), ParseError> {
+        let kind = self.string_arg(t)?;
+        let params = self.params()?;
+        let span = t.span.start..kind.span.end;
+        let ctm = self.state.ctm;
+        if !self.in_world {
+            return Err(ParseError::new("shapes come after `WorldBegin`", span));
+        }
+        let partial = |reader: &mut Self, params: &Params, what: &str| -> Result<(), ParseError> {
+            let phimax = params.float_or("phimax", 360.0)?;
+            if phimax < 360.0 {
+                reader.warn(
+                    format!("a partial {what} (phimax {phimax}) is drawn whole"),
+                    span.clone(),
+                );
+            }
+            Ok(())
+        };
+        let mut shapes: Vec<(ShapeDesc, Mat4)> = Vec::new();
+        match kind.text.as_str() {
+            "sphere" => {
+                let r = params.float_or("radius", 1.0)?;
+                let (zmin, zmax) = (params.float_or("zmin", -r)?, params.float_or("zmax", r)?);
+                if zmin > -r || zmax < r {
+                    self.warn("a sphere cut by zmin/zmax is drawn whole", span.clone());
+                }
+                partial(self, &params, "sphere")?;
+                shapes.push((ShapeDesc::Sphere, ctm * Mat4::from_scale(Vec3::splat(r))));
+            }
+            "disk" => {
+                let r = params.float_or("radius", 1.0)?;
+                let inner = params.float_or("innerradius", 0.0)?;
+                let h = params.float_or("height", 0.0)?;
+                partial(self, &params, "disk")?;
+                if r.is_nan() || r <= 0.0 || !(0.0..r).contains(&inner) {
+                    return Err(ParseError::new("a disk needs 0 ≤ innerradius < radius", span));
+                }
+                shapes.push((
+                    ShapeDesc::Disk { inner: inner / r },
+                    ctm * Mat4::from_translation(Vec3::new(0.0, 0.0, h)) * Mat4::from_scale(Vec3::new(r, r, 1.0)),
+                ));
+            }
+            "cylinder" => {
+                let r = params.float_or("radius", 1.0)?;
+                let (z0, z1) = (params.float_or("zmin", -1.0)?, params.float_or("zmax", 1.0)?);
+                let (z0, z1) = (z0.min(z1), z0.max(z1));
+                partial(self, &params, "cylinder")?;
+                if !(r > 0.0 && z1 > z0) {
+                    return Err(ParseError::new(
+                        "a cylinder needs a positive radius and zmax > zmin",
+                        span,
+                    ));
+                }
+                shapes.push((
+                    ShapeDesc::Cylinder { capped: false },
+                    ctm * Mat4::from_translation(Vec3::new(0.0, 0.0, z0)) * Mat4::from_scale(Vec3::new(r, r, z1 - z0)),
+                ));
+            }
+            "trianglemesh" | "loopsubdiv" => {
+                if kind.text == "loopsubdiv" {
+                    self.warn("a subdivision surface is drawn as its control mesh", span.clone());
+                    let _ = params.int("levels");
+                }
+                if let Some(mesh) = self.triangle_mesh(&params, &span, 3)? {
+                    shapes.push((ShapeDesc::Trimesh(Box::new(mesh)), ctm));
+                }
+            }
+            "bilinearmesh" => {
+                if let Some(mesh) = self.triangle_mesh(&params, &span, 4)? {
+                    shapes.push((ShapeDesc::Trimesh(Box::new(mesh)), ctm));
+                }
+            }
+            "plymesh" => {
+                let Some((file, fspan)) = params.string("filename")? else {
+                    return Err(ParseError::new("a plymesh needs `string filename`", span));
+                };
+                if params.has("displacement") {
+                    let _ = params.spectrum("displacement");
+                    let _ = params.float("edgelength");
+                    self.warn("displacement is not applied", span.clone());
+                }
+                let path = self.dir.join(&file);
+                let ply = ply::read(self.files, &path, &fspan)?;
+                self.desc.warnings.extend(ply.warnings);
+                let n = ply.points.len();
+                let mesh = TrimeshDesc {
+                    points: ply.points,
+                    triangles: ply.triangles,
+                    normals: ply.normals.filter(|v| v.len() == n),
+                    materials: None,
+                    uvs: ply.uvs.filter(|v| v.len() == n),
+                };
+                if !mesh.triangles.is_empty() {
+                    shapes.push((ShapeDesc::Trimesh(Box::new(mesh)), ctm));
+                }
+            }
+            other => {
+                self.warn(
+                    format!("the {other} shape is not supported: left out"),
+                    kind.span.clone(),
+                );
+            }
+        }
+        if params.has("alpha") {
+            let _ = params.spectrum("alpha");
+            self.warn_once(
+                "alpha",
+                "alpha cut-outs are not applied: shapes are drawn whole",
+                span.clone(),
+            );
+        }
+        self.report_unused(&params, &format!("the {} shape", kind.text));
+        let material = match &self.state.material {
+            CurrentMaterial::Desc(m) => (**m).clone(),
+            CurrentMaterial::Interface => {
+                self.warn_once(
+                    "interface",
+                    "shapes with the `interface` material bound media and are not drawn",
+                    span,
+                );
+                return Ok(());
+            }
+        };
+        for (shape, world_from_object) in shapes {
+            let mut material = material.clone();
+            if let Some(light) = self.state.area_light.clone() {
+                let mut radiance = light.radiance;
+                if let Some(power) = light.power {
+                    let area = shape_area(&shape, &world_from_object);
+                    let sides = if light.twosided { 2.0 } else { 1.0 };
+                    radiance *=
+                        power / (sides * std::f32::consts::PI * area * luminance(radiance).max(1e-9)).max(1e-12);
+                }
+                if !light.twosided {
+                    self.warn_once(
+                        "onesided",
+                        "caustica's area lights emit from both faces; pbrt's one-sided ones only along the normal",
+                        span.clone(),
+                    );
+                }
+                if self.defining.is_some() {
+                    self.warn_once(
+                        "instancedlight",
+                        "area lights inside object instances do not emit (as in pbrt)",
+                        span.clone(),
+                    );
+                } else {
+                    material.emissive = Param::Constant(radiance);
+                }
+            }
+            let object = ObjectDesc {
+                shape,
+                world_from_object,
+                material,
+                span: span.clone(),
+            };
+            match &mut self.defining {
+                Some((_, objects, _)) => objects.push(object),
+                None => self.desc.objects.push(object),
+            }
+        }
+        Ok(())
+    }
+
+    /// A `trianglemesh` (`corners` 3) or `bilinearmesh` (4: p00 p10 p01 p11 per patch).
+    fn triangle_mesh(
+        &mut self,
+        params: &Params,
+        span: &Span,
+        corners: usize,
+    ) -> Result<Option<TrimeshDesc>, ParseError> {
+        let Some((p, pspan)) = params.list("P", &["point3"], 3)? else {
+            return Err(ParseError::new("a mesh needs `point3 P`", span.clone()));
+        };
+        let points: Vec<Vec3> = p
+            .chunks(3)
+            .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
+            .collect();
+        let n = points.len();
+        let indices: Vec<f64> = match params.list("indices", &["integer"], 1)? {
+            Some((v, _)) => v,
+            None if n == corners => (0..corners).map(|i| i as f64).collect(),
+            None => return Err(ParseError::new("a mesh needs `integer indices`", pspan)),
+        };
+        let ispan = params.span_of("indices").unwrap_or(pspan);
+        if !indices.chunks_exact(corners).remainder().is_empty() {
+            self.warn(
+                format!("`indices` is not a multiple of {corners}: the extra ones are dropped"),
+                ispan.clone(),
+            );
+        }
+        if let Some(bad) = indices.iter().find(|&&i| i < 0.0 || i >= n as f64 || i.fract() != 0.0) {
+            return Err(ParseError::new(
+                format!("index {bad} is out of range: the mesh has {n} points"),
+                ispan,
+            ));
+        }
+        let mut triangles = Vec::new();
+        for f in indices.chunks_exact(corners) {
+            let f: Vec<u32> = f.iter().map(|&i| i as u32).collect();
+            if corners == 3 {
+                triangles.push([f[0], f[1], f[2]]);
+            } else {
+                triangles.push([f[0], f[1], f[3]]);
+                triangles.push([f[0], f[3], f[2]]);
+            }
+        }
+        let normals = match params.list("N", &["normal"], 3)? {
+            Some((v, s)) if v.len() != 3 * n => {
+                self.warn("`N` does not have one normal per point: left out", s);
+                None
+            }
+            Some((v, _)) => Some(
+                v.chunks(3)
+                    .map(|c| Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32))
+                    .collect(),
+            ),
+            None => None,
+        };
+        let uv = match params.list("uv", &["point2"], 2)? {
+            Some(v) => Some(v),
+            None => params.list("st", &["point2"], 2)?,
+        };
+        let uvs = match uv {
+            Some((v, s)) if v.len() != 2 * n => {
+                self.warn("`uv` does not have one pair per point: left out", s);
+                None
+            }
+            Some((v, _)) => Some(v.chunks(2).map(|c| Vec2::new(c[0] as f32, c[1] as f32)).collect()),
+            None => None,
+        };
+        let _ = params.list("S", &["vector3"], 3);
+        let _ = params.list("faceIndices", &["integer"], 1);
+        Ok((!triangles.is_empty()).then_some(TrimeshDesc {
+            points,
+            triangles,
+            normals,
+            materials: None,
+            uvs,
+        }))
+    }
+}
+
+fn parse_number(t: &Token) -> Result<f32, ParseError> {
+    let bad = || ParseError::new(format!("expected a number, found `{}`", t.text), t.span.clone());
+    let first = t.text.chars().next().ok_or_else(bad)?;
+    if !(first.is_ascii_digit() || matches!(first, '-' | '+' | '.')) {
+        return Err(bad());
+    }
+    let v: f64 = t.text.parse().map_err(|_| bad())?;
+    if !v.is_finite() || v.abs() > f32::MAX as f64 {
+        return Err(ParseError::new(format!("`{}` is out of range", t.text), t.span.clone()));
+    }
+    Ok(v as f32)
+}
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+fn diffuse(reflectance: Param) -> MaterialDesc {
+    MaterialDesc {
+        diffuse: reflectance,
+        ..MaterialDesc::default()
+    }
+}
+
+fn scaled(p: Param, s: f32) -> Param {
+    match p {
+        Param::Constant(c) => Param::Constant(c * s),
+        other => other,
+    }
+}
+
+/// The course reading of a glossy lobe of normal reflectance `f0` and GGX α: a mirror when
+/// smooth, else a Phong highlight of exponent 2/α² − 2 (the Beckmann–Phong correspondence).
+fn course_gloss(m: &mut MaterialDesc, f0: Vec3, alpha: f32) {
+    if alpha < 1e-3 {
+        m.reflective = Param::Constant(f0);
+    } else {
+        m.specular = Param::Constant(f0);
+        m.shininess = Param::grey((2.0 / (alpha * alpha) - 2.0).clamp(1.0, 10_000.0));
+    }
+}
+
+/// The rotation part of a matrix (its scale removed), for the sky's frame.
+fn orthonormal(m: Mat3) -> Mat3 {
+    let x = m.x_axis.normalize_or_zero();
+    let y = (m.y_axis - x * x.dot(m.y_axis)).normalize_or_zero();
+    let z = x.cross(y);
+    if x == Vec3::ZERO || y == Vec3::ZERO {
+        return Mat3::IDENTITY;
+    }
+    // Keep a mirrored frame mirrored.
+    let z = if m.determinant() < 0.0 { -z } else { z };
+    Mat3::from_cols(x, y, z)
+}
+
+/// World area of a shape, for area lights given by `power`.
+fn shape_area(shape: &ShapeDesc, m: &Mat4) -> f32 {
+    let pi = std::f32::consts::PI;
+    let linear = Mat3::from_mat4(*m);
+    let scale2 = |a: Vec3, b: Vec3| (linear * a).cross(linear * b).length();
+    match shape {
+        ShapeDesc::Sphere => 4.0 * pi * scale2(Vec3::X, Vec3::Y).max(scale2(Vec3::Y, Vec3::Z)),
+        ShapeDesc::Disk { inner } => pi * (1.0 - inner * inner) * scale2(Vec3::X, Vec3::Y),
+        ShapeDesc::Cylinder { .. } => 2.0 * pi * (linear * Vec3::X).length() * (linear * Vec3::Z).length(),
+        ShapeDesc::Trimesh(mesh) => mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| m.transform_point3(mesh.points[i as usize]));
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum(),
+        _ => 1.0,
+    }
+}

@@ -1,0 +1,248 @@
+use super::*;
+use crate::error::Error;
+use crate::progress::NoProgress;
+
+fn read_text(text: &str) -> Result<SceneSource> {
+    read(Path::new("t.pbrt"), text.to_string(), Path::new("."), &NoProgress)
+}
+
+fn scene(body: &str) -> SceneDescription {
+    let text = format!("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\nWorldBegin\n{body}\n");
+    read_text(&text).unwrap_or_else(|e| panic!("{e}")).description
+}
+
+fn error(text: &str) -> (String, usize, usize) {
+    match read_text(text) {
+        Err(Error::Scene { path, text, error }) => {
+            let (line, col) = crate::error::line_col(&text, error.span.start);
+            assert_eq!(path, Path::new("t.pbrt"));
+            (error.message, line, col)
+        }
+        other => panic!(
+            "expected an error, got {:?}",
+            other.map(|s| s.description.objects.len())
+        ),
+    }
+}
+
+/// pbrt's camera looks down +z of its space with x to the right of the image: from +z towards
+/// the origin with y up, the world's +x is on the image's left (not mirrored as a right-handed
+/// reading of the same numbers would put it).
+#[test]
+fn the_camera_is_not_mirrored() {
+    let desc = scene("");
+    let camera = crate::camera::Camera::from_desc(desc.camera.as_ref().unwrap());
+    let (sx, sy) = camera.project(Vec3::new(1.0, 0.5, 0.0)).unwrap();
+    assert!(sx < 0.5, "pbrt puts +x on the left here: {sx}");
+    assert!(sy > 0.5, "and +y up: {sy}");
+    // fov spans the shorter axis: 1280×720 by default, so 45° vertically.
+    let (_, top) = camera
+        .project(Vec3::new(0.0, 5.0 * (22.5f32).to_radians().tan(), 0.0))
+        .unwrap();
+    assert!((top - 1.0).abs() < 1e-3, "{top}");
+    assert_eq!(desc.hints.width, Some(1280));
+    assert_eq!(desc.hints.height, Some(720));
+    // A mirroring scale before the camera flips the image back, as in pbrt.
+    let text = "Scale -1 1 1\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n";
+    let mirrored = read_text(text).unwrap().description;
+    let camera = crate::camera::Camera::from_desc(mirrored.camera.as_ref().unwrap());
+    assert!(camera.project(Vec3::new(1.0, 0.0, 0.0)).unwrap().0 > 0.5);
+}
+
+#[test]
+fn transforms_compose_as_pbrt_does() {
+    let desc = scene(
+        "AttributeBegin\nTranslate 1 2 3\nRotate 90 0 0 1\nScale 2 2 2\nShape \"sphere\" \"float radius\" 0.5\nAttributeEnd\n\
+         AttributeBegin\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  4 5 6 1]\nConcatTransform [2 0 0 0 0 2 0 0 0 0 2 0 0 0 0 1]\nShape \"sphere\"\nAttributeEnd\n\
+         Shape \"sphere\"",
+    );
+    let m = desc.objects[0].world_from_object;
+    // Scale 2 × radius 0.5, then a quarter turn about z (x → y), then the translation.
+    let p = m.transform_point3(Vec3::X);
+    assert!((p - Vec3::new(1.0, 3.0, 3.0)).length() < 1e-5, "{p:?}");
+    let q = desc.objects[1].world_from_object.transform_point3(Vec3::X);
+    assert!((q - Vec3::new(6.0, 5.0, 6.0)).length() < 1e-5, "{q:?}");
+    assert_eq!(
+        desc.objects[2].world_from_object,
+        Mat4::IDENTITY,
+        "AttributeEnd restores"
+    );
+}
+
+#[test]
+fn film_sampler_and_integrator_become_hints() {
+    let text =
+        "Film \"rgb\" \"integer xresolution\" [200] \"integer yresolution\" 100 \"string filename\" \"out.exr\"\n\
+                Sampler \"halton\" \"integer pixelsamples\" 32\n\
+                Integrator \"sppm\" \"integer maxdepth\" 7 \"integer photonsperiteration\" 5000\n\
+                Camera \"perspective\"\nWorldBegin\n";
+    let hints = read_text(text).unwrap().description.hints;
+    assert_eq!((hints.width, hints.height), (Some(200), Some(100)));
+    assert_eq!(hints.output, Some(PathBuf::from("out.exr")));
+    assert_eq!(hints.samples, Some(32));
+    assert_eq!(hints.integrator, Some(IntegratorHint::Ppm));
+    assert_eq!(hints.max_depth, Some(7));
+    assert_eq!(hints.photons_per_pass, Some(5000));
+    assert!(hints.physical);
+    let bdpt = read_text("Integrator \"bdpt\"\nWorldBegin\n").unwrap().description;
+    assert_eq!(bdpt.hints.integrator, Some(IntegratorHint::Path));
+    assert!(bdpt.warnings.iter().any(|(w, _)| w.contains("vcm")));
+}
+
+#[test]
+fn materials_map_to_both_models() {
+    let desc = scene(
+        "Material \"dielectric\" \"spectrum eta\" \"glass-F11\"\nShape \"sphere\"\n\
+         Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.01\nShape \"sphere\"\n\
+         Material \"conductor\"\nShape \"sphere\"\n\
+         Material \"coateddiffuse\" \"rgb reflectance\" [0.5 0.1 0.1] \"float roughness\" 0\nShape \"sphere\"\n\
+         Material \"diffusetransmission\"\nShape \"sphere\"\n\
+         MakeNamedMaterial \"red\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0 0]\nNamedMaterial \"red\"\nShape \"sphere\"",
+    );
+    let m: Vec<&MaterialDesc> = desc.objects.iter().map(|o| &o.material).collect();
+    assert_eq!(m[0].index, Param::grey(1.78472));
+    assert_eq!(m[0].abbe, Some(25.68));
+    assert_eq!(m[0].transmissive, Param::grey(1.0));
+    let Some(PhysicalMaterial::Conductor { roughness, eta, .. }) = &m[1].physical else {
+        panic!()
+    };
+    assert!((roughness - 0.1).abs() < 1e-6, "remapped: √0.01");
+    assert_eq!(*eta, spectra::metal("metal-Au").unwrap().0);
+    assert!(
+        matches!(m[1].specular, Param::Constant(c) if c.x > 0.9),
+        "{:?}",
+        m[1].specular
+    );
+    let Some(PhysicalMaterial::Conductor { roughness, .. }) = &m[2].physical else {
+        panic!()
+    };
+    assert_eq!(*roughness, 0.0);
+    assert!(
+        matches!(m[2].reflective, Param::Constant(c) if c.x > 0.9 && c.z < 0.6),
+        "copper by default"
+    );
+    assert!(matches!(m[3].physical, Some(PhysicalMaterial::CoatedDiffuse { eta, .. }) if eta == 1.5));
+    assert_eq!(m[3].diffuse, Param::Constant(Vec3::new(0.5, 0.1, 0.1)));
+    assert!(matches!(
+        m[4].physical,
+        Some(PhysicalMaterial::DiffuseTransmission { .. })
+    ));
+    assert_eq!(m[5].diffuse, Param::Constant(Vec3::new(0.8, 0.0, 0.0)));
+}
+
+#[test]
+fn lights_shapes_and_instances() {
+    let desc = scene(
+        "LightSource \"point\" \"point3 from\" [0 4 0] \"rgb I\" [2 2 2] \"float scale\" 3\n\
+         LightSource \"distant\" \"point3 from\" [0 1 0] \"point3 to\" [0 0 0] \"blackbody L\" 5500\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4] \"bool twosided\" true\nShape \"disk\" \"float radius\" 2 \"float innerradius\" 1\nAttributeEnd\n\
+         Shape \"cylinder\" \"float zmin\" -1 \"float zmax\" 3\n\
+         ObjectBegin \"tri\"\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\nObjectEnd\n\
+         Translate 10 0 0\nObjectInstance \"tri\"\nTranslate 10 0 0\nObjectInstance \"tri\"",
+    );
+    let LightDesc::Point { position, color, .. } = &desc.lights[0] else {
+        panic!()
+    };
+    assert_eq!((*position, *color), (Vec3::new(0.0, 4.0, 0.0), Vec3::splat(6.0)));
+    let LightDesc::Directional { direction, color, .. } = &desc.lights[1] else {
+        panic!()
+    };
+    assert_eq!(*direction, -Vec3::Y);
+    assert!((0.2126 * color.x + 0.7152 * color.y + 0.0722 * color.z - 1.0).abs() < 1e-3);
+    assert!(matches!(desc.objects[0].shape, ShapeDesc::Disk { inner } if inner == 0.5));
+    assert_eq!(desc.objects[0].material.emissive, Param::grey(4.0));
+    let cylinder = desc.objects[1].world_from_object;
+    assert!((cylinder.transform_point3(Vec3::Z) - Vec3::new(0.0, 0.0, 3.0)).length() < 1e-6);
+    assert_eq!(desc.objects.len(), 4, "two instances of the triangle");
+    assert!((desc.objects[3].world_from_object.transform_point3(Vec3::ZERO).x - 20.0).abs() < 1e-6);
+}
+
+#[test]
+fn unsupported_directives_warn_with_their_place_and_reading_goes_on() {
+    let text = "WorldBegin\nFrobnicate \"x\" [1 2] 3\nShape \"curve\" \"point3 P\" [0 0 0]\nShape \"sphere\" \"float bogus\" 1\n";
+    let source = read_text(text).unwrap();
+    let w = &source.description.warnings;
+    let at = |needle: &str| {
+        let (_, span) = w
+            .iter()
+            .find(|(m, _)| m.contains(needle))
+            .unwrap_or_else(|| panic!("{needle}: {w:?}"));
+        crate::error::line_col(text, span.start)
+    };
+    assert_eq!(at("Frobnicate"), (2, 1));
+    assert_eq!(at("curve"), (3, 7));
+    assert_eq!(at("bogus"), (4, 16));
+    assert_eq!(source.description.objects.len(), 1);
+}
+
+#[test]
+fn malformed_files_get_located_errors() {
+    assert_eq!(error("WorldBegin\nShape \"sphere\" \"float radius\" [1\n").1, 2);
+    let (m, line, col) = error("WorldBegin\nTranslate 1 x 2\n");
+    assert!(m.contains("number"), "{m}");
+    assert_eq!((line, col), (2, 13));
+    assert!(error("LookAt 0 0 0 0 0 1 0 1 0\n").0.contains("WorldBegin"));
+    assert!(
+        error("WorldBegin\nShape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 5]\n")
+            .0
+            .contains("out of range")
+    );
+    assert!(error("WorldBegin\nNamedMaterial \"nope\"\n").0.contains("nope"));
+    assert!(error("WorldBegin\nShape \"sphere\" \"floot radius\" 1\n")
+        .0
+        .contains("floot"));
+    assert!(error("WorldBegin\nLookAt 0 0 0  0 0 0  0 1 0\n").0.contains("LookAt"));
+    assert!(error("WorldBegin\nShape \"sphere\" \"float radius\" \"one\"\n")
+        .0
+        .contains("cannot take"));
+    assert!(
+        error("WorldBegin\nMaterial \"dielectric\" \"spectrum eta\" \"glass-XYZ\"\n")
+            .0
+            .contains("glass-XYZ")
+    );
+}
+
+#[test]
+fn included_files_name_themselves_in_errors() {
+    let dir = std::env::temp_dir().join(format!("caustica-pbrt-include-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("geometry.pbrt"),
+        "Shape \"sphere\"\nShape \"sphere\" \"float radius\" [2 oops]\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("ok.pbrt"),
+        "Material \"diffuse\" \"rgb reflectance\" [0.1 0.2 0.3]\nShape \"sphere\"\n",
+    )
+    .unwrap();
+    let main = "WorldBegin\nImport \"ok.pbrt\"\nShape \"sphere\"\nInclude \"geometry.pbrt\"\n";
+    let result = read(&dir.join("main.pbrt"), main.to_string(), &dir, &NoProgress);
+    let Err(Error::Scene { path, text, error }) = result else {
+        panic!("expected an error")
+    };
+    assert_eq!(path, dir.join("geometry.pbrt"));
+    assert_eq!(crate::error::line_col(&text, error.span.start), (2, 34));
+    // Import keeps its material to itself.
+    let main = "WorldBegin\nImport \"ok.pbrt\"\nShape \"sphere\"\n";
+    let desc = read(&dir.join("main.pbrt"), main.to_string(), &dir, &NoProgress)
+        .unwrap()
+        .description;
+    assert_eq!(
+        desc.objects[0].material.diffuse,
+        Param::Constant(Vec3::new(0.1, 0.2, 0.3))
+    );
+    assert_eq!(desc.objects[1].material.diffuse, Param::grey(0.5));
+    // A missing file is an error at the directive that names it.
+    let Err(Error::Scene { path, error, .. }) = read(
+        &dir.join("main.pbrt"),
+        "WorldBegin\nInclude \"gone.pbrt\"\n".into(),
+        &dir,
+        &NoProgress,
+    ) else {
+        panic!()
+    };
+    assert_eq!(path, dir.join("main.pbrt"));
+    assert_eq!(error.span.start, 19);
+    std::fs::remove_dir_all(&dir).ok();
+}
