@@ -1,13 +1,14 @@
 //! `caustica render`: the options become a render session of the library, which this command
 //! runs with progress bars, saving the image (and the partial sums) as it goes.
 
+use super::load_scene;
 use super::shown;
-use super::{check_photon_memory, load_scene, thread_pool};
 use crate::cli::RenderArgs;
 use crate::progress::Bars;
 use caustica::film::ToneMap;
 use caustica::image_io::ImageFormat;
-use caustica::integrator::config::{IntegratorKind, Model};
+use caustica::integrator::config::thread_pool;
+use caustica::integrator::config::Model;
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
 use caustica::light::Light;
 use caustica::progress::Control;
@@ -47,6 +48,8 @@ pub fn config(args: &RenderArgs) -> Result<RenderConfig> {
             (_, true) => Some(false),
             _ => None,
         },
+        max_memory: args.photon.max_memory,
+        partial: p.partial.clone(),
     })
 }
 
@@ -55,17 +58,9 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let start = Instant::now();
     let config = config(&args)?;
     let options = &args.progressive;
-    if config.integrator_kind()? != IntegratorKind::Path {
-        check_photon_memory(config.photon_total(), args.photon.max_memory)?;
-    }
     let integrator = config.integrator()?;
     let progressive = integrator.is_progressive();
     let plan = config.plan()?;
-    if !progressive && options.partial.is_some() {
-        return Err(Error::InvalidSettings(
-            "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
-        ));
-    }
     if !options.exposure.is_finite() || options.exposure.abs() > 64.0 {
         return Err(Error::InvalidSettings(
             "--exposure must be a number of stops between -64 and 64".into(),
