@@ -11,13 +11,14 @@ use caustica::integrator::config::thread_pool;
 use caustica::integrator::config::Model;
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
 use caustica::light::Light;
+use caustica::preview::{tev, Preview, PreviewReport, PreviewSettings};
 use caustica::progress::Control;
 use caustica::scene::Scene;
 use caustica::{Error, Result};
 use serde_json::json;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// The library's render options from the command line.
 pub fn config(args: &RenderArgs) -> Result<RenderConfig> {
@@ -80,13 +81,11 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     if let Some(o) = &output {
         ImageFormat::from_path(o)?;
     }
+    let display = args.preview.display.as_deref().map(tev::parse_address).transpose()?;
+    check_preview(&args, &output)?;
     let pool = thread_pool(args.threads)?;
     let quiet = args.quiet || args.json;
     let bars = Bars::new(quiet);
-    let control = Control {
-        progress: &bars,
-        cancel,
-    };
 
     let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
     let scene = &loaded.scene;
@@ -121,6 +120,36 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     } else {
         ToneMap::Clamp
     };
+    let preview = if display.is_some() || args.preview.preview {
+        let name = [&output, &options.partial]
+            .into_iter()
+            .flatten()
+            .next()
+            .and_then(|p| p.file_name())
+            .map_or_else(|| "caustica".to_string(), |n| n.to_string_lossy().into_owned());
+        let settings = PreviewSettings {
+            display,
+            file: output.clone().filter(|_| args.preview.preview).map(|o| (o, tone_map)),
+            name,
+            interval: Duration::from_secs_f64(args.preview.preview_every),
+        };
+        let warn = move |message: String| {
+            if !quiet {
+                eprintln!("warning: preview: {message}");
+            }
+        };
+        Some(Preview::start(width, height, settings, warn)?)
+    } else {
+        None
+    };
+    let preview_progress = preview.as_ref().map(|p| p.progress(&bars));
+    let control = Control {
+        progress: match &preview_progress {
+            Some(p) => p,
+            None => &bars,
+        },
+        cancel,
+    };
     let save = |session: &RenderSession| -> Result<()> {
         if let Some(o) = &output {
             session.image().save(o, tone_map)?;
@@ -134,6 +163,9 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let mut last_save = Instant::now();
     let summary = pool.install(|| {
         session.run(&plan, control, |session| {
+            if let Some(preview) = &preview {
+                preview.offer(|| session.image());
+            }
             // Progressive renders are rewritten as they converge; the final save is below.
             if progressive && last_save.elapsed().as_secs_f64() >= options.save_every {
                 save(session)?;
@@ -142,6 +174,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
             Ok(())
         })
     })?;
+    // The viewer gets the final image; the preview's last file write is over before the save.
+    let preview_report = preview.map(|p| p.finish(&session.image()));
     let photon_stats = session.caustic_map().map(|m| m.stats.clone());
     if !quiet {
         if let Some(s) = &photon_stats {
@@ -207,6 +241,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                     "total": total,
                 },
                 "peak_memory_bytes": super::peak_memory_bytes(),
+                "preview": preview_json(&preview_report),
             })
         } else {
             let aa = config.aa;
@@ -228,6 +263,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                     "total": total,
                 },
                 "peak_memory_bytes": super::peak_memory_bytes(),
+                "preview": preview_json(&preview_report),
             })
         };
         println!("{summary}");
@@ -264,6 +300,34 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         }
     }
     Ok(if complete { 0 } else { crate::EXIT_INTERRUPTED })
+}
+
+/// Refuses preview options that cannot work, before any work.
+fn check_preview(args: &RenderArgs, output: &Option<PathBuf>) -> Result<()> {
+    let every = args.preview.preview_every;
+    if !(every > 0.0 && every <= 3600.0) {
+        return Err(Error::InvalidSettings(
+            "--preview-every must be a positive number of seconds (at most 3600)".into(),
+        ));
+    }
+    if args.preview.preview && output.is_none() {
+        return Err(Error::InvalidSettings(
+            "--preview rewrites the output image: give one with -o".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The preview's work in the JSON summary (`null` without one).
+fn preview_json(report: &Option<PreviewReport>) -> serde_json::Value {
+    match report {
+        Some(r) => json!({
+            "updates": r.updates,
+            "busy_seconds": r.busy_seconds,
+            "bytes_sent": r.bytes_sent,
+        }),
+        None => serde_json::Value::Null,
+    }
 }
 
 /// What the physical model reads differently from the course's shading.
