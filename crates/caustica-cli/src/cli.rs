@@ -200,9 +200,10 @@ pub struct PreviewOptions {
     /// that reloads it never sees half a file).
     #[arg(long)]
     pub preview: bool,
-    /// Seconds between updates of --display and --preview.
-    #[arg(long, default_value_t = 0.5)]
-    pub preview_every: f64,
+    /// Seconds between updates [default: 0.5 for --display, 2 for --preview, whose image
+    /// encoding costs more].
+    #[arg(long)]
+    pub preview_every: Option<f64>,
 }
 
 /// The physical model and its integrators.

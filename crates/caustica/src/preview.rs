@@ -30,8 +30,19 @@ pub struct PreviewSettings {
     pub file: Option<(PathBuf, ToneMap)>,
     /// The name of the image in the viewer.
     pub name: String,
-    /// Time between updates.
-    pub interval: Duration,
+    /// Time between updates of the viewer.
+    pub display_every: Duration,
+    /// Time between writes of the file (encoding an image costs more than sending it).
+    pub file_every: Duration,
+}
+
+impl PreviewSettings {
+    /// How often the preview thread looks for changes: as often as its most frequent output.
+    fn interval(&self) -> Duration {
+        let display = self.display.as_ref().map(|_| self.display_every);
+        let file = self.file.as_ref().map(|_| self.file_every);
+        display.into_iter().chain(file).min().unwrap_or(self.file_every)
+    }
 }
 
 /// What a preview did, for the front end's summary.
@@ -98,7 +109,7 @@ impl Preview {
             wake: Condvar::new(),
             blocks_x,
         });
-        let interval = settings.interval;
+        let interval = settings.interval();
         let thread = {
             let shared = Arc::clone(&shared);
             std::thread::Builder::new()
@@ -219,8 +230,9 @@ struct Updater {
     unsent: Vec<bool>,
     /// Blocks the render has shown at all (the rest are still black).
     touched: Vec<bool>,
-    /// Whether the file is behind the image.
+    /// Whether the file is behind the image, and when it was last written.
     file_stale: bool,
+    file_written: Option<Instant>,
     viewer: Option<tev::TevClient>,
     /// When a connection was last tried, and whether the viewer was missing then.
     last_attempt: Option<Instant>,
@@ -246,6 +258,7 @@ impl Updater {
             unsent: vec![false; blocks],
             touched: vec![false; blocks],
             file_stale: false,
+            file_written: None,
             viewer: None,
             last_attempt: None,
             viewer_missing: false,
@@ -263,7 +276,7 @@ impl Updater {
                 let (latest, _) = self
                     .shared
                     .wake
-                    .wait_timeout_while(latest, self.settings.interval, |l| !l.done)
+                    .wait_timeout_while(latest, self.settings.interval(), |l| !l.done)
                     .unwrap_or_else(|e| e.into_inner());
                 latest.done
             };
@@ -281,7 +294,7 @@ impl Updater {
         if changed || last || self.viewer.is_none() {
             self.send_to_viewer();
         }
-        if changed && !last {
+        if !last {
             self.write_file();
         }
         if changed {
@@ -402,10 +415,12 @@ impl Updater {
         let Some((path, tone_map)) = &self.settings.file else {
             return;
         };
-        if !self.file_stale {
+        let due = !matches!(self.file_written, Some(t) if t.elapsed() < self.settings.file_every);
+        if !self.file_stale || !due {
             return;
         }
         self.file_stale = false;
+        self.file_written = Some(Instant::now());
         if let Err(e) = self.image.save(path, *tone_map) {
             if !self.file_failed {
                 (self.warn)(format!("cannot write the preview: {e}"));
@@ -429,7 +444,8 @@ mod tests {
             display: None,
             file: Some((path.clone(), ToneMap::Clamp)),
             name: "p".into(),
-            interval: Duration::from_millis(5),
+            display_every: Duration::from_secs(3600),
+            file_every: Duration::from_millis(5),
         };
         let preview = Preview::start(200, 3, settings, |m| panic!("{m}")).unwrap();
         // A tile straddling two preview blocks.

@@ -131,7 +131,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
             display,
             file: output.clone().filter(|_| args.preview.preview).map(|o| (o, tone_map)),
             name,
-            interval: Duration::from_secs_f64(args.preview.preview_every),
+            display_every: Duration::from_secs_f64(args.preview.preview_every.unwrap_or(0.5)),
+            file_every: Duration::from_secs_f64(args.preview.preview_every.unwrap_or(2.0)),
         };
         let warn = move |message: String| {
             if !quiet {
@@ -304,8 +305,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
 
 /// Refuses preview options that cannot work, before any work.
 fn check_preview(args: &RenderArgs, output: &Option<PathBuf>) -> Result<()> {
-    let every = args.preview.preview_every;
-    if !(every > 0.0 && every <= 3600.0) {
+    if args.preview.preview_every.is_some_and(|s| !(s > 0.0 && s <= 3600.0)) {
         return Err(Error::InvalidSettings(
             "--preview-every must be a positive number of seconds (at most 3600)".into(),
         ));
