@@ -52,7 +52,8 @@ def test_cancel_stops_the_pass_in_flight_and_keeps_the_rest(scenes):
             threading.Timer(0.05, run.cancel).start()
             started = time.perf_counter()
     stopped = time.perf_counter() - started
-    assert seen in (2, 3) and run.passes == seen
+    # The third pass, or one after it on a machine faster than 50 ms a pass, was cut short.
+    assert seen >= 2 and run.passes == seen
     assert stopped < 5, f"the run took {stopped:.1f} s to stop"
     expected = caustica.render(scenes / "glass_sphere.ray", **{**options, "passes": seen})
     assert np.array_equal(run.image(), expected)

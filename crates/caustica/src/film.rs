@@ -64,12 +64,13 @@ impl Film {
 
     /// 8-bit RGB bytes under `tone_map`.
     pub fn to_rgb8(&self, tone_map: ToneMap) -> Vec<u8> {
-        // The exposure's factor once, not per value (the same bytes; a live preview calls this
-        // often).
+        // The exposure's factor once, not per value (the same bytes).
         let scale = exposure_scale(tone_map);
-        let mut bytes = Vec::with_capacity(self.pixels.len() * 3);
-        for p in &self.pixels {
-            bytes.extend(p.to_array().map(|c| encode_scaled(c, tone_map, scale)));
+        let mut bytes = vec![0; self.pixels.len() * 3];
+        for (rgb, p) in bytes.chunks_exact_mut(3).zip(&self.pixels) {
+            rgb[0] = encode_scaled(p.x, tone_map, scale);
+            rgb[1] = encode_scaled(p.y, tone_map, scale);
+            rgb[2] = encode_scaled(p.z, tone_map, scale);
         }
         bytes
     }

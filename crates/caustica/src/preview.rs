@@ -230,15 +230,27 @@ struct Updater {
     unsent: Vec<bool>,
     /// Blocks the render has shown at all (the rest are still black).
     touched: Vec<bool>,
-    /// Whether the file is behind the image, and when it was last written.
+    /// Whether the file is behind the image, and when it may next be written.
     file_stale: bool,
-    file_written: Option<Instant>,
+    file_due: Option<Instant>,
+    /// When the viewer may next be updated.
+    viewer_due: Option<Instant>,
     viewer: Option<tev::TevClient>,
     /// When a connection was last tried, and whether the viewer was missing then.
     last_attempt: Option<Instant>,
     viewer_missing: bool,
     file_failed: bool,
     report: PreviewReport,
+}
+
+/// The preview may keep one core busy for at most this fraction of the time: after an update
+/// that took t, the next waits at least t / SHARE (however short the interval), so a large
+/// image or a slow disk slows the preview, not the render.
+const SHARE: f64 = 0.02;
+
+/// The time to wait after work that took `busy`, at least `interval`.
+fn pause_after(busy: Duration, interval: Duration) -> Duration {
+    interval.max(busy.div_f64(SHARE))
 }
 
 /// Time between attempts to reach a viewer that is not there.
@@ -258,7 +270,8 @@ impl Updater {
             unsent: vec![false; blocks],
             touched: vec![false; blocks],
             file_stale: false,
-            file_written: None,
+            file_due: None,
+            viewer_due: None,
             viewer: None,
             last_attempt: None,
             viewer_missing: false,
@@ -292,7 +305,7 @@ impl Updater {
         let start = Instant::now();
         let changed = self.take_changes();
         if changed || last || self.viewer.is_none() {
-            self.send_to_viewer();
+            self.send_to_viewer(last);
         }
         if !last {
             self.write_file();
@@ -334,16 +347,26 @@ impl Updater {
         (x0, y0, w, h)
     }
 
-    fn send_to_viewer(&mut self) {
+    fn send_to_viewer(&mut self, last: bool) {
         let Some(address) = self.settings.display.clone() else {
             return;
         };
+        if !last && matches!(self.viewer_due, Some(t) if Instant::now() < t) {
+            return;
+        }
+        let start = Instant::now();
+        self.send_blocks(&address);
+        self.viewer_due = Some(Instant::now() + pause_after(start.elapsed(), self.settings.display_every));
+    }
+
+    /// Connects if need be, then sends the blocks the viewer has not seen.
+    fn send_blocks(&mut self, address: &str) {
         if self.viewer.is_none() {
             if self.last_attempt.is_some_and(|t| t.elapsed() < RECONNECT) {
                 return;
             }
             self.last_attempt = Some(Instant::now());
-            match tev::TevClient::connect(&address) {
+            match tev::TevClient::connect(address) {
                 Ok(client) => {
                     self.viewer = Some(client);
                     self.viewer_missing = false;
@@ -415,13 +438,15 @@ impl Updater {
         let Some((path, tone_map)) = &self.settings.file else {
             return;
         };
-        let due = !matches!(self.file_written, Some(t) if t.elapsed() < self.settings.file_every);
+        let due = !matches!(self.file_due, Some(t) if Instant::now() < t);
         if !self.file_stale || !due {
             return;
         }
         self.file_stale = false;
-        self.file_written = Some(Instant::now());
-        if let Err(e) = self.image.save(path, *tone_map) {
+        let start = Instant::now();
+        let written = self.image.save(path, *tone_map);
+        self.file_due = Some(Instant::now() + pause_after(start.elapsed(), self.settings.file_every));
+        if let Err(e) = written {
             if !self.file_failed {
                 (self.warn)(format!("cannot write the preview: {e}"));
                 self.file_failed = true;
@@ -434,6 +459,14 @@ impl Updater {
 mod tests {
     use super::*;
     use crate::progress::NoProgress;
+
+    #[test]
+    fn slow_updates_wait_longer_than_the_interval() {
+        let interval = Duration::from_millis(500);
+        // Quick work keeps the interval; slow work waits fifty times as long as it took.
+        assert_eq!(pause_after(Duration::from_millis(2), interval), interval);
+        assert_eq!(pause_after(Duration::from_millis(40), interval), Duration::from_secs(2));
+    }
 
     #[test]
     fn tiles_and_passes_reach_the_file() {
