@@ -41,6 +41,8 @@ class RenderOptions(TypedDict, total=False):
     footprint: float
     alpha: float
     no_camera_specular: bool
+    spectral: bool | None
+    no_spectral: bool
     cone_quirks: bool
     dialect: Literal["tokenizer", "dictionary"] | None
 

@@ -35,6 +35,8 @@ pub const RENDER: &[&str] = &[
     "footprint",
     "alpha",
     "no_camera_specular",
+    "spectral",
+    "no_spectral",
     "cone_quirks",
     "dialect",
 ];
@@ -78,6 +80,7 @@ pub fn parse(
         save_every: 10.0,
     };
     let (mut cone_quirks, mut dialect, mut load_given) = (false, None::<String>, false);
+    let (mut spectral, mut no_spectral) = (None, false);
     let Some(kwargs) = kwargs else {
         return Ok(options);
     };
@@ -136,6 +139,8 @@ pub fn parse(
             "footprint" => c.footprint = v.number()? as f32,
             "alpha" => c.alpha = v.number()? as f32,
             "no_camera_specular" => c.no_camera_specular = v.flag()?,
+            "spectral" => spectral = v.optional(Value::flag)?,
+            "no_spectral" => no_spectral = v.flag()?,
             "save_every" => options.save_every = v.number()?,
             "cone_quirks" => {
                 cone_quirks = v.flag()?;
@@ -148,6 +153,16 @@ pub fn parse(
             _ => unreachable!("every allowed option is read"),
         }
     }
+    // `no_spectral` is the command line's spelling of `spectral=False`.
+    options.config.spectral = match (spectral, no_spectral) {
+        (Some(true), true) => {
+            return Err(PyValueError::new_err(format!(
+                "{function}(): spectral=True and no_spectral=True contradict each other"
+            )))
+        }
+        (_, true) => Some(false),
+        (given, false) => given,
+    };
     if !(options.save_every > 0.0 && options.save_every.is_finite()) {
         return Err(PyValueError::new_err("save_every must be a positive number of seconds"));
     }

@@ -162,7 +162,8 @@ impl SceneSource {
 /// line's, `-` written `_`: model, integrator, width, height, aa, depth, threads, seed, photons,
 /// max_emitted, photons_per_light, no_aim, max_memory, k, radius, cone_filter,
 /// no_estimate_reuse, passes (N or "A..B"), time, partial (a path: the sums of the passes are
-/// saved there, for merge()), footprint, alpha, no_camera_specular, cone_quirks, dialect.
+/// saved there, for merge()), footprint, alpha, no_camera_specular, spectral (True, False or
+/// None for the default: spectral when a glass disperses), no_spectral, cone_quirks, dialect.
 ///
 /// The GIL is released while it renders; Ctrl-C stops the render and raises KeyboardInterrupt
 /// (a partial file still gets the passes completed).

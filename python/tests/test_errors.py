@@ -75,6 +75,8 @@ def test_a_misspelt_keyword_gets_help(tmp_path):
         (dict(photons=10**9), ValueError, "max_memory"),
         (dict(threads=0), ValueError, "threads must be between 1 and 1024"),
         (dict(dialect="klingon"), ValueError, "unknown dialect"),
+        (dict(spectral="yes"), TypeError, "spectral must be True or False"),
+        (dict(model="physical", spectral=True, no_spectral=True), ValueError, "contradict"),
     ],
     ids=lambda v: str(v)[:30],
 )

@@ -38,6 +38,8 @@ PHYSICAL = [
     ("glass_sphere.ray", dict(integrator="gi", width=24, passes=2, photons=3000, k=20, alpha=0.5)),
     ("glass_sphere.ray", dict(integrator="path", width=32, passes="1..3", depth=8, no_camera_specular=True)),
     ("ring.ray", dict(integrator="ppm", width=32, passes=2, photons=4000, footprint=3, seed=7)),
+    ("glass_sphere.ray", dict(model="physical", width=24, passes=2, photons=3000, spectral=True)),
+    ("glass_sphere.ray", dict(integrator="path", width=24, passes=2, spectral=True)),
 ]
 
 
@@ -47,6 +49,25 @@ def test_pixels_equal_the_command_lines_exr(tmp_path, scenes, scene, options):
     theirs = cli_image(tmp_path, scenes / scene, options)
     assert ours.shape == theirs.shape
     assert np.array_equal(ours, theirs), f"largest difference {np.abs(ours - theirs).max()}"
+
+
+def test_spectral_keywords_choose_the_transport_as_the_command_line_does(tmp_path, scenes):
+    # The glass ball, made dispersive: spectral by default, RGB with no_spectral or spectral=False.
+    text = (scenes / "glass_sphere.ray").read_text()
+    assert "index = 1.5;" in text
+    path = tmp_path / "dispersive.ray"
+    path.write_text(text.replace("index = 1.5;", "index = 1.5; abbe = 30;"))
+    options = dict(model="physical", width=24, passes=2, photons=3000)
+    default = caustica.render(path, **options)
+    assert np.array_equal(default, caustica.render(path, spectral=True, **options))
+    assert np.array_equal(default, cli_image(tmp_path, path, options))
+    rgb = caustica.render(path, no_spectral=True, **options)
+    assert not np.array_equal(rgb, default)
+    assert np.array_equal(rgb, caustica.render(path, spectral=False, **options))
+    assert np.array_equal(rgb, cli_image(tmp_path, path, {**options, "no_spectral": True}))
+    # Without dispersion RGB is the default, and spectral=True changes the image.
+    plain = scenes / "glass_sphere.ray"
+    assert not np.array_equal(caustica.render(plain, spectral=True, **options), caustica.render(plain, **options))
 
 
 def test_the_built_in_scene_and_a_loaded_scene_render_as_the_command_line(tmp_path, scenes):
@@ -66,7 +87,7 @@ def test_the_thread_count_does_not_change_the_image(scenes):
 
 
 def test_info_is_the_command_lines_json(scenes):
-    for name in ["ring.ray", "glass_sphere.ray", "pool.ray"]:
+    for name in ["ring.ray", "glass_sphere.ray", "pool.ray", "magnifier_sun.ray"]:
         path = str(scenes / name)
         ours = caustica.Scene(path).info()
         theirs = json.loads(cli("info", path, "--json").stdout)
