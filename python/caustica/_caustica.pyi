@@ -44,7 +44,7 @@ class RenderOptions(TypedDict, total=False):
     spectral: bool | None
     no_spectral: bool
     cone_quirks: bool
-    dialect: Literal["tokenizer", "dictionary"] | None
+    dialect: Literal["tokenizer", "dictionary", "hkust"] | None
 
 class ProgressiveOptions(RenderOptions, total=False):
     """`render()`'s options and the seconds between writes of the `partial` file."""
@@ -62,7 +62,7 @@ class PhotonOptions(TypedDict, total=False):
     seed: int
     threads: int | None
     cone_quirks: bool
-    dialect: Literal["tokenizer", "dictionary"] | None
+    dialect: Literal["tokenizer", "dictionary", "hkust"] | None
 
 class SceneError(ValueError):
     """A scene file is malformed; the message starts with file:line:col."""
@@ -84,7 +84,7 @@ class Scene:
         path: PathLike | None = None,
         *,
         cone_quirks: bool = False,
-        dialect: Literal["tokenizer", "dictionary"] | None = None,
+        dialect: Literal["tokenizer", "dictionary", "hkust"] | None = None,
     ) -> None: ...
     def info(self) -> dict[str, Any]:
         """What was read: the same dict as `caustica info --json` prints."""
