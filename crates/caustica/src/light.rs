@@ -554,7 +554,7 @@ impl LightSet {
                 let (s, pdf) = light.sample_towards(p, u)?;
                 let to = s.point - p;
                 let d = to.length();
-                if !(d > 0.0) || pdf <= 0.0 {
+                if d.is_nan() || d <= 0.0 || pdf <= 0.0 {
                     return None;
                 }
                 (to / d, d, s.radiance / pdf)

@@ -35,6 +35,8 @@ impl CsgOp {
 }
 
 /// A node of the tree.
+// Leaves keep their shape inline (no pointer to follow per leaf test); trees are small.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum CsgNode {
     /// A closed shape with its material id; leaves are numbered in order (the hit's `part`).
@@ -130,9 +132,7 @@ impl Csg {
 
     /// The nearest crossing of the solid's surface in `(0, t_max)` along the world ray.
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Crossing> {
-        if self.bounds.intersect(ray.origin, ray.dir.recip(), 0.0, t_max).is_none() {
-            return None;
-        }
+        self.bounds.intersect(ray.origin, ray.dir.recip(), 0.0, t_max)?;
         let mut next_part = 0;
         let (_, crossings) = node_crossings(&self.root, ray, &mut next_part);
         crossings.into_iter().find(|c| c.t > 0.0 && c.t < t_max)

@@ -45,7 +45,7 @@ pub fn roots_in(c: &[f64], lo: f64, hi: f64) -> Roots {
         degree -= 1;
     }
     let c = &c[..=degree];
-    if degree == 0 || !(lo <= hi) {
+    if degree == 0 || lo.is_nan() || hi.is_nan() || lo > hi {
         return out;
     }
     if degree == 1 {

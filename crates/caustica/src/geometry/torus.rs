@@ -40,7 +40,7 @@ impl Torus {
         let none = super::roots::Roots::default();
         let (o, d) = (ray.origin.as_dvec3(), ray.dir.as_dvec3());
         let len = d.length();
-        if !(len > 0.0) || !len.is_finite() {
+        if !len.is_finite() || len <= 0.0 {
             return none;
         }
         let u = d / len;
@@ -60,7 +60,7 @@ impl Torus {
             s0 = s0.max(a.min(c));
             s1 = s1.min(a.max(c));
         }
-        if !(s0 <= s1) {
+        if s0.is_nan() || s1.is_nan() || s0 > s1 {
             return none;
         }
         // The quartic in s for the origin moved to s0.

@@ -538,7 +538,7 @@ fn emit_from_soft(
             let cones: Vec<ConeLobe> = targets.iter().map(|t| cone_towards(s.point, t)).collect();
             let weights: Vec<f32> = cones.iter().map(|c| 1.0 - c.cos_max).collect();
             let total: f32 = weights.iter().sum();
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 return None;
             }
             let mut pick = rng.uniform() * total;

@@ -221,7 +221,7 @@ impl LightFields {
                 (0.5 * size * (1.0 - blend), 0.5 * size)
             }
             Some("angle") => {
-                let angle = self.num("angle").map(|(v, s)| (v, s)).expect("given");
+                let angle = self.num("angle").expect("given");
                 if !(0.0..=std::f32::consts::PI).contains(&angle.0) {
                     return Err(ParseError::new(
                         format!(

@@ -21,10 +21,13 @@ pub(crate) const MAX_CSG_LEAVES: usize = 256;
 /// Fields of `metaballs` and `metaball` besides `material` and `name`.
 pub(crate) const METABALL_FIELDS: &[&str] = &["balls", "ball", "radius", "size", "threshold", "blend"];
 
+/// Ball centres, each with its own radius if given.
+type Balls = Vec<(Vec3, Option<f32>)>;
+
 /// The values of a metaballs block as read.
 #[derive(Default)]
 pub(crate) struct MetaballFields {
-    balls: Option<(Vec<(Vec3, Option<f32>)>, Span)>,
+    balls: Option<(Balls, Span)>,
     radius: Option<(f32, Span)>,
     threshold: Option<(f32, Span)>,
     blend: Option<(f32, Span)>,
