@@ -22,6 +22,8 @@ pub enum Command {
   caustica render scene.ray --photons 0             # plain Whitted, no caustics
   caustica render scene.ray --model physical --passes 256 -o out.exr     # progressive photon mapping
   caustica render scene.ray --integrator path --time 60 -o reference.exr # path-traced reference
+  caustica render scene.ray --model physical --display 14158 -o out.exr  # watch it in tev
+  caustica render scene.ray --aa 4 --preview -o out.png                  # out.png rewritten as it renders
   caustica render scene.pbrt                         # pbrt-v4: its Film, Sampler and Integrator apply
   caustica render model.glb --integrator ppm -o model.png
   caustica render bunny.obj --point-light 0,4,4,16,16,16 --look-from 0,1,3")]
@@ -211,7 +213,26 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub progressive: ProgressiveOptions,
     #[command(flatten)]
+    pub preview: PreviewOptions,
+    #[command(flatten)]
     pub scene_args: SceneArgs,
+}
+
+/// Watching a render as it runs.
+#[derive(Args, Debug, Clone)]
+pub struct PreviewOptions {
+    /// Show the image in a running tev viewer at [HOST:]PORT (host 127.0.0.1 by default; tev
+    /// listens on 14158) as it renders: the Whitted tiles as they finish, the mean after each pass.
+    #[arg(long, value_name = "[HOST:]PORT")]
+    pub display: Option<String>,
+    /// Rewrite the output image with the running image as it renders (atomically: a viewer
+    /// that reloads it never sees half a file).
+    #[arg(long)]
+    pub preview: bool,
+    /// Seconds between updates [default: 0.5 for --display, 2 for --preview, whose image
+    /// encoding costs more].
+    #[arg(long)]
+    pub preview_every: Option<f64>,
 }
 
 /// The physical model and its integrators.

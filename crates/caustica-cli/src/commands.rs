@@ -10,35 +10,19 @@ pub mod render;
 use crate::cli::{PhotonOptions, SceneArgs};
 use crate::progress::Bars;
 use caustica::description::LightDesc;
-use caustica::format::ray_file::ast::Dialect;
-use caustica::format::ray_file::ParseOptions;
-use caustica::format::{self, obj, Format, ReadOptions};
+use caustica::format::{obj, Format};
 use caustica::integrator::RenderConfig;
-use caustica::loader::{build_detected, scene_id, LoadSettings};
+use caustica::loader::{load_timed, LoadSettings, Loaded};
 use caustica::math::Vec3;
 use caustica::photon::PhotonSettings;
-use caustica::presets;
-use caustica::scene::Scene;
 use caustica::{Error, Result};
 use std::path::Path;
-use std::time::Instant;
 
 /// Load settings from the command line.
 pub fn load_settings(args: &SceneArgs) -> Result<LoadSettings> {
-    let mut settings = LoadSettings::default();
-    settings.build.shapes.cone_quirks = args.cone_quirks;
-    settings.read = ReadOptions {
-        ray: ParseOptions {
-            dialect: match args.dialect.as_deref() {
-                Some("tokenizer") => Some(Dialect::Tokenizer),
-                Some("dictionary") => Some(Dialect::Dictionary),
-                Some("hkust") => Some(Dialect::Hkust),
-                _ => None,
-            },
-        },
-        format: args.format.as_deref().map(Format::from_name).transpose()?,
-        obj: obj_options(args)?,
-    };
+    let mut settings = LoadSettings::new(args.cone_quirks, args.dialect.as_deref())?;
+    settings.read.format = args.format.as_deref().map(Format::from_name).transpose()?;
+    settings.read.obj = obj_options(args)?;
     Ok(settings)
 }
 
@@ -107,18 +91,6 @@ fn obj_options(args: &SceneArgs) -> Result<obj::SceneOptions> {
     Ok(options)
 }
 
-/// A built scene and the seconds its two phases took.
-pub struct Loaded {
-    /// The scene.
-    pub scene: Scene,
-    /// What identifies it in a render's fingerprint.
-    pub scene_id: String,
-    /// Reading and parsing the file.
-    pub parse_seconds: f64,
-    /// Building shapes, meshes, textures and the BVH.
-    pub build_seconds: f64,
-}
-
 /// Reads and parses the scene file, or the built-in ring scene when no path is given, then
 /// builds it: two phases, each with its bar.
 pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<Loaded> {
@@ -134,51 +106,7 @@ pub fn load_scene(path: Option<&Path>, args: &SceneArgs, bars: &Bars) -> Result<
             ));
         }
     }
-    let start = Instant::now();
-    let source = match path {
-        Some(path) => format::read_file(path, &settings.read, bars),
-        None => format::read_text(
-            Path::new("<built-in ring scene>"),
-            presets::RING.to_string(),
-            Path::new("."),
-            &settings.read,
-            bars,
-        ),
-    };
-    let parse_seconds = start.elapsed().as_secs_f64();
-    let start = Instant::now();
-    let source = source?;
-    let scene_id = scene_id(&source, &settings);
-    let (_, scene) = build_detected(source, &settings, bars)?;
-    Ok(Loaded {
-        scene,
-        scene_id,
-        parse_seconds,
-        build_seconds: start.elapsed().as_secs_f64(),
-    })
-}
-
-/// Makes a thread pool of `threads` workers (all cores by default).
-pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
-    if threads == Some(0) || threads.is_some_and(|t| t > 1024) {
-        return Err(Error::InvalidSettings("--threads must be between 1 and 1024".into()));
-    }
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.unwrap_or(0))
-        .build()
-        .map_err(|e| Error::InvalidSettings(format!("cannot start worker threads: {e}")))
-}
-
-/// Refuses photon counts whose map would exceed `--max-memory` MB, before any work.
-pub fn check_photon_memory(total: usize, max_memory: u64) -> Result<()> {
-    // 24 bytes a photon plus the tree's node per 8–16 photons; stored counts overshoot by a few.
-    let needed_mb = (total as u64).saturating_mul(25) / 1_000_000;
-    if needed_mb > max_memory {
-        return Err(Error::InvalidSettings(format!(
-            "{total} photons need about {needed_mb} MB, more than --max-memory {max_memory} MB: store fewer photons or raise the cap"
-        )));
-    }
-    Ok(())
+    load_timed(path, &settings, bars)
 }
 
 /// Photon settings from the command line, checked.
@@ -189,9 +117,9 @@ pub fn photon_settings(options: &PhotonOptions, seed: u64) -> Result<PhotonSetti
         photons_per_light: options.photons_per_light.clone(),
         no_aim: options.no_aim,
         seed,
+        max_memory: options.max_memory,
         ..RenderConfig::default()
     };
-    check_photon_memory(config.photon_total(), options.max_memory)?;
     config.integrator()?;
     Ok(config.photon_settings())
 }

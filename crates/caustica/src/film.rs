@@ -64,10 +64,15 @@ impl Film {
 
     /// 8-bit RGB bytes under `tone_map`.
     pub fn to_rgb8(&self, tone_map: ToneMap) -> Vec<u8> {
-        self.pixels
-            .iter()
-            .flat_map(|p| p.to_array().map(|c| encode_channel(c, tone_map)))
-            .collect()
+        // The exposure's factor once, not per value (the same bytes).
+        let scale = exposure_scale(tone_map);
+        let mut bytes = vec![0; self.pixels.len() * 3];
+        for (rgb, p) in bytes.chunks_exact_mut(3).zip(&self.pixels) {
+            rgb[0] = encode_scaled(p.x, tone_map, scale);
+            rgb[1] = encode_scaled(p.y, tone_map, scale);
+            rgb[2] = encode_scaled(p.z, tone_map, scale);
+        }
+        bytes
     }
 
     /// Writes the film as PNG or EXR by the extension of `path`, atomically.
@@ -79,15 +84,29 @@ impl Film {
     }
 }
 
+/// 2^exposure, the factor a tone map applies first.
+fn exposure_scale(tone_map: ToneMap) -> f32 {
+    match tone_map {
+        ToneMap::Clamp => 1.0,
+        ToneMap::Reinhard { exposure } | ToneMap::Linear { exposure } => exposure.exp2(),
+    }
+}
+
+#[cfg(test)]
 fn encode_channel(c: f32, tone_map: ToneMap) -> u8 {
+    encode_scaled(c, tone_map, exposure_scale(tone_map))
+}
+
+/// One channel under `tone_map`, whose exposure factor is `scale`.
+fn encode_scaled(c: f32, tone_map: ToneMap, scale: f32) -> u8 {
     let c = if c.is_finite() { c } else { 0.0 };
     match tone_map {
         ToneMap::Clamp => (c.clamp(0.0, 1.0) * 255.0) as u8,
-        ToneMap::Reinhard { exposure } => {
-            let x = (c * exposure.exp2()).max(0.0);
+        ToneMap::Reinhard { .. } => {
+            let x = (c * scale).max(0.0);
             (srgb_encode(x / (1.0 + x)) * 255.0).round() as u8
         }
-        ToneMap::Linear { exposure } => (srgb_encode((c * exposure.exp2()).clamp(0.0, 1.0)) * 255.0).round() as u8,
+        ToneMap::Linear { .. } => (srgb_encode((c * scale).clamp(0.0, 1.0)) * 255.0).round() as u8,
     }
 }
 

@@ -5,6 +5,7 @@ use crate::error::{Error, Result};
 use crate::math::Vec3;
 use crate::texture::Texture;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Largest texture accepted, in pixels (8192 × 4096): a small compressed file can declare a huge
 /// image, and each pixel costs 24 bytes once converted.
@@ -136,7 +137,11 @@ fn temporary_path(path: &Path) -> PathBuf {
         .extension()
         .map(|e| e.to_string_lossy().into_owned())
         .unwrap_or_default();
-    path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()))
+    // Numbered per call: two writers of one process (a preview thread, a front end's own threads)
+    // never share a temporary file.
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, Ordering::Relaxed);
+    path.with_file_name(format!(".{name}.{}-{n}.tmp.{ext}", std::process::id()))
 }
 
 #[cfg(test)]

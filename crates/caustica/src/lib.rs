@@ -25,6 +25,7 @@ pub mod material;
 pub mod math;
 pub mod photon;
 pub mod presets;
+pub mod preview;
 pub mod progress;
 pub mod sampling;
 pub mod scene;

@@ -3,9 +3,11 @@
 
 use crate::error::{ParseError, Result};
 use crate::format::{self, ReadOptions, SceneSource};
+use crate::presets;
 use crate::progress::{NoProgress, Progress};
 use crate::scene::{BuildSettings, Scene};
 use std::path::Path;
+use std::time::Instant;
 
 /// How a scene file is read and built.
 #[derive(Clone, Debug, Default)]
@@ -14,6 +16,56 @@ pub struct LoadSettings {
     pub read: ReadOptions,
     /// How the scene is built.
     pub build: BuildSettings,
+}
+
+impl LoadSettings {
+    /// The settings of the command line's `--cone-quirks` and `--dialect` (`tokenizer`,
+    /// `dictionary` or `hkust`; `None` detects it).
+    pub fn new(cone_quirks: bool, dialect: Option<&str>) -> Result<LoadSettings> {
+        let mut settings = LoadSettings::default();
+        settings.build.shapes.cone_quirks = cone_quirks;
+        settings.read.ray.dialect = dialect.map(str::parse).transpose()?;
+        Ok(settings)
+    }
+}
+
+/// A built scene, what identifies it, and the seconds its two phases took.
+pub struct Loaded {
+    /// The scene.
+    pub scene: Scene,
+    /// What identifies it in a render's fingerprint ([`scene_id`]).
+    pub scene_id: String,
+    /// Reading and parsing the file.
+    pub parse_seconds: f64,
+    /// Building shapes, meshes, textures and the BVHs.
+    pub build_seconds: f64,
+}
+
+/// Reads and builds the scene file at `path`, or the built-in ring scene when there is none,
+/// reporting a "parse" and a "build" phase and timing each.
+pub fn load_timed(path: Option<&Path>, settings: &LoadSettings, progress: &dyn Progress) -> Result<Loaded> {
+    let start = Instant::now();
+    let source = match path {
+        Some(path) => format::read_file(path, &settings.read, progress),
+        None => format::read_text(
+            Path::new("<built-in ring scene>"),
+            presets::RING.to_string(),
+            Path::new("."),
+            &settings.read,
+            progress,
+        ),
+    };
+    let parse_seconds = start.elapsed().as_secs_f64();
+    let start = Instant::now();
+    let source = source?;
+    let scene_id = scene_id(&source, settings);
+    let (_, scene) = build_detected(source, settings, progress)?;
+    Ok(Loaded {
+        scene,
+        scene_id,
+        parse_seconds,
+        build_seconds: start.elapsed().as_secs_f64(),
+    })
 }
 
 /// Reads and builds the scene file at `path`.

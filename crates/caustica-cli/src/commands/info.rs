@@ -3,29 +3,21 @@
 use super::load_scene;
 use crate::cli::InfoArgs;
 use crate::progress::Bars;
-use caustica::scene::summary::{LightSummary, SceneSummary};
+use caustica::scene::summary::{LightSummary, LoadSeconds, SceneReport, SceneSummary};
 use caustica::{Error, Result};
-use serde::Serialize;
-use serde_json::json;
-
-/// `info --json`: the file, the summary, and the time reading and building took.
-#[derive(Serialize)]
-struct InfoJson<'a> {
-    scene: String,
-    #[serde(flatten)]
-    summary: &'a SceneSummary,
-    seconds: serde_json::Value,
-}
 
 /// Runs the command; returns the exit code.
 pub fn run(args: InfoArgs) -> Result<u8> {
     let loaded = load_scene(Some(&args.scene), &args.scene_args, &Bars::new(false))?;
     let summary = loaded.scene.summary();
     if args.json {
-        let info = InfoJson {
+        let info = SceneReport {
             scene: args.scene.display().to_string(),
             summary: &summary,
-            seconds: json!({ "parse": loaded.parse_seconds, "build": loaded.build_seconds }),
+            seconds: LoadSeconds {
+                parse: loaded.parse_seconds,
+                build: loaded.build_seconds,
+            },
         };
         let text = serde_json::to_string(&info).map_err(|e| Error::InvalidSettings(e.to_string()))?;
         println!("{text}");

@@ -3,7 +3,7 @@
 use crate::cli::MergeArgs;
 use caustica::film::ToneMap;
 use caustica::image_io::ImageFormat;
-use caustica::integrator::partial::Accumulator;
+use caustica::integrator::partial::merge_files;
 use caustica::{Error, Result};
 
 /// Runs the command; returns the exit code.
@@ -14,18 +14,7 @@ pub fn run(args: MergeArgs) -> Result<u8> {
             "--exposure must be a number of stops between -64 and 64".into(),
         ));
     }
-    let mut parts = args.parts.iter();
-    let first = parts
-        .next()
-        .ok_or_else(|| Error::InvalidSettings("no partial files given".into()))?;
-    let mut merged = Accumulator::load(first)?;
-    for path in parts {
-        let part = Accumulator::load(path)?;
-        merged.merge(&part).map_err(|e| match e {
-            Error::InvalidSettings(m) => Error::InvalidSettings(format!("{}: {m}", path.display())),
-            other => other,
-        })?;
-    }
+    let merged = merge_files(&args.parts)?;
     merged.film().save(
         &args.output,
         ToneMap::Reinhard {

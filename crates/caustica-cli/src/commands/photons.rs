@@ -1,10 +1,11 @@
 //! `caustica photons`: the stored caustic photons drawn through the camera, and a PLY dump.
 
 use super::shown;
-use super::{load_scene, photon_settings, thread_pool};
+use super::{load_scene, photon_settings};
 use crate::cli::PhotonArgs;
 use crate::progress::Bars;
 use caustica::film::ToneMap;
+use caustica::integrator::config::thread_pool;
 use caustica::integrator::image_size;
 use caustica::integrator::session::check_image_size;
 use caustica::photon::picture::{draw_photons, write_ply};

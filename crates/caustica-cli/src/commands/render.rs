@@ -1,24 +1,26 @@
 //! `caustica render`: the options become a render session of the library, which this command
 //! runs with progress bars, saving the image (and the partial sums) as it goes.
 
+use super::load_scene;
 use super::shown;
-use super::{check_photon_memory, load_scene, thread_pool};
 use crate::cli::RenderArgs;
 use crate::progress::Bars;
 use caustica::description::RenderHints;
 use caustica::film::ToneMap;
 use caustica::format::Format;
 use caustica::image_io::ImageFormat;
+use caustica::integrator::config::thread_pool;
 use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
 use caustica::light::Light;
+use caustica::preview::{tev, Preview, PreviewReport, PreviewSettings};
 use caustica::progress::Control;
 use caustica::scene::Scene;
 use caustica::{Error, Result};
 use serde_json::json;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// The library's render options: the scene's own settings (`hints`), then the command line's.
 pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
@@ -72,6 +74,8 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
             (_, true) => Some(false),
             _ => None,
         },
+        max_memory: args.photon.max_memory,
+        partial: p.partial.clone(),
     })
 }
 
@@ -91,14 +95,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     };
     let checked = config(&args, &early)?;
     let options = &args.progressive;
-    if checked.integrator_kind()? != IntegratorKind::Path {
-        check_photon_memory(checked.photon_total(), args.photon.max_memory)?;
-    }
-    if !checked.integrator()?.is_progressive() && options.partial.is_some() {
-        return Err(Error::InvalidSettings(
-            "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
-        ));
-    }
+    // The integrator's own checks (photon memory, passes only where they mean something).
+    checked.integrator()?;
     checked.plan()?;
     if !options.exposure.is_finite() || options.exposure.abs() > 64.0 {
         return Err(Error::InvalidSettings(
@@ -113,28 +111,17 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     if let Some(o) = &args.output {
         ImageFormat::from_path(o)?;
     }
+    let display = args.preview.display.as_deref().map(tev::parse_address).transpose()?;
     let pool = thread_pool(args.threads)?;
     let quiet = args.quiet || args.json;
     let bars = Bars::new(quiet);
-    let control = Control {
-        progress: &bars,
-        cancel,
-    };
 
     let loaded = load_scene(args.scene.as_deref(), &args.scene_args, &bars)?;
     let scene = &loaded.scene;
     let config = config(&args, scene.hints())?;
-    if config.integrator_kind()? != IntegratorKind::Path {
-        check_photon_memory(config.photon_total(), args.photon.max_memory)?;
-    }
     let integrator = config.integrator()?;
     let progressive = integrator.is_progressive();
     let plan = config.plan()?;
-    if !progressive && options.partial.is_some() {
-        return Err(Error::InvalidSettings(
-            "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
-        ));
-    }
     // An image, unless only a partial file is asked for; a pbrt-v4 scene may name its own.
     let output: Option<PathBuf> = match (&args.output, &options.partial, &scene.hints().output) {
         (Some(o), _, _) => Some(o.clone()),
@@ -142,6 +129,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         (None, None, Some(named)) if ImageFormat::from_path(named).is_ok() => Some(named.clone()),
         (None, None, _) => Some("caustica.png".into()),
     };
+    check_preview(&args, &output)?;
     if !quiet {
         for warning in scene.warnings() {
             eprintln!("warning: {warning}");
@@ -173,6 +161,37 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     } else {
         ToneMap::Clamp
     };
+    let preview = if display.is_some() || args.preview.preview {
+        let name = [&output, &options.partial]
+            .into_iter()
+            .flatten()
+            .next()
+            .and_then(|p| p.file_name())
+            .map_or_else(|| "caustica".to_string(), |n| n.to_string_lossy().into_owned());
+        let settings = PreviewSettings {
+            display,
+            file: output.clone().filter(|_| args.preview.preview).map(|o| (o, tone_map)),
+            name,
+            display_every: Duration::from_secs_f64(args.preview.preview_every.unwrap_or(0.5)),
+            file_every: Duration::from_secs_f64(args.preview.preview_every.unwrap_or(2.0)),
+        };
+        let warn = move |message: String| {
+            if !quiet {
+                eprintln!("warning: preview: {message}");
+            }
+        };
+        Some(Preview::start(width, height, settings, warn)?)
+    } else {
+        None
+    };
+    let preview_progress = preview.as_ref().map(|p| p.progress(&bars));
+    let control = Control {
+        progress: match &preview_progress {
+            Some(p) => p,
+            None => &bars,
+        },
+        cancel,
+    };
     let save = |session: &RenderSession| -> Result<()> {
         if let Some(o) = &output {
             session.image().save(o, tone_map)?;
@@ -186,6 +205,9 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let mut last_save = Instant::now();
     let summary = pool.install(|| {
         session.run(&plan, control, |session| {
+            if let Some(preview) = &preview {
+                preview.offer(|| session.image());
+            }
             // Progressive renders are rewritten as they converge; the final save is below.
             if progressive && last_save.elapsed().as_secs_f64() >= options.save_every {
                 save(session)?;
@@ -194,6 +216,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
             Ok(())
         })
     })?;
+    // The viewer gets the final image; the preview's last file write is over before the save.
+    let preview_report = preview.map(|p| p.finish(&session.image()));
     let photon_stats = session.caustic_map().map(|m| m.stats.clone());
     if !quiet {
         if let Some(s) = &photon_stats {
@@ -259,6 +283,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                     "total": total,
                 },
                 "peak_memory_bytes": super::peak_memory_bytes(),
+                "preview": preview_json(&preview_report),
             })
         } else {
             let aa = config.aa;
@@ -280,6 +305,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                     "total": total,
                 },
                 "peak_memory_bytes": super::peak_memory_bytes(),
+                "preview": preview_json(&preview_report),
             })
         };
         println!("{summary}");
@@ -316,6 +342,33 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         }
     }
     Ok(if complete { 0 } else { crate::EXIT_INTERRUPTED })
+}
+
+/// Refuses preview options that cannot work, before any work.
+fn check_preview(args: &RenderArgs, output: &Option<PathBuf>) -> Result<()> {
+    if args.preview.preview_every.is_some_and(|s| !(s > 0.0 && s <= 3600.0)) {
+        return Err(Error::InvalidSettings(
+            "--preview-every must be a positive number of seconds (at most 3600)".into(),
+        ));
+    }
+    if args.preview.preview && output.is_none() {
+        return Err(Error::InvalidSettings(
+            "--preview rewrites the output image: give one with -o".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The preview's work in the JSON summary (`null` without one).
+fn preview_json(report: &Option<PreviewReport>) -> serde_json::Value {
+    match report {
+        Some(r) => json!({
+            "updates": r.updates,
+            "busy_seconds": r.busy_seconds,
+            "bytes_sent": r.bytes_sent,
+        }),
+        None => serde_json::Value::Null,
+    }
 }
 
 /// What the physical model reads differently from the course's shading.

@@ -35,6 +35,8 @@ impl CsgOp {
 }
 
 /// A node of the tree.
+// Leaves keep their shape inline (no pointer to follow per leaf test); trees are small.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum CsgNode {
     /// A closed shape with its material id; leaves are numbered in order (the hit's `part`).

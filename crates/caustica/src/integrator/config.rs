@@ -13,6 +13,7 @@ use super::{Integrator, WhittedOptions};
 use crate::description::{IntegratorHint, RenderHints};
 use crate::error::{Error, Result};
 use crate::photon::{EstimateSettings, PhotonSettings};
+use std::path::PathBuf;
 use std::str::FromStr;
 
 /// The shading model.
@@ -79,7 +80,7 @@ impl FromStr for IntegratorKind {
     }
 }
 
-/// Every option of `caustica render` that shapes the image.
+/// Every option of `caustica render` that shapes the image, and the two it checks with them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderConfig {
     /// `--model`.
@@ -125,6 +126,10 @@ pub struct RenderConfig {
     /// `--spectral` / `--no-spectral` (physical model): light at sampled wavelengths or in RGB;
     /// by default spectral exactly when the scene has a dispersive glass.
     pub spectral: Option<bool>,
+    /// `--max-memory`: the largest photon map in MB.
+    pub max_memory: u64,
+    /// `--partial`: where the sums of the passes go (only the physical integrators keep sums).
+    pub partial: Option<PathBuf>,
 }
 
 impl Default for RenderConfig {
@@ -151,6 +156,8 @@ impl Default for RenderConfig {
             alpha: 2.0 / 3.0,
             no_camera_specular: false,
             spectral: None,
+            max_memory: 4096,
+            partial: None,
         }
     }
 }
@@ -233,8 +240,11 @@ impl RenderConfig {
     /// The integrator with its settings (checked).
     pub fn integrator(&self) -> Result<Integrator> {
         let kind = self.integrator_kind()?;
+        if kind != IntegratorKind::Path {
+            check_photon_memory(self.photon_total(), self.max_memory)?;
+        }
         let progressive = kind != IntegratorKind::Whitted;
-        if !progressive && (self.passes.is_some() || self.time.is_some()) {
+        if !progressive && (self.passes.is_some() || self.time.is_some() || self.partial.is_some()) {
             return Err(Error::InvalidSettings(
                 "--passes, --time and --partial belong to the physical model's integrators (--model physical)".into(),
             ));
@@ -350,4 +360,28 @@ impl RenderConfig {
         }
         ignored
     }
+}
+
+/// Refuses photon counts whose map would exceed `max_memory` MB (`--max-memory`), before any
+/// work.
+pub fn check_photon_memory(total: usize, max_memory: u64) -> Result<()> {
+    // 24 bytes a photon plus the tree's node per 8–16 photons; stored counts overshoot by a few.
+    let needed_mb = (total as u64).saturating_mul(25) / 1_000_000;
+    if needed_mb > max_memory {
+        return Err(Error::InvalidSettings(format!(
+            "{total} photons need about {needed_mb} MB, more than --max-memory {max_memory} MB: store fewer photons or raise the cap"
+        )));
+    }
+    Ok(())
+}
+
+/// The worker threads `--threads` asks for (all cores by default).
+pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    if threads == Some(0) || threads.is_some_and(|t| t > 1024) {
+        return Err(Error::InvalidSettings("--threads must be between 1 and 1024".into()));
+    }
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| Error::InvalidSettings(format!("cannot start worker threads: {e}")))
 }

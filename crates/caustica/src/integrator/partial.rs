@@ -53,6 +53,11 @@ impl Accumulator {
         }
     }
 
+    /// Whether pass `pass` is among those held.
+    pub fn holds(&self, pass: u64) -> bool {
+        self.passes.iter().any(|&(a, b)| a <= pass && pass < b)
+    }
+
     /// Number of passes held.
     pub fn pass_count(&self) -> u64 {
         self.passes.iter().map(|(a, b)| b - a).sum()
@@ -210,6 +215,24 @@ impl Accumulator {
         }
         Ok(acc)
     }
+}
+
+/// The sums of several partial files of one run, merged in the order given (`caustica merge`);
+/// a part that does not fit the others is named in the error.
+pub fn merge_files(paths: &[impl AsRef<Path>]) -> Result<Accumulator> {
+    let mut paths = paths.iter().map(AsRef::as_ref);
+    let first = paths
+        .next()
+        .ok_or_else(|| Error::InvalidSettings("no partial files given".into()))?;
+    let mut merged = Accumulator::load(first)?;
+    for path in paths {
+        let part = Accumulator::load(path)?;
+        merged.merge(&part).map_err(|e| match e {
+            Error::InvalidSettings(m) => Error::InvalidSettings(format!("{}: {m}", path.display())),
+            other => other,
+        })?;
+    }
+    Ok(merged)
 }
 
 /// `a..b` ranges separated by commas (empty for none).

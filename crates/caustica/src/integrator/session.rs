@@ -103,6 +103,16 @@ impl PassPlan {
     }
 }
 
+impl PassPlan {
+    /// Whether pass `pass` is to start, `done` passes having been rendered in `elapsed` seconds:
+    /// not past the end, and not past the time limit once a pass is done.
+    pub fn admits(&self, pass: u64, done: u64, elapsed: f64) -> bool {
+        let past_end = self.end.is_some_and(|end| pass >= end);
+        let out_of_time = self.time_limit.is_some_and(|limit| done > 0 && elapsed >= limit);
+        !past_end && !out_of_time
+    }
+}
+
 /// What a run did.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RunSummary {
@@ -281,13 +291,9 @@ impl<'a> RenderSession<'a> {
         let mut reported = 0u64;
         let mut pass = plan.first;
         loop {
-            if plan.end.is_some_and(|end| pass >= end) || control.cancelled() {
+            let done = self.accumulator.pass_count();
+            if control.cancelled() || !plan.admits(pass, done, start.elapsed().as_secs_f64()) {
                 break;
-            }
-            if let Some(limit) = plan.time_limit {
-                if self.accumulator.pass_count() > 0 && start.elapsed().as_secs_f64() >= limit {
-                    break;
-                }
             }
             if !self.render_pass(pass, control) {
                 break;
@@ -336,5 +342,23 @@ impl<'a> RenderSession<'a> {
     /// a pass).
     pub fn merge(&mut self, part: &Accumulator) -> Result<()> {
         self.accumulator.merge(part)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_plan_admits_passes_up_to_its_end_and_one_pass_past_its_time() {
+        let counted = PassPlan::new(Some("2..4"), None).unwrap();
+        assert!(counted.admits(2, 0, 1e9) && counted.admits(3, 1, 0.0));
+        assert!(!counted.admits(4, 2, 0.0));
+        let timed = PassPlan::new(None, Some(1.0)).unwrap();
+        // The first pass always runs; later ones only within the time.
+        assert!(timed.admits(0, 0, 5.0) && timed.admits(7, 7, 0.5));
+        assert!(!timed.admits(1, 1, 1.0));
+        let both = PassPlan::new(Some("3"), Some(10.0)).unwrap();
+        assert!(!both.admits(3, 3, 0.0) && !both.admits(1, 1, 10.0));
     }
 }

@@ -5,7 +5,7 @@
 use crate::camera::Camera;
 use crate::film::Film;
 use crate::math::Vec3;
-use crate::progress::Control;
+use crate::progress::{Control, PixelBlock};
 use crate::sampling::Rng;
 use rayon::prelude::*;
 
@@ -62,8 +62,8 @@ where
 }
 
 /// Computes `pixel(x, y)` for every pixel, 16×16 tiles in parallel, into rows from the top;
-/// tiles not begun before cancellation stay black. With `report`, each finished tile advances
-/// the progress by its pixel count. Returns the pixels and whether every tile was done.
+/// tiles not begun before cancellation stay black. With `report`, each finished tile is shown to
+/// the progress (for a live preview) and advances it by its pixel count. Returns the pixels and whether every tile was done.
 pub(crate) fn shade_tiles<F>(width: usize, height: usize, control: Control, report: bool, pixel: F) -> (Vec<Vec3>, bool)
 where
     F: Fn(usize, usize) -> Vec3 + Sync,
@@ -85,6 +85,13 @@ where
                 }
             }
             if report {
+                control.progress.pixels(&PixelBlock {
+                    x: x0,
+                    y: y0,
+                    width: x1 - x0,
+                    height: y1 - y0,
+                    pixels: &out,
+                });
                 control.progress.advance(out.len() as u64);
             }
             Some(out)

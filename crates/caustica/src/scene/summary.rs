@@ -37,6 +37,28 @@ pub struct SceneSummary {
     pub warnings: Vec<String>,
 }
 
+/// What `caustica info --json` prints and the Python module's `Scene.info()` returns: the file
+/// as named, its summary, and the seconds reading and building it took.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneReport<'a> {
+    /// The file as the user named it.
+    pub scene: String,
+    /// The summary, its fields at the top level.
+    #[serde(flatten)]
+    pub summary: &'a SceneSummary,
+    /// Seconds per loading phase.
+    pub seconds: LoadSeconds,
+}
+
+/// Seconds spent loading a scene.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct LoadSeconds {
+    /// Reading and parsing the file.
+    pub parse: f64,
+    /// Building the scene.
+    pub build: f64,
+}
+
 /// The pinhole camera.
 #[derive(Clone, Debug, Serialize)]
 pub struct CameraSummary {

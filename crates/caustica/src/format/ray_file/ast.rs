@@ -36,6 +36,21 @@ impl Dialect {
     }
 }
 
+impl std::str::FromStr for Dialect {
+    type Err = crate::error::Error;
+
+    fn from_str(s: &str) -> Result<Dialect, Self::Err> {
+        match s {
+            "tokenizer" => Ok(Dialect::Tokenizer),
+            "dictionary" => Ok(Dialect::Dictionary),
+            "hkust" => Ok(Dialect::Hkust),
+            other => Err(crate::error::Error::InvalidSettings(format!(
+                "unknown dialect `{other}`: expected tokenizer, dictionary or hkust"
+            ))),
+        }
+    }
+}
+
 /// Everything a `.ray` file describes.
 #[derive(Clone, Debug)]
 pub struct RayScene {
