@@ -10,7 +10,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     (
         "base",
         &[
-            "math", "sampling", "spectrum", "error", "progress", "texture", "image_io", "film", "presets",
+            "math", "sampling", "spectrum", "error", "progress", "texture", "image_io", "film", "presets", "preview",
         ],
     ),
     ("description", &["description"]),
