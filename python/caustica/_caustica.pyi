@@ -19,7 +19,7 @@ class RenderOptions(TypedDict, total=False):
     """The options of `caustica render`, `-` written `_`; the defaults are the command line's."""
 
     model: Literal["course", "physical"] | None
-    integrator: Literal["whitted", "path", "ppm", "gi"] | None
+    integrator: Literal["whitted", "path", "ppm", "gi", "lt"] | None
     width: int
     height: int | None
     aa: int
@@ -130,7 +130,7 @@ class Progressive:
         """(width, height) of the image."""
     @property
     def integrator(self) -> str:
-        """whitted, path, ppm or gi."""
+        """whitted, path, ppm, gi or lt."""
     @property
     def fingerprint(self) -> str:
         """What must agree for two runs' sums to merge."""

@@ -231,7 +231,7 @@ impl Progressive {
         (self.width, self.height)
     }
 
-    /// The integrator's name: whitted, path, ppm or gi.
+    /// The integrator's name: whitted, path, ppm, gi or lt.
     #[getter]
     fn integrator(&self) -> &'static str {
         self.integrator
@@ -255,7 +255,7 @@ impl Drop for Progressive {
 /// with `render()`'s options plus `save_every` (seconds between writes of the `partial` file;
 /// it is also written when the run ends). Nothing is rendered until it is iterated.
 ///
-/// The physical integrators (path, ppm, gi) yield the running mean after each pass of the plan
+/// The physical integrators (path, ppm, gi, lt) yield the running mean after each pass of the plan
 /// `passes` (N or "A..B", 64 by default) or until `time` seconds have passed; the course
 /// model's Whitted renderer yields its one image.
 #[pyfunction]

@@ -180,7 +180,7 @@ pub struct RenderArgs {
     /// N×N stratified, jittered samples per pixel.
     #[arg(long, default_value_t = 1)]
     pub aa: u32,
-    /// Maximum reflection/refraction depth [default: 5 for whitted, 64 bounces for path, ppm, gi;
+    /// Maximum reflection/refraction depth [default: 5 for whitted, 64 bounces for path, ppm, gi, lt;
     /// a pbrt-v4 scene's maxdepth].
     #[arg(long)]
     pub depth: Option<u32>,
@@ -243,9 +243,10 @@ pub struct ProgressiveOptions {
     /// for .ray and .obj, physical for .pbrt and glTF].
     #[arg(long, value_parser = ["course", "physical"])]
     pub model: Option<String>,
-    /// Integrator: whitted (course model), or path, ppm, gi (physical model; ppm by default
-    /// there, or what a pbrt-v4 scene names).
-    #[arg(long, value_parser = ["whitted", "path", "ppm", "gi"])]
+    /// Integrator: whitted (course model), or path, ppm, gi, lt (physical model; ppm by default
+    /// there, or what a pbrt-v4 scene names). lt is light tracing: mirrors, glass and lights seen
+    /// by the camera are black.
+    #[arg(long, value_parser = ["whitted", "path", "ppm", "gi", "lt"])]
     pub integrator: Option<String>,
     /// Passes to render: N (passes 0..N) or A..B (passes A to B−1 of a run split across
     /// machines) [default: 64 unless --time is given, or a pbrt-v4 scene's pixelsamples].

@@ -4,14 +4,15 @@
 //!
 //! - [`whitted`]: the course model: the course's Whitted ray tracer plus caustics from a photon
 //!   map, rendered in one go.
-//! - [`path`], [`ppm`], [`gi`]: the physical model, rendered in independent passes that
+//! - [`path`], [`ppm`], [`gi`], [`lt`]: the physical model, rendered in independent passes that
 //!   converge: a path tracer, progressive photon mapping, Jensen's photon mapping with final
-//!   gathering.
+//!   gathering, light tracing.
 
 pub mod config;
 pub mod darkness;
 pub mod direct;
 pub mod gi;
+pub mod lt;
 pub mod partial;
 pub mod path;
 pub mod ppm;
@@ -30,6 +31,7 @@ use crate::math::Vec3;
 use crate::photon::{EstimateSettings, PhotonSettings};
 use crate::progress::Control;
 use gi::GiSettings;
+use lt::LtSettings;
 use path::PathSettings;
 use ppm::PpmSettings;
 use radius::InitialRadius;
@@ -46,6 +48,8 @@ pub enum Integrator {
     Ppm(PpmSettings),
     /// Jensen's photon mapping with final gathering.
     Gi(GiSettings),
+    /// Light tracing: photons splatted onto the film through the pinhole.
+    Lt(LtSettings),
 }
 
 /// Everything the course model's render uses.
@@ -83,6 +87,7 @@ impl Integrator {
             Integrator::Path(_) => "path",
             Integrator::Ppm(_) => "ppm",
             Integrator::Gi(_) => "gi",
+            Integrator::Lt(_) => "lt",
         }
     }
 
@@ -124,6 +129,10 @@ impl Integrator {
                 check_alpha(s.alpha)?;
                 check_radius(s.caustic_radius)?;
                 check_k(s.k_global)?;
+                check_photons_per_pass(self.name(), s.photons_per_pass)
+            }
+            Integrator::Lt(s) => {
+                check_depth(s.max_depth)?;
                 check_photons_per_pass(self.name(), s.photons_per_pass)
             }
         }

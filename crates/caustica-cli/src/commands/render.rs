@@ -150,6 +150,13 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                     ignored.join(", ")
                 );
             }
+            let ignored = config.ignored_by_lt();
+            if !ignored.is_empty() {
+                eprintln!(
+                    "note: {} set a gather radius; lt gathers nothing and ignores them",
+                    ignored.join(", ")
+                );
+            }
         }
     }
     let mut session = RenderSession::new(scene, config.render_options(loaded.scene_id.clone())?)?;
@@ -261,6 +268,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let photons_per_pass = match session.integrator() {
         Integrator::Ppm(s) => s.photons_per_pass,
         Integrator::Gi(s) => s.photons_per_pass,
+        Integrator::Lt(s) => s.photons_per_pass,
         _ => 0,
     };
     if args.json {

@@ -4,6 +4,7 @@
 //! the same image.
 
 use super::gi::GiSettings;
+use super::lt::LtSettings;
 use super::path::PathSettings;
 use super::ppm::PpmSettings;
 use super::radius::InitialRadius;
@@ -50,6 +51,8 @@ pub enum IntegratorKind {
     Ppm,
     /// Jensen's photon mapping with final gathering.
     Gi,
+    /// Light tracing.
+    Lt,
 }
 
 impl IntegratorKind {
@@ -60,6 +63,7 @@ impl IntegratorKind {
             IntegratorKind::Path => "path",
             IntegratorKind::Ppm => "ppm",
             IntegratorKind::Gi => "gi",
+            IntegratorKind::Lt => "lt",
         }
     }
 }
@@ -73,8 +77,9 @@ impl FromStr for IntegratorKind {
             "path" => Ok(IntegratorKind::Path),
             "ppm" => Ok(IntegratorKind::Ppm),
             "gi" => Ok(IntegratorKind::Gi),
+            "lt" => Ok(IntegratorKind::Lt),
             other => Err(Error::InvalidSettings(format!(
-                "unknown integrator `{other}`: expected whitted, path, ppm or gi"
+                "unknown integrator `{other}`: expected whitted, path, ppm, gi or lt"
             ))),
         }
     }
@@ -209,7 +214,7 @@ impl RenderConfig {
                 )))
             }
             (Some(Model::Physical), Some(IntegratorKind::Whitted)) => Err(Error::InvalidSettings(
-                "the whitted integrator renders the course model; with --model physical use path, ppm or gi".into(),
+                "the whitted integrator renders the course model; with --model physical use path, ppm, gi or lt".into(),
             )),
             (Some(Model::Physical), None) => Ok(IntegratorKind::Ppm),
             (_, Some(kind)) => Ok(kind),
@@ -240,7 +245,8 @@ impl RenderConfig {
     /// The integrator with its settings (checked).
     pub fn integrator(&self) -> Result<Integrator> {
         let kind = self.integrator_kind()?;
-        if kind != IntegratorKind::Path {
+        // path and lt store no photons.
+        if !matches!(kind, IntegratorKind::Path | IntegratorKind::Lt) {
             check_photon_memory(self.photon_total(), self.max_memory)?;
         }
         let progressive = kind != IntegratorKind::Whitted;
@@ -293,6 +299,11 @@ impl RenderConfig {
                 alpha: self.alpha,
                 max_depth: depth,
                 specular_camera_paths,
+                spectral: self.spectral,
+            }),
+            IntegratorKind::Lt => Integrator::Lt(LtSettings {
+                photons_per_pass,
+                max_depth: depth,
                 spectral: self.spectral,
             }),
         };
@@ -357,6 +368,28 @@ impl RenderConfig {
         }
         if self.no_estimate_reuse {
             ignored.push("--no-estimate-reuse");
+        }
+        ignored
+    }
+
+    /// Options given that light tracing does not read: it gathers nothing, so has no radius.
+    pub fn ignored_by_lt(&self) -> Vec<&'static str> {
+        let mut ignored = Vec::new();
+        if self.integrator != Some(IntegratorKind::Lt) {
+            return ignored;
+        }
+        let default = RenderConfig::default();
+        if self.radius.is_some() {
+            ignored.push("--radius");
+        }
+        if self.footprint != default.footprint {
+            ignored.push("--footprint");
+        }
+        if self.alpha != default.alpha {
+            ignored.push("--alpha");
+        }
+        if self.k != default.k {
+            ignored.push("--k");
         }
         ignored
     }

@@ -6,6 +6,7 @@
 //! photons traced first; the physical integrators render independent passes that converge.
 
 use super::gi::Gi;
+use super::lt::LightTracer;
 use super::partial::Accumulator;
 use super::path::PathTracer;
 use super::ppm::Ppm;
@@ -165,6 +166,7 @@ impl<'a> RenderSession<'a> {
             Integrator::Path(s) => Some(Box::new(PathTracer::new(scene, s.clone(), width, height, seed))),
             Integrator::Ppm(s) => Some(Box::new(Ppm::new(scene, s.clone(), width, height, seed))),
             Integrator::Gi(s) => Some(Box::new(Gi::new(scene, s.clone(), width, height, seed))),
+            Integrator::Lt(s) => Some(Box::new(LightTracer::new(scene, s.clone(), width, height, seed))),
         };
         let fingerprint = format!(
             "scene {} size {width}x{height} seed {seed} {:?}",

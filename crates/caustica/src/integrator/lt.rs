@@ -1,0 +1,266 @@
+//! Light tracing (a particle tracer): photons leave the lights as in [`ppm`](super::ppm), and
+//! at every smooth surface they meet the light they scatter towards the eye is splatted onto the
+//! pixel the point projects to. No kernel and no radius: the image is unbiased, and sharp where
+//! photon mapping blurs (the focus of a caustic), but noisy where little light reaches the eye.
+//!
+//! The camera is a pinhole, so a camera ray can never be continued from a photon path: mirrors
+//! and glass seen by the camera are black (as in `--no-camera-specular`), and so are lights seen
+//! directly. What lies behind or beyond them, seen by a photon, is not.
+//!
+//! Determinism: a pass emits its photons in fixed batches; each batch records its splats and the
+//! batches are added to the film in index order, so the thread count never changes the image.
+
+use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
+use super::Progressive;
+use crate::bsdf::{Bsdf, Transport};
+use crate::camera::Camera;
+use crate::math::{offset_origin, Ray, Vec3};
+use crate::progress::Control;
+use crate::sampling::Rng;
+use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, Wavelengths};
+use rayon::prelude::*;
+
+/// Settings of the light tracer.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LtSettings {
+    /// Photons emitted per pass.
+    pub photons_per_pass: u64,
+    /// Longest photon path in bounces: light reaches the eye from at most N + 1 surfaces, the
+    /// same paths as `ppm`'s photons.
+    pub max_depth: u32,
+    /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
+    /// dispersive glass).
+    pub spectral: Option<bool>,
+}
+
+impl Default for LtSettings {
+    fn default() -> Self {
+        LtSettings {
+            photons_per_pass: 200_000,
+            max_depth: 64,
+            spectral: None,
+        }
+    }
+}
+
+/// Photons per batch: the unit of parallel work and of the fixed order of addition.
+const BATCH: u64 = 4096;
+/// Batches traced before their splats are added, so memory stays bounded at any photon count.
+const ROUND: u64 = 64;
+
+/// Where on the film a point is seen, and how much importance the eye gives it.
+pub struct Sensor {
+    eye: Vec3,
+    /// Unit normal of the image plane (towards the scene).
+    normal: Vec3,
+    /// W·H·d² / |u × v|: pixels per unit of image-plane area times the plane's distance squared.
+    scale: f32,
+    width: usize,
+    height: usize,
+}
+
+/// A point's pixel and the factor that turns the light it sends to the eye into that pixel's
+/// value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SensorSample {
+    /// Pixel index, rows from the top.
+    pub pixel: usize,
+    /// Unit direction from the point to the eye.
+    pub to_eye: Vec3,
+    /// Distance from the point to the eye.
+    pub distance: f32,
+    /// The camera's importance We along the direction (per steradian).
+    pub importance: f32,
+}
+
+impl Sensor {
+    /// The sensor of `camera` with a film of `width`×`height` pixels.
+    pub fn new(camera: &Camera, width: usize, height: usize) -> Sensor {
+        let cross = camera.u.cross(camera.v);
+        let area = cross.length();
+        let normal = if area > 0.0 { cross / area } else { camera.look };
+        let normal = if normal.dot(camera.look) < 0.0 { -normal } else { normal };
+        let d = camera.look.dot(normal);
+        let scale = if area > 0.0 && d > 0.0 {
+            (width * height) as f32 * d * d / area
+        } else {
+            0.0
+        };
+        Sensor {
+            eye: camera.eye,
+            normal,
+            scale,
+            width,
+            height,
+        }
+    }
+
+    /// Where `p` lands on the film of `camera` (`None`: outside the view or behind the eye).
+    ///
+    /// A pixel's value is the mean radiance over its square of screen coordinates (sx, sy),
+    /// of area 1/(W·H). Screen point (sx, sy) lies on the image plane at
+    /// eye + look + (sx − ½)·u + (sy − ½)·v, so dA = |u × v| dsx dsy; seen from the eye
+    /// dω = cos θ dA / ℓ² with ℓ = d / cos θ (d: the plane's distance, θ: the angle to its
+    /// normal). So the pixel is ∫ W·H·d² / (|u × v| cos³θ) · L dω over its directions, and
+    /// that factor is the importance We (docs/radiometry.md).
+    pub fn sample(&self, camera: &Camera, p: Vec3) -> Option<SensorSample> {
+        if self.scale <= 0.0 {
+            return None;
+        }
+        let (sx, sy) = camera.project(p)?;
+        let x = sx * self.width as f32;
+        let y = (1.0 - sy) * self.height as f32;
+        if !(x >= 0.0 && y >= 0.0 && x < self.width as f32 && y < self.height as f32) {
+            return None;
+        }
+        let offset = self.eye - p;
+        let distance = offset.length();
+        if distance.is_nan() || distance <= 0.0 {
+            return None;
+        }
+        let to_eye = offset / distance;
+        let cos = -to_eye.dot(self.normal);
+        if cos <= 0.0 {
+            return None;
+        }
+        let (px, py) = ((x as usize).min(self.width - 1), (y as usize).min(self.height - 1));
+        Some(SensorSample {
+            pixel: py * self.width + px,
+            to_eye,
+            distance,
+            importance: self.scale / (cos * cos * cos),
+        })
+    }
+}
+
+/// The light tracer over a whole image.
+pub struct LightTracer<'a> {
+    scene: &'a Scene,
+    settings: LtSettings,
+    width: usize,
+    height: usize,
+    seed: u64,
+    sensor: Sensor,
+    spectral: bool,
+}
+
+impl<'a> LightTracer<'a> {
+    /// A light tracer for `scene` at `width`×`height`.
+    pub fn new(scene: &'a Scene, settings: LtSettings, width: usize, height: usize, seed: u64) -> LightTracer<'a> {
+        LightTracer {
+            scene,
+            sensor: Sensor::new(scene.camera(), width, height),
+            spectral: settings_spectral(&settings.spectral, scene),
+            settings,
+            width,
+            height,
+            seed,
+        }
+    }
+
+    /// Follows photon `index` of pass `pass` and records what each smooth surface it meets
+    /// sends to the eye, in film units (already divided by the pass's photon count).
+    fn trace(&self, pass: u64, index: u64, wl: &Wavelengths, out: &mut Vec<(u32, Vec3)>) {
+        let scene = self.scene;
+        let mut rng = Rng::new(self.seed ^ PHOTON_SEED, (pass << 40) ^ index);
+        let Some(emitted) = scene.lights().emit(scene, wl, &mut rng) else {
+            return;
+        };
+        let mut power = emitted.flux * (1.0 / self.settings.photons_per_pass as f32);
+        let mut ray = emitted.ray;
+        let mut dispersed = false;
+        for _ in 0..=self.settings.max_depth {
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                return;
+            };
+            let hit = scene.surface(&ray, &isect);
+            let wo = -ray.dir;
+            let bsdf = Bsdf::at(scene, &hit, wo, wl);
+            if bsdf.is_smooth() {
+                let splat = self.connect(&hit, &bsdf, wo, power);
+                if let Some((pixel, value)) = splat {
+                    let rgb = wl.to_rgb(value);
+                    if rgb.is_finite() {
+                        out.push((pixel as u32, rgb));
+                    }
+                }
+            }
+            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance) else {
+                return;
+            };
+            // The photon tracer's roulette: flux stays nearly constant along the path.
+            let q = sample.weight.max_element().min(1.0);
+            if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                return;
+            }
+            power *= sample.weight / q;
+            if sample.dispersive {
+                wl.terminate_secondary(&mut power, &mut dispersed);
+            }
+            ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+        }
+    }
+
+    /// The pixel a photon of flux `power` arriving at `hit` from `wo` lights, and by how much:
+    /// power · f(wo, ωe) · cos θ / r² · We, where θ is the angle at the surface to the eye
+    /// direction ωe and r the distance to the eye (the geometry term, the pinhole being a
+    /// point), and We the camera's importance ([`Sensor::sample`]). With shading normals the
+    /// adjoint BSDF needs Veach's correction |wo·ns| |ωe·ng| / (|wo·ng| |ωe·ns|), so the cosine
+    /// becomes |ωe·ng| |wo·ns| / |wo·ng|.
+    fn connect(&self, hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3, power: Spectrum) -> Option<(usize, Spectrum)> {
+        let s = self.sensor.sample(self.scene.camera(), hit.point)?;
+        let f = bsdf.eval(wo, s.to_eye);
+        if f == Spectrum::ZERO {
+            return None;
+        }
+        let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
+        let wo_ng = wo.dot(ng).abs();
+        if wo_ng <= 0.0 {
+            return None;
+        }
+        let cos = s.to_eye.dot(ng).abs() * wo.dot(ns).abs() / wo_ng;
+        if !self.scene.unoccluded(hit.point, ng, s.to_eye, s.distance) {
+            return None;
+        }
+        let g = cos / (s.distance * s.distance);
+        Some((s.pixel, power * f * (g * s.importance)))
+    }
+}
+
+impl Progressive for LightTracer<'_> {
+    fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
+        let wl = pass_wavelengths(self.spectral, self.seed, pass);
+        let mut film = vec![Vec3::ZERO; self.width * self.height];
+        let count = self.settings.photons_per_pass;
+        if self.scene.lights().is_empty() {
+            return Some(film);
+        }
+        let batches = count.div_ceil(BATCH);
+        let mut first = 0;
+        while first < batches {
+            let end = (first + ROUND).min(batches);
+            let splats: Vec<Option<Vec<(u32, Vec3)>>> = (first..end)
+                .into_par_iter()
+                .map(|b| {
+                    if control.cancelled() {
+                        return None;
+                    }
+                    let mut out = Vec::new();
+                    for i in b * BATCH..((b + 1) * BATCH).min(count) {
+                        self.trace(pass, i, &wl, &mut out);
+                    }
+                    Some(out)
+                })
+                .collect();
+            // In batch order: the sums do not depend on which thread traced what.
+            for batch in splats {
+                for (pixel, value) in batch? {
+                    film[pixel as usize] += value;
+                }
+            }
+            first = end;
+        }
+        Some(film)
+    }
+}
