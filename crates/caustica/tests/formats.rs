@@ -344,7 +344,14 @@ fn obj_files(meshes: &[Mesh]) -> (String, String) {
     (obj, mtl)
 }
 
+/// The scene in every format, written once per test run: tests run in parallel and must not
+/// read a file another is still writing.
 fn write_scenes() -> PathBuf {
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(write_scene_files).clone()
+}
+
+fn write_scene_files() -> PathBuf {
     let dir = std::env::temp_dir().join(format!("caustica-formats-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let m = meshes();
