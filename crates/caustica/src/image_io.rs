@@ -108,6 +108,40 @@ pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
     Ok((rgb.width() as usize, rgb.height() as usize, pixels))
 }
 
+/// Checks, before any work, that a file can be written at `path` as [`write_atomically`] will:
+/// its folder exists and takes a new file (one is created there and removed), and `path` is
+/// not a folder.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let refuse = |why: String| {
+        Err(Error::InvalidSettings(format!(
+            "cannot write `{}`: {why}",
+            path.display()
+        )))
+    };
+    if !folder.is_dir() {
+        return refuse(format!("the folder `{}` does not exist", folder.display()));
+    }
+    if path.is_dir() {
+        return refuse("it is a folder".into());
+    }
+    let probe = temporary_path(path);
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        Err(e) => refuse(format!(
+            "the folder `{}` does not take new files ({e})",
+            folder.display()
+        )),
+    }
+}
+
 /// Runs `write` on a temporary path in the target's directory, then renames it over `path`.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> std::result::Result<(), String>) -> Result<()> {
     let tmp = temporary_path(path);
@@ -169,6 +203,10 @@ mod tests {
         assert_eq!(leftovers, 0);
         assert!(ImageFormat::from_path(Path::new("x.jpg")).is_err());
         assert!(load_texture(&dir.join("missing.png")).is_err());
+        assert!(check_writable(&dir.join("b.png")).is_ok());
+        assert!(check_writable(&dir.join("no-such-folder/b.png")).is_err());
+        assert!(check_writable(&dir).is_err(), "a folder is not a file");
+        assert!(!dir.join("b.png").exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

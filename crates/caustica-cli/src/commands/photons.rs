@@ -20,6 +20,9 @@ use std::time::Instant;
 pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let start = Instant::now();
     caustica::image_io::ImageFormat::from_path(&args.output)?;
+    for path in std::iter::once(&args.output).chain(&args.ply) {
+        caustica::image_io::check_writable(path)?;
+    }
     let settings = photon_settings(&args.photon, args.seed)?;
     let pool = thread_pool(args.threads)?;
     let bars = Bars::new(args.quiet || args.json);
@@ -67,7 +70,7 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
             },
             "peak_memory_bytes": super::peak_memory_bytes(),
         });
-        println!("{summary}");
+        crate::stdout::println(&summary.to_string())?;
     } else if !args.quiet {
         eprintln!(
             "{}{}: {} photons stored of {} emitted ({:.1}% useful){} — parse {:.2} s, build {:.2} s, photons {photon_seconds:.2} s, total {total:.2} s{}",

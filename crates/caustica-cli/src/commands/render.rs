@@ -8,7 +8,7 @@ use crate::progress::Bars;
 use caustica::description::RenderHints;
 use caustica::film::ToneMap;
 use caustica::format::Format;
-use caustica::image_io::ImageFormat;
+use caustica::image_io::{check_writable, ImageFormat};
 use caustica::integrator::config::thread_pool;
 use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
@@ -111,6 +111,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     if let Some(o) = &args.output {
         ImageFormat::from_path(o)?;
     }
+    // A folder that is missing or read-only fails now, not after the render.
+    for path in args.output.iter().chain(&options.partial) {
+        check_writable(path)?;
+    }
     let display = args.preview.display.as_deref().map(tev::parse_address).transpose()?;
     let pool = thread_pool(args.threads)?;
     let quiet = args.quiet || args.json;
@@ -129,6 +133,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         (None, None, Some(named)) if ImageFormat::from_path(named).is_ok() => Some(named.clone()),
         (None, None, _) => Some("caustica.png".into()),
     };
+    // The default or the scene's own name, checked before any photon is traced.
+    if let Some(o) = output.as_ref().filter(|_| args.output.is_none()) {
+        check_writable(o)?;
+    }
     check_preview(&args, &output)?;
     if !quiet {
         for warning in scene.warnings() {
@@ -308,7 +316,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "preview": preview_json(&preview_report),
             })
         };
-        println!("{summary}");
+        crate::stdout::println(&summary.to_string())?;
     } else if !args.quiet {
         if progressive {
             let written: Vec<String> = [&output, &options.partial]
