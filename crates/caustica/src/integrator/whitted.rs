@@ -86,7 +86,7 @@ where
         let w = weight * p.reflective;
         if w.max_element() >= MIN_PATH_WEIGHT {
             let dir = reflect(d, n);
-            let origin = offset_origin(hit.point, hit.geometric_normal, dir);
+            let origin = hit.ray_origin(dir);
             color += p.reflective * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w, caustic);
         }
     }
@@ -101,7 +101,7 @@ where
                 let (eta, n_in) = refraction_geometry(index, entering, hit.shading_normal);
                 // Total internal reflection turns the transmitted ray back inside (as photons do).
                 let dir = refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in));
-                let origin = offset_origin(hit.point, hit.geometric_normal, dir);
+                let origin = hit.ray_origin(dir);
                 let kt = p.transmissive * mask;
                 color += kt * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w * mask, caustic);
             }
@@ -140,7 +140,7 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
             continue;
         }
         let shadow = match light.shadow_targets(hit.point) {
-            None => transmittance(scene, hit.point, hit.geometric_normal, ls.wi, ls.distance),
+            None => transmittance_from(scene, hit.ray_origin(ls.wi), hit.point, ls.wi, ls.distance),
             // A light with a size: the mean over shadow rays to points spread over it.
             Some(targets) => {
                 let (mut sum, mut n) = (Vec3::ZERO, 0.0f32);
@@ -148,7 +148,8 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
                     let to = q - hit.point;
                     let d = to.length();
                     if d > 0.0 {
-                        sum += transmittance(scene, hit.point, hit.geometric_normal, to / d, d);
+                        let wi = to / d;
+                        sum += transmittance_from(scene, hit.ray_origin(wi), hit.point, wi, d);
                     }
                     n += 1.0;
                 }
@@ -166,7 +167,11 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
 /// The product of the `transmissive` colours of everything between `point` and a light at
 /// `distance` along `wi` (zero when an opaque object is in the way).
 pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec3, distance: f32) -> Vec3 {
-    let origin = offset_origin(point, geometric_normal, wi);
+    transmittance_from(scene, offset_origin(point, geometric_normal, wi), point, wi, distance)
+}
+
+/// [`transmittance`] along the shadow ray from `origin`, which is `point` moved off its surface.
+fn transmittance_from(scene: &Scene, origin: Vec3, point: Vec3, wi: Vec3, distance: f32) -> Vec3 {
     let ray = Ray::new(origin, wi);
     let t_max = if distance.is_finite() {
         (distance - (origin - point).length()) * (1.0 - 1e-5)

@@ -24,7 +24,7 @@ use crate::bsdf::{Bsdf, Transport};
 use crate::light::emission::{caustic_targets, Aim, Emitter, Target};
 use crate::light::{distance_attenuation, Light};
 use crate::material::{channel_indices, refraction_geometry};
-use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
+use crate::math::{reflect, refract, Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
@@ -360,7 +360,7 @@ pub fn trace_path<M: PhotonModel>(
         let Some(dir) = model.interact(scene, &hit, &ray, &mut photon, rng, out) else {
             return;
         };
-        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, dir), dir);
+        ray = Ray::new(hit.ray_origin(dir), dir);
     }
 }
 
