@@ -311,3 +311,82 @@ fn sharing_a_pixels_caustic_estimate_changes_the_image_only_slightly() {
     assert!(diff < 0.01 * mean(&fresh), "mean absolute difference {diff}");
     assert!(shared != fresh, "the reuse took effect");
 }
+
+/// A glass slab with a faint diffuse colour (kd 0.1, kr = kt = 0.7) seen from above under a
+/// light from above. The course's value is the diffuse term of the light on each side it is
+/// seen from: the top, kd·E = 0.1, plus through the top (weighted kt) the inside of the bottom
+/// face, lit through the top: kd·kt·E = 0.07. Caustics must add nothing to it: 0.1 + 0.7 · 0.07
+/// = 0.149. (Photons stored inside the glass made it 0.25.)
+#[test]
+fn faint_diffuse_glass_shows_only_its_diffuse_term() {
+    use caustica::integrator::whitted::{render, WhittedSettings};
+    use caustica::integrator::ImageSettings;
+    let scene = common::scene(
+        "SBT-raytracer 1.0
+         camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 20; }
+         directional_light { direction = (0, 0, -1); color = (1, 1, 1); }
+         scale(10, 10, 0.5, box { material = { diffuse = (0.1, 0.1, 0.1); transmissive = (0.7, 0.7, 0.7);
+                                               reflective = (0.7, 0.7, 0.7); index = 1.5; } })",
+    );
+    let map = trace(&scene, photons(50_000), 100);
+    let image = ImageSettings {
+        width: 16,
+        height: 16,
+        aa: 1,
+        seed: 0,
+    };
+    let estimate = EstimateSettings::default();
+    let film = render(
+        &scene,
+        Some((&map, &estimate)),
+        &WhittedSettings::default(),
+        &image,
+        common::control(),
+    )
+    .0;
+    for p in &film.pixels {
+        assert!((p.x - 0.149).abs() < 1e-4, "{p:?}");
+    }
+    // Photons that went through the glass found nothing diffuse outside it to land on.
+    assert_eq!(map.len(), 0, "photons stored inside the glass");
+    assert!(map.stats.emitted > 0);
+}
+
+/// A thin glass ellipsoid (kr = kt = 0.7) traps photons by total internal reflection. Inside,
+/// photons choose as camera rays do (refraction only), so their power cannot grow there: at
+/// most it gains kt / P(refract) = 0.7 / 0.5 on entering. No stored photon may carry more than
+/// 1.4 × what a photon leaves the light with (E·π·R² over the photons emitted, for the disc of
+/// radius R they are aimed through), up to the 8-bit mantissa of its stored power. (It was
+/// 47,000 times that, 1.4³².)
+#[test]
+fn photons_gain_no_power_inside_glass() {
+    let scene = common::scene(
+        "SBT-raytracer 1.0
+         directional_light { direction = (0.3, 0.2, -1); color = (1, 1, 1); }
+         translate(0, 0, 2, scale(2, 2, 0.3, sphere { material = { diffuse = (0.02, 0.02, 0.02);
+             transmissive = (0.7, 0.7, 0.7); reflective = (0.7, 0.7, 0.7); index = 1.5; } }))
+         scale(30, square { material = { diffuse = (1, 1, 1); } })",
+    );
+    let map = trace(&scene, photons(50_000), 100);
+    let targets = caustica::light::emission::caustic_targets(&scene);
+    assert_eq!(targets.len(), 1);
+    let emitted_power = std::f32::consts::PI * targets[0].radius.powi(2) / map.stats.emitted as f32;
+    let largest = map
+        .photons()
+        .iter()
+        .map(|p| p.power().max_element())
+        .fold(0.0, f32::max);
+    assert!(map.len() >= 50_000);
+    assert!(
+        largest <= 1.4 * emitted_power * (1.0 + 1.0 / 128.0),
+        "a photon carries {} times the emitted power",
+        largest / emitted_power
+    );
+    assert!(
+        largest >= 1.3 * emitted_power,
+        "photons through the glass do carry 1.4×"
+    );
+    for p in map.photons() {
+        assert!(p.position.z.abs() < 1e-3, "stored off the floor: {:?}", p.position);
+    }
+}

@@ -76,7 +76,11 @@ where
     };
     if local.diffuse != Vec3::ZERO || local.specular != Vec3::ZERO {
         color += direct_light(scene, &hit, &local, n, wo);
-        color += caustic(&hit, p, wo, n, depth);
+        // Inside glass the shadow rays (filtered by kt) already bring all the light the course
+        // model gives there; photons are not stored on that side either.
+        if !inside_transmissive {
+            color += caustic(&hit, p, wo, n, depth);
+        }
     }
 
     if depth >= settings.max_depth {

@@ -49,6 +49,9 @@ pub struct PhotonSettings {
     pub first_hit: bool,
     /// Photons to store for each light, overriding the shared budget.
     pub per_light: Option<Vec<usize>>,
+    /// Photons inside glass reflect by its `reflective` colour too, not only by total internal
+    /// reflection (keep equal to the Whitted renderer's setting).
+    pub internal_reflection: bool,
 }
 
 impl Default for PhotonSettings {
@@ -61,6 +64,7 @@ impl Default for PhotonSettings {
             max_bounces: 32,
             first_hit: false,
             per_light: None,
+            internal_reflection: false,
         }
     }
 }
@@ -155,6 +159,7 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
         let model = CourseModel {
             light: lights[index],
             first_hit: settings.first_hit,
+            internal_reflection: settings.internal_reflection,
         };
         let run = trace_light(scene, &model, emitter, index, share, light_cap, settings, control);
         stats.emitted += run.emitted;
@@ -370,6 +375,9 @@ pub struct CourseModel<'a> {
     pub light: &'a Light,
     /// Store every photon at its first surface instead (a map of direct light, for checks).
     pub first_hit: bool,
+    /// Reflect by `reflective` inside glass too, not only by total internal reflection (as the
+    /// Whitted renderer's setting of the same name).
+    pub internal_reflection: bool,
 }
 
 impl PhotonModel for CourseModel<'_> {
@@ -390,7 +398,10 @@ impl PhotonModel for CourseModel<'_> {
         } else {
             hit.shading_normal
         };
-        let receives = p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO;
+        // Inside glass the light is what the course's shadow rays already bring through it
+        // (filtered by kt): a photon stored there would count it twice.
+        let inside_transmissive = !entering && p.transmissive != Vec3::ZERO;
+        let receives = (p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO) && !inside_transmissive;
         if receives && (photon.flags != 0 || self.first_hit) {
             let stored = photon.power.truncate() * falloff_scale(self.light, photon.length);
             out.push(Photon::new(hit.point, stored, d, facing, photon.flags));
@@ -398,7 +409,14 @@ impl PhotonModel for CourseModel<'_> {
         if self.first_hit {
             return None;
         }
-        let pr = p.reflective.max_element().max(0.0);
+        // Inside glass photons reflect as the camera's rays do: only by total internal
+        // reflection, unless internal reflection is asked for (so no chain inside can gain power).
+        let reflects = self.internal_reflection || !inside_transmissive;
+        let pr = if reflects {
+            p.reflective.max_element().max(0.0)
+        } else {
+            0.0
+        };
         let pt = p.transmissive.max_element().max(0.0);
         let norm = (pr + pt).max(1.0);
         let (pr, pt) = (pr / norm, pt / norm);
