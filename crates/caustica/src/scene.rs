@@ -653,18 +653,28 @@ impl Scene {
 
     /// Whether an object can reflect or refract specularly (anywhere on it).
     pub fn object_is_specular(&self, object: ObjectRef) -> bool {
+        self.any_material_of(object, Material::is_specular)
+    }
+
+    /// Whether a caustic can show on an object: it is diffuse or glossy somewhere.
+    pub fn object_receives(&self, object: ObjectRef) -> bool {
+        self.any_material_of(object, Material::may_receive)
+    }
+
+    /// Whether any material the object uses (a mesh's per-vertex ones included) passes `test`.
+    fn any_material_of(&self, object: ObjectRef, test: impl Fn(&Material) -> bool) -> bool {
         match object {
             ObjectRef::Mesh(i) => {
                 let mesh = &self.meshes[i as usize];
                 match &mesh.vertex_materials {
-                    Some(ids) => ids.iter().any(|&id| self.materials[id as usize].is_specular()),
-                    None => self.materials[mesh.material as usize].is_specular(),
+                    Some(ids) => ids.iter().any(|&id| test(&self.materials[id as usize])),
+                    None => test(&self.materials[mesh.material as usize]),
                 }
             }
             ObjectRef::Shape(i) => self
                 .shape_material_ids(i as usize)
                 .iter()
-                .any(|&id| self.materials[id as usize].is_specular()),
+                .any(|&id| test(&self.materials[id as usize])),
         }
     }
 }

@@ -59,8 +59,10 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
             "height": height,
             "photons_stored": s.stored,
             "photons_emitted": s.emitted,
+            "photons_landed": s.landed,
             "useful_fraction": s.useful_fraction(),
             "cap_reached": s.cap_reached,
+            "none_reason": s.none.map(|r| r.name()),
             "complete": complete,
             "seconds": {
                 "parse": loaded.parse_seconds,
@@ -72,13 +74,16 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
         });
         crate::stdout::println(&summary.to_string())?;
     } else if !args.quiet {
+        if s.none.is_some() {
+            eprintln!("{}", super::photon_lines(s, photon_seconds).join("\n"));
+        }
         eprintln!(
-            "{}{}: {} photons stored of {} emitted ({:.1}% useful){} — parse {:.2} s, build {:.2} s, photons {photon_seconds:.2} s, total {total:.2} s{}",
+            "{}{}: {} photons stored of {} emitted ({}){} — parse {:.2} s, build {:.2} s, photons {photon_seconds:.2} s, total {total:.2} s{}",
             args.output.display(),
             args.ply.as_ref().map_or(String::new(), |p| format!(" and {}", p.display())),
             s.stored,
             s.emitted,
-            100.0 * s.useful_fraction(),
+            super::landed_text(s),
             if s.cap_reached { ", emission cap reached" } else { "" },
             loaded.parse_seconds,
             loaded.build_seconds,

@@ -229,20 +229,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let photon_stats = session.caustic_map().map(|m| m.stats.clone());
     if !quiet {
         if let Some(s) = &photon_stats {
-            eprintln!(
-                "photons: {} emitted, {} stored ({:.1}% useful) in {:.2} s{}",
-                s.emitted,
-                s.stored,
-                100.0 * s.useful_fraction(),
-                summary.photon_seconds,
-                if s.cap_reached {
-                    " — emission cap reached before the budget was stored"
-                } else {
-                    ""
-                }
-            );
-            if s.stored == 0 {
-                eprintln!("photons: none stored (the scene has no mirror or glass that lights reach): no caustics");
+            for line in super::photon_lines(s, summary.photon_seconds) {
+                eprintln!("{line}");
             }
         }
     }
@@ -304,6 +292,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "samples_per_pixel": aa * aa,
                 "photons_stored": photon_stats.as_ref().map_or(0, |s| s.stored),
                 "photons_emitted": photon_stats.as_ref().map_or(0, |s| s.emitted),
+                "photons_landed": photon_stats.as_ref().map_or(0, |s| s.landed),
+                "photons_useful_fraction": photon_stats.as_ref().map_or(0.0, |s| s.useful_fraction()),
+                "photons_cap_reached": photon_stats.as_ref().is_some_and(|s| s.cap_reached),
+                "photons_none_reason": photon_stats.as_ref().and_then(|s| s.none).map(|r| r.name()),
                 "complete": complete,
                 "seconds": {
                     "parse": parse_seconds,

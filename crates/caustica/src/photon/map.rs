@@ -17,8 +17,8 @@
 //!   [`PhotonMap::radiance_within`]) or the k nearest (Jensen's global and caustic maps,
 //!   [`PhotonMap::radiance_nearest`]), with the BSDF the camera paths use.
 
+use super::budget::{trace_photons, PhotonSettings, PhotonStats};
 use super::kd_tree::{KdTree, Neighbor};
-use super::trace::{trace_photons, PhotonSettings, PhotonStats};
 use super::{Photon, DISPERSED};
 use crate::bsdf::Bsdf;
 use crate::material::SurfaceParams;
