@@ -23,7 +23,7 @@ fn main() -> ExitCode {
     let cli = cli::Cli::parse();
     let cancel = interrupt::install();
     let result = match cli.command {
-        cli::Command::Render(args) => commands::render::run(args, cancel),
+        cli::Command::Render(args) => commands::render::run(*args, cancel),
         cli::Command::Info(args) => commands::info::run(args),
         cli::Command::Photons(args) => commands::photons::run(args, cancel),
         cli::Command::Bench(args) => commands::bench::run(args),

@@ -89,6 +89,9 @@ fn bad_options_are_refused_with_exit_2_before_any_work() {
         vec!["render", "-o", "picture.jpg"],
         vec!["render", "--threads", "0"],
         vec!["render", "--no-such-flag"],
+        vec!["render", "--estimate", "widest"],
+        vec!["render", "--tone-map", "gamma"],
+        vec!["render", "--exposure", "nan"],
     ] {
         let assert = caustica().current_dir(&dir).args(&args).assert().code(2);
         let stderr = String::from_utf8(assert.get_output().stderr.clone()).unwrap();

@@ -9,12 +9,13 @@
 
 pub mod budget;
 pub mod kd_tree;
+pub mod kernel;
 pub mod map;
 pub mod picture;
 pub mod trace;
 
 pub use budget::{NoCaustics, PhotonSettings, PhotonStats};
-pub use map::{EstimateSettings, PhotonMap};
+pub use map::{EstimateSettings, Estimator, PhotonMap};
 
 use crate::math::{Vec2, Vec3, Vec4};
 

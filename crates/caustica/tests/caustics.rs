@@ -5,15 +5,28 @@ mod common;
 use caustica::integrator::whitted::transmittance;
 use caustica::light::distance_attenuation;
 use caustica::math::Vec3;
-use caustica::photon::{EstimateSettings, PhotonMap, PhotonSettings};
+use caustica::photon::{EstimateSettings, Estimator, PhotonMap, PhotonSettings};
 
+/// A photon map for Jensen's k-nearest estimate (the checks of photon transport use it: its
+/// box over thousands of photons averages smooth fields).
 fn trace(scene: &caustica::scene::Scene, settings: PhotonSettings, k: usize) -> PhotonMap {
-    PhotonMap::trace(scene, &settings, k, common::control())
+    let estimate = EstimateSettings {
+        estimator: Estimator::Nearest,
+        k,
+        ..EstimateSettings::default()
+    };
+    PhotonMap::trace(scene, &settings, &estimate, common::control())
+}
+
+/// A photon map for the default (kernel) estimate with `estimate`.
+fn trace_for(scene: &caustica::scene::Scene, settings: PhotonSettings, estimate: &EstimateSettings) -> PhotonMap {
+    PhotonMap::trace(scene, &settings, estimate, common::control())
 }
 
 /// For smooth fields: 10,000 photons per estimate (noise ≈ 1/√k = 1%) and a box filter.
 fn smooth() -> EstimateSettings {
     EstimateSettings {
+        estimator: Estimator::Nearest,
         k: 10_000,
         max_radius: Some(1e3),
         cone_filter: None,
@@ -61,6 +74,7 @@ fn flat_mirror_caustic_is_the_mirror_image_of_the_light() {
     }
     // Behind the mirror (x < 0) the floor receives no reflected light.
     let near = EstimateSettings {
+        estimator: Estimator::Nearest,
         max_radius: Some(0.5),
         ..EstimateSettings::default()
     };
@@ -185,20 +199,31 @@ translate(0, 0, 1, scale(0.02, 6, 2, box { material = { diffuse = (1, 1, 1); } }
 scale(20, square { material = { diffuse = (1, 1, 1); } })
 ";
     let scene = common::scene(text);
-    let map = trace(&scene, photons(100_000), 100);
-    let estimate = EstimateSettings {
-        k: 100,
-        max_radius: Some(0.5),
-        ..EstimateSettings::default()
-    };
-    let lit = map.flux_density(&scene, Vec3::new(0.1, 0.0, 0.0), Vec3::Z, &estimate).x;
-    let behind = map
-        .flux_density(&scene, Vec3::new(-0.1, 0.0, 0.0), Vec3::Z, &estimate)
-        .x;
-    // The mirror image of the light is at (4.5, 0, 4): irradiance 0.019 at (0.1, 0, 0), of which a
-    // gather disc cut in half by the wall sees at least a good part.
-    assert!(lit > 0.006, "the lit side receives the mirror's light: {lit}");
-    assert!(behind < 0.01 * lit, "light bled through the wall: {behind} vs {lit}");
+    // Both estimates: k nearest photons, and photons spread over their own kernels (those
+    // beside the wall reach across it).
+    for estimator in [Estimator::Nearest, Estimator::Kernels] {
+        let estimate = EstimateSettings {
+            estimator,
+            k: 100,
+            max_radius: Some(0.5),
+            ..EstimateSettings::default()
+        };
+        let map = trace_for(&scene, photons(100_000), &estimate);
+        let lit = map.flux_density(&scene, Vec3::new(0.1, 0.0, 0.0), Vec3::Z, &estimate).x;
+        let behind = map
+            .flux_density(&scene, Vec3::new(-0.1, 0.0, 0.0), Vec3::Z, &estimate)
+            .x;
+        // The mirror image of the light is at (4.5, 0, 4): irradiance 0.019 at (0.1, 0, 0), of
+        // which a gather disc cut in half by the wall sees at least a good part.
+        assert!(
+            lit > 0.006,
+            "{estimator:?}: the lit side receives the mirror's light: {lit}"
+        );
+        assert!(
+            behind < 0.01 * lit,
+            "{estimator:?}: light bled through the wall: {behind} vs {lit}"
+        );
+    }
 }
 
 #[test]
@@ -285,8 +310,8 @@ fn sharing_a_pixels_caustic_estimate_changes_the_image_only_slightly() {
     use caustica::integrator::ImageSettings;
     let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../scenes/ring.ray")).unwrap();
     let scene = common::scene(&text);
-    let map = trace(&scene, photons(100_000), 100);
     let estimate = EstimateSettings::default();
+    let map = trace_for(&scene, photons(100_000), &estimate);
     let image = ImageSettings {
         width: 96,
         height: 96,
@@ -335,14 +360,14 @@ fn faint_diffuse_glass_shows_only_its_diffuse_term() {
          scale(10, 10, 0.5, box { material = { diffuse = (0.1, 0.1, 0.1); transmissive = (0.7, 0.7, 0.7);
                                                reflective = (0.7, 0.7, 0.7); index = 1.5; } })",
     );
-    let map = trace(&scene, photons(50_000), 100);
+    let estimate = EstimateSettings::default();
+    let map = trace_for(&scene, photons(50_000), &estimate);
     let image = ImageSettings {
         width: 16,
         height: 16,
         aa: 1,
         seed: 0,
     };
-    let estimate = EstimateSettings::default();
     let film = render(
         &scene,
         Some((&map, &estimate)),

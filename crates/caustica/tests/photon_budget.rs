@@ -5,7 +5,7 @@ mod common;
 
 use caustica::math::luminance;
 use caustica::photon::budget::trace_photons;
-use caustica::photon::{NoCaustics, PhotonMap, PhotonSettings};
+use caustica::photon::{EstimateSettings, Estimator, NoCaustics, PhotonMap, PhotonSettings};
 
 fn trace(text: &str, stored: usize) -> PhotonMap {
     let scene = common::scene(text);
@@ -14,7 +14,12 @@ fn trace(text: &str, stored: usize) -> PhotonMap {
         seed: 3,
         ..PhotonSettings::default()
     };
-    PhotonMap::trace(&scene, &settings, 50, common::control())
+    // Only the photons matter here: the map for the cheaper k-nearest estimate.
+    let estimate = EstimateSettings {
+        estimator: Estimator::Nearest,
+        ..EstimateSettings::default()
+    };
+    PhotonMap::trace(&scene, &settings, &estimate, common::control())
 }
 
 /// A sun and a lamp with the course's gentle falloff both light a mirror over a floor. The

@@ -127,7 +127,7 @@ fn a_scaled_and_moved_ellipsoid_is_lit_without_specks() {
          translate(-2, -1, -10, scale(0.2, 0.2, 20, sphere { material = { diffuse = (0.8, 0.4, 0); } }))",
     );
     let settings = WhittedSettings::default();
-    let none = |_: &SurfaceHit, _: &SurfaceParams, _: Vec3, _: Vec3, _: u32| Vec3::ZERO;
+    let none = |_: &SurfaceHit, _: &SurfaceParams, _: Vec3, _: Vec3, _: u32, _: f32| Vec3::ZERO;
     let light = Vec3::new(1.0, 1.0, 0.2).normalize();
     let (n, mut lit, mut wrong) = (240, 0, Vec::new());
     for y in 0..n {

@@ -9,7 +9,7 @@ use caustica::integrator::config::thread_pool;
 use caustica::integrator::image_size;
 use caustica::integrator::session::check_image_size;
 use caustica::photon::picture::{draw_photons, write_ply};
-use caustica::photon::PhotonMap;
+use caustica::photon::{EstimateSettings, Estimator, PhotonMap};
 use caustica::progress::Control;
 use caustica::Result;
 use serde_json::json;
@@ -40,12 +40,18 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
         cancel,
     };
     let t_photons = Instant::now();
-    let map = pool.install(|| PhotonMap::trace(&scene, &settings, 1, control));
+    // Only the photons are drawn: the cheapest map will do.
+    let estimate = EstimateSettings {
+        estimator: Estimator::Nearest,
+        k: 1,
+        ..EstimateSettings::default()
+    };
+    let map = pool.install(|| PhotonMap::trace(&scene, &settings, &estimate, control));
     let photon_seconds = t_photons.elapsed().as_secs_f64();
     // Checked right after tracing: a Ctrl-C while writing does not make the map partial.
     let complete = !cancel.load(Ordering::Relaxed);
     let film = draw_photons(&scene, map.photons(), width, height);
-    film.save(&args.output, ToneMap::Clamp)?;
+    film.save(&args.output, ToneMap::Clamp { exposure: 0.0 })?;
     if let Some(ply) = &args.ply {
         write_ply(ply, map.photons())?;
     }

@@ -13,6 +13,7 @@ use caustica::integrator::config::thread_pool;
 use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
 use caustica::light::Light;
+use caustica::photon::Estimator;
 use caustica::preview::{tev, Preview, PreviewReport, PreviewSettings};
 use caustica::progress::Control;
 use caustica::scene::Scene;
@@ -59,6 +60,10 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         k: args.k,
         radius: args.radius.or(scene.radius),
         cone_filter: args.cone_filter,
+        estimator: match args.estimate.as_str() {
+            "nearest" => Estimator::Nearest,
+            _ => Estimator::Kernels,
+        },
         no_estimate_reuse: args.no_estimate_reuse,
         passes: p.passes.clone().or(if p.time.is_none() && !course {
             scene.passes
@@ -162,12 +167,13 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     }
     let mut session = RenderSession::new(scene, config.render_options(loaded.scene_id.clone())?)?;
     let (width, height) = session.size();
-    let tone_map = if progressive {
-        ToneMap::Reinhard {
-            exposure: options.exposure,
-        }
-    } else {
-        ToneMap::Clamp
+    let exposure = options.exposure;
+    let tone_map = match options.tone_map.as_deref() {
+        Some("reinhard") => ToneMap::Reinhard { exposure },
+        Some("linear") => ToneMap::Linear { exposure },
+        Some(_) => ToneMap::Clamp { exposure },
+        None if progressive => ToneMap::Reinhard { exposure },
+        None => ToneMap::Clamp { exposure },
     };
     let preview = if display.is_some() || args.preview.preview {
         let name = [&output, &options.partial]

@@ -221,7 +221,7 @@ impl<'a> RenderSession<'a> {
             internal_reflection: options.whitted.internal_reflection,
             ..options.photons.clone()
         };
-        self.caustic_map = Some(PhotonMap::trace(self.scene, &photons, options.estimate.k, control));
+        self.caustic_map = Some(PhotonMap::trace(self.scene, &photons, &options.estimate, control));
         self.photon_seconds += start.elapsed().as_secs_f64();
     }
 
