@@ -4,6 +4,7 @@
 use crate::to_py;
 use caustica::integrator::RenderConfig;
 use caustica::loader::LoadSettings;
+use caustica::photon::Estimator;
 use pyo3::conversion::FromPyObjectOwned;
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -28,6 +29,7 @@ pub const RENDER: &[&str] = &[
     "k",
     "radius",
     "cone_filter",
+    "estimate",
     "no_estimate_reuse",
     "passes",
     "time",
@@ -89,7 +91,9 @@ pub fn parse(
         if !allowed.contains(&key.as_str()) {
             let hint = match key.as_str() {
                 "output" | "o" => " (the image is returned as an array)",
-                "quiet" | "json" | "exposure" => " (it only changes what the command line prints or writes)",
+                "quiet" | "json" | "exposure" | "tone_map" => {
+                    " (it only changes what the command line prints or writes)"
+                }
                 _ => "",
             };
             return Err(PyTypeError::new_err(format!(
@@ -132,6 +136,17 @@ pub fn parse(
             "k" => c.k = v.whole()?,
             "radius" => c.radius = v.optional(Value::number)?.map(|r| r as f32),
             "cone_filter" => c.cone_filter = v.number()? as f32,
+            "estimate" => {
+                c.estimator = match v.text()?.as_str() {
+                    "kernels" => Estimator::Kernels,
+                    "nearest" => Estimator::Nearest,
+                    other => {
+                        return Err(PyValueError::new_err(format!(
+                            "estimate must be 'kernels' or 'nearest', not '{other}'"
+                        )))
+                    }
+                }
+            }
             "no_estimate_reuse" => c.no_estimate_reuse = v.flag()?,
             "passes" => c.passes = v.optional(Value::passes)?,
             "time" => c.time = v.optional(Value::number)?,

@@ -4,7 +4,7 @@ use crate::options::{self, PHOTONS};
 use crate::run_interruptible;
 use crate::scene::{SceneArg, SceneSource};
 use caustica::integrator::config::thread_pool;
-use caustica::photon::{PhotonMap, REFLECTED, REFRACTED};
+use caustica::photon::{EstimateSettings, Estimator, PhotonMap, REFLECTED, REFRACTED};
 use caustica::progress::{Control, NoProgress};
 use caustica::Error;
 use numpy::{PyArray1, PyArray2, PyArrayMethods};
@@ -74,7 +74,13 @@ pub fn photons(py: Python<'_>, scene: Option<SceneArg>, options: Option<&Bound<'
             progress: &NoProgress,
             cancel: &flag,
         };
-        let map = pool.install(|| PhotonMap::trace(&loaded.scene, &settings, 1, control));
+        // Only the photons are returned: the cheapest map will do.
+        let estimate = EstimateSettings {
+            estimator: Estimator::Nearest,
+            k: 1,
+            ..EstimateSettings::default()
+        };
+        let map = pool.install(|| PhotonMap::trace(&loaded.scene, &settings, &estimate, control));
         if control.cancelled() {
             return Err(Error::Interrupted);
         }

@@ -27,7 +27,7 @@ pub enum Command {
   caustica render scene.pbrt                         # pbrt-v4: its Film, Sampler and Integrator apply
   caustica render model.glb --integrator ppm -o model.png
   caustica render bunny.obj --point-light 0,4,4,16,16,16 --look-from 0,1,3")]
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Show what was parsed: camera, lights, objects, bounds, materials.
     #[command(after_help = "Examples:
   caustica info scenes/ring.ray
@@ -207,6 +207,11 @@ pub struct RenderArgs {
     /// Cone filter constant (≥ 1); 0 turns the filter off.
     #[arg(long, default_value_t = 1.1)]
     pub cone_filter: f32,
+    /// Course model's caustic estimate: `kernels`, each photon spread over a kernel as wide as
+    /// its distance to its k-th neighbour (adapts to the photon density), or `nearest`, the k
+    /// nearest photons within the largest radius (Jensen's).
+    #[arg(long, value_parser = ["kernels", "nearest"], default_value = "kernels")]
+    pub estimate: String,
     /// Compute the caustic estimate for every sample instead of sharing a pixel's first one.
     #[arg(long)]
     pub no_estimate_reuse: bool,
@@ -261,9 +266,14 @@ pub struct ProgressiveOptions {
     /// Seconds between rewrites of the image while passes run.
     #[arg(long, default_value_t = 10.0)]
     pub save_every: f64,
-    /// Exposure in stops for PNG output of the physical model (x·2^E, then x/(1+x), then sRGB).
+    /// Exposure in stops for PNG output: values are multiplied by 2^E before the tone map.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+    /// PNG tone map: `clamp` (the course's: clamp to 1, no gamma), `reinhard` (x/(1+x), then
+    /// sRGB) or `linear` (clamp to 1, then sRGB) [default: clamp for the course model, reinhard
+    /// for the physical one].
+    #[arg(long, value_parser = ["clamp", "reinhard", "linear"])]
+    pub tone_map: Option<String>,
     /// ppm: first gather radius in pixels at the gather point (the footprint the blur starts from).
     #[arg(long, default_value_t = 2.0)]
     pub footprint: f32,

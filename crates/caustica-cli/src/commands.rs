@@ -14,7 +14,7 @@ use caustica::format::{obj, Format};
 use caustica::integrator::RenderConfig;
 use caustica::loader::{load_timed, LoadSettings, Loaded};
 use caustica::math::Vec3;
-use caustica::photon::PhotonSettings;
+use caustica::photon::{NoCaustics, PhotonSettings, PhotonStats};
 use caustica::{Error, Result};
 use std::path::Path;
 
@@ -122,6 +122,43 @@ pub fn photon_settings(options: &PhotonOptions, seed: u64) -> Result<PhotonSetti
     };
     config.integrator()?;
     Ok(config.photon_settings())
+}
+
+/// How many emitted photons stored something, e.g. "62.1% landed, 1.20 stores each".
+pub fn landed_text(s: &PhotonStats) -> String {
+    let each = s.stores_per_landing();
+    if each > 1.005 {
+        format!("{:.1}% landed, {each:.2} stores each", 100.0 * s.useful_fraction())
+    } else {
+        format!("{:.1}% landed", 100.0 * s.useful_fraction())
+    }
+}
+
+/// The photon pass in words: what it emitted and stored, and why there are no caustics when
+/// there are none.
+pub fn photon_lines(s: &PhotonStats, seconds: f64) -> Vec<String> {
+    if let Some(reason) = s.none {
+        let traced = match reason {
+            NoCaustics::NoneLanded { .. } => "stopped early",
+            _ => "none traced",
+        };
+        return vec![format!("photons: {traced}: {reason}: no caustics")];
+    }
+    let mut lines = vec![format!(
+        "photons: {} emitted, {} stored ({}) in {seconds:.2} s{}",
+        s.emitted,
+        s.stored,
+        landed_text(s),
+        if s.cap_reached {
+            " — emission cap reached before the budget was stored"
+        } else {
+            ""
+        }
+    )];
+    if s.stored == 0 {
+        lines.push("photons: none stored: no caustics".into());
+    }
+    lines
 }
 
 /// A path as JSON shows it (`null` for none); any path prints, UTF-8 or not.

@@ -7,6 +7,7 @@ mod commands;
 mod diagnostics;
 mod interrupt;
 mod progress;
+mod stdout;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -22,7 +23,7 @@ fn main() -> ExitCode {
     let cli = cli::Cli::parse();
     let cancel = interrupt::install();
     let result = match cli.command {
-        cli::Command::Render(args) => commands::render::run(args, cancel),
+        cli::Command::Render(args) => commands::render::run(*args, cancel),
         cli::Command::Info(args) => commands::info::run(args),
         cli::Command::Photons(args) => commands::photons::run(args, cancel),
         cli::Command::Bench(args) => commands::bench::run(args),
@@ -31,6 +32,8 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(code) => ExitCode::from(code),
+        // The reader of our output went away (`| head`): what it wanted was printed.
+        Err(error) if stdout::is_closed_pipe(&error) => ExitCode::SUCCESS,
         Err(error) => {
             let code = if error.is_bad_input() {
                 EXIT_BAD_INPUT

@@ -89,6 +89,9 @@ fn bad_options_are_refused_with_exit_2_before_any_work() {
         vec!["render", "-o", "picture.jpg"],
         vec!["render", "--threads", "0"],
         vec!["render", "--no-such-flag"],
+        vec!["render", "--estimate", "widest"],
+        vec!["render", "--tone-map", "gamma"],
+        vec!["render", "--exposure", "nan"],
     ] {
         let assert = caustica().current_dir(&dir).args(&args).assert().code(2);
         let stderr = String::from_utf8(assert.get_output().stderr.clone()).unwrap();
@@ -224,4 +227,110 @@ fn max_memory_caps_the_photon_map() {
         ])
         .assert()
         .success();
+}
+
+/// `caustica info big.ray | head -1`: the reader closes the pipe long before the output ends
+/// (far more than a pipe's buffer of it), and caustica stops quietly with success.
+#[test]
+fn a_reader_that_stops_early_ends_info_quietly() {
+    use std::io::{BufRead, Read};
+    use std::process::Stdio;
+    let dir = temp_dir("pipe");
+    let scene = dir.join("many.ray");
+    let mut text =
+        String::from("SBT-raytracer 1.0\ncamera { position = (0, 0, 40); viewdir = (0, 0, -1); updir = (0, 1, 0); }\n");
+    for i in 0..3000 {
+        text += &format!(
+            "translate({}, {}, 0, sphere {{ material = {{ diffuse = (1, 1, 1); }} }})\n",
+            i % 60,
+            i / 60
+        );
+    }
+    std::fs::write(&scene, text).unwrap();
+    let exe = assert_cmd::cargo::cargo_bin("caustica");
+    for json in [false, true] {
+        let mut child = std::process::Command::new(&exe)
+            .arg("info")
+            .arg(&scene)
+            .args(json.then_some("--json"))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        std::io::BufReader::new(child.stdout.take().unwrap())
+            .take(100)
+            .read_line(&mut first)
+            .unwrap();
+        assert!(!first.is_empty());
+        // Dropping the reader closed the pipe.
+        let output = child.wait_with_output().unwrap();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(0), "json {json}: {stderr}");
+        assert!(stderr.is_empty(), "json {json}: {stderr}");
+    }
+}
+
+/// An output into a folder that does not exist is refused before the scene is even read (the
+/// scene here is malformed, and that is not what is reported), for every command that writes.
+#[test]
+fn outputs_are_checked_before_any_work() {
+    let dir = temp_dir("outputs");
+    let bad_scene = dir.join("bad.ray");
+    std::fs::write(&bad_scene, "SBT-raytracer 1.0\ncamera { difuse = 1; }\n").unwrap();
+    let missing = dir.join("no-such-folder");
+    let part = dir.join("a.part");
+    let cases: Vec<Vec<std::ffi::OsString>> = vec![
+        vec![
+            "render".into(),
+            bad_scene.clone().into(),
+            "-o".into(),
+            missing.join("x.png").into(),
+        ],
+        vec![
+            "render".into(),
+            bad_scene.clone().into(),
+            "--model".into(),
+            "physical".into(),
+            "--partial".into(),
+            missing.join("x.part").into(),
+        ],
+        vec![
+            "photons".into(),
+            bad_scene.clone().into(),
+            "-o".into(),
+            missing.join("x.png").into(),
+        ],
+        vec![
+            "photons".into(),
+            bad_scene.clone().into(),
+            "-o".into(),
+            dir.join("x.png").into(),
+            "--ply".into(),
+            missing.join("x.ply").into(),
+        ],
+        vec![
+            "merge".into(),
+            part.clone().into(),
+            "-o".into(),
+            missing.join("x.exr").into(),
+        ],
+        vec![
+            "render".into(),
+            bad_scene.clone().into(),
+            "-o".into(),
+            dir.clone().join("sub.png/").into(),
+        ],
+    ];
+    std::fs::create_dir_all(dir.join("sub.png")).unwrap();
+    for args in cases {
+        let assert = caustica().args(&args).assert().code(2);
+        let output = assert.get_output();
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains("cannot write"), "{args:?}: {stderr}");
+        assert!(!stderr.contains("bad.ray:"), "{args:?} read the scene first: {stderr}");
+        assert!(output.stdout.is_empty());
+    }
+    assert!(!missing.exists());
+    assert!(!dir.join("x.png").exists());
 }

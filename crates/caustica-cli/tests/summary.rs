@@ -57,10 +57,11 @@ fn render_json_has_every_phase() {
     assert_eq!(summary["output"].as_str(), Some(out.to_str().unwrap()));
     assert_eq!(summary["width"], 32);
     assert_eq!(summary["samples_per_pixel"], 4);
-    assert!(
-        summary["photons_stored"].as_u64().is_some_and(|n| n >= 3000),
-        "{summary}"
-    );
+    assert_eq!(summary["photons_stored"], 3000, "exactly the budget: {summary}");
+    let useful = summary["photons_useful_fraction"].as_f64().unwrap();
+    assert!(useful > 0.0 && useful <= 1.0, "{summary}");
+    assert_eq!(summary["photons_cap_reached"], false);
+    assert_eq!(summary["photons_none_reason"], Value::Null);
     assert_eq!(summary["complete"], true);
     assert!(
         stderr.is_empty(),
@@ -238,4 +239,50 @@ fn photons_ctrl_c_draws_the_partial_map_and_exits_130() {
     assert_eq!(summary["complete"], false);
     assert!(summary["photons_stored"].as_u64().unwrap() < 5_000_000);
     assert!(out.exists(), "the photons stored so far are drawn");
+}
+
+/// A scene whose photons can make no caustic stops the photon pass at once and says why, in
+/// words and in JSON.
+#[test]
+fn a_scene_without_caustics_says_why() {
+    let dir = temp_dir("no-caustics");
+    let cases = [
+        (
+            "mirror.ray",
+            "scale(2, box { material = { reflective = (0.8, 0.8, 0.8); } })",
+            "no_receiver",
+            "nowhere to land",
+        ),
+        (
+            "ball.ray",
+            "sphere { material = { diffuse = (0.5, 0.5, 0.5); reflective = (0.8, 0.8, 0.8); } }",
+            "none_landed",
+            "none of the first 65536 photons",
+        ),
+    ];
+    for (name, objects, reason, words) in cases {
+        let file = dir.join(name);
+        std::fs::write(
+            &file,
+            format!(
+                "SBT-raytracer 1.0\ncamera {{ position = (0, 0, 6); viewdir = (0, 0, -1); updir = (0, 1, 0); }}\n\
+                 directional_light {{ direction = (0, 0.3, -1); color = (1, 1, 1); }}\n{objects}"
+            ),
+        )
+        .unwrap();
+        let render = |extra: &str| {
+            run(caustica()
+                .arg("render")
+                .arg(&file)
+                .arg("-o")
+                .arg(dir.join("out.png"))
+                .args(["--width", "16"])
+                .arg(extra))
+        };
+        let summary = json(&render("--json").0);
+        assert_eq!(summary["photons_none_reason"], reason, "{summary}");
+        assert_eq!(summary["photons_stored"], 0);
+        let (_, stderr) = render("--seed=0");
+        assert!(stderr.contains(words) && stderr.contains("no caustics"), "{stderr}");
+    }
 }

@@ -16,7 +16,7 @@ use std::time::Duration;
 
 use caustica::loader::{load, LoadSettings};
 use caustica::math::Vec3;
-use caustica::photon::{Photon, PhotonMap, PhotonSettings, PhotonStats};
+use caustica::photon::{EstimateSettings, Estimator, Photon, PhotonMap, PhotonSettings, PhotonStats};
 use caustica::progress::{Control, NoProgress};
 use caustica::sampling::Rng;
 use caustica::scene::Scene;
@@ -43,12 +43,18 @@ fn trace(c: &mut Criterion) {
     group.sample_size(10).measurement_time(Duration::from_secs(4));
     for name in ["ring.ray", "pool.ray"] {
         let scene = scene(name);
-        let emitted = PhotonMap::trace(&scene, &settings, 100, control).stats.emitted;
+        let emitted = PhotonMap::trace(&scene, &settings, &EstimateSettings::default(), control)
+            .stats
+            .emitted;
         group.throughput(Throughput::Elements(emitted));
         for threads in [1, 2] {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             group.bench_function(BenchmarkId::new(name, format!("{threads}-thread")), |b| {
-                b.iter(|| pool.install(|| black_box(PhotonMap::trace(&scene, &settings, 100, control).len())))
+                b.iter(|| {
+                    pool.install(|| {
+                        black_box(PhotonMap::trace(&scene, &settings, &EstimateSettings::default(), control).len())
+                    })
+                })
             });
         }
     }
@@ -98,7 +104,14 @@ fn build(c: &mut Criterion) {
     group.sample_size(10).measurement_time(Duration::from_secs(8));
     for n in sizes {
         let photons = caustic_photons(n);
-        let map = PhotonMap::from_photons(photons.clone(), PhotonStats::default(), 100);
+        // The k-nearest build (tree and automatic radius) as measured before, then the kernel
+        // estimate's (the tree and every photon's kernel).
+        let nearest = EstimateSettings {
+            estimator: Estimator::Nearest,
+            ..EstimateSettings::default()
+        };
+        let kernels = EstimateSettings::default();
+        let map = PhotonMap::from_photons(photons.clone(), PhotonStats::default(), &kernels);
         eprintln!(
             "photons/build/{n}: map {:.1} MB ({:.2} bytes per photon), process peak {:.0} MB",
             map.heap_bytes() as f64 / 1e6,
@@ -110,7 +123,14 @@ fn build(c: &mut Criterion) {
         group.bench_function(BenchmarkId::from_parameter(n), |b| {
             b.iter_batched(
                 || photons.clone(),
-                |p| black_box(PhotonMap::from_photons(p, PhotonStats::default(), 100).auto_radius()),
+                |p| black_box(PhotonMap::from_photons(p, PhotonStats::default(), &nearest).auto_radius()),
+                BatchSize::LargeInput,
+            )
+        });
+        group.bench_function(BenchmarkId::new("kernels", n), |b| {
+            b.iter_batched(
+                || photons.clone(),
+                |p| black_box(PhotonMap::from_photons(p, PhotonStats::default(), &kernels).heap_bytes()),
                 BatchSize::LargeInput,
             )
         });

@@ -31,7 +31,7 @@ fn render_once(scene: &Scene, aa: u32, control: Control) -> f32 {
         target_stored: STORED,
         ..PhotonSettings::default()
     };
-    let map = PhotonMap::trace(scene, &photons, estimate.k, control);
+    let map = PhotonMap::trace(scene, &photons, &estimate, control);
     let (width, height) = image_size(scene.camera(), WIDTH, None);
     let image = ImageSettings {
         width,

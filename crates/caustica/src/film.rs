@@ -8,15 +8,20 @@ use std::path::Path;
 /// How linear values become 8-bit PNG values.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ToneMap {
-    /// The course's convention: clamp to [0, 1], scale by 255 and truncate; no gamma.
-    Clamp,
-    /// Physical mode: multiply by 2^exposure, map with x / (1 + x) per channel (Reinhard), then
-    /// encode with the sRGB transfer curve and round.
+    /// The course's convention: clamp to [0, 1], scale by 255 and truncate; no gamma. With an
+    /// exposure other than 0, the values are first multiplied by 2^exposure.
+    Clamp {
+        /// Exposure in stops.
+        exposure: f32,
+    },
+    /// Multiply by 2^exposure, map with x / (1 + x) per channel (Reinhard), then encode with
+    /// the sRGB transfer curve and round: the physical model's default, and a way to show a
+    /// course caustic brighter than 1 without clipping it.
     Reinhard {
         /// Exposure in stops.
         exposure: f32,
     },
-    /// Physical mode without compression: 2^exposure, clamp, sRGB curve.
+    /// Without compression: 2^exposure, clamp, sRGB curve.
     Linear {
         /// Exposure in stops.
         exposure: f32,
@@ -87,8 +92,7 @@ impl Film {
 /// 2^exposure, the factor a tone map applies first.
 fn exposure_scale(tone_map: ToneMap) -> f32 {
     match tone_map {
-        ToneMap::Clamp => 1.0,
-        ToneMap::Reinhard { exposure } | ToneMap::Linear { exposure } => exposure.exp2(),
+        ToneMap::Clamp { exposure } | ToneMap::Reinhard { exposure } | ToneMap::Linear { exposure } => exposure.exp2(),
     }
 }
 
@@ -101,7 +105,7 @@ fn encode_channel(c: f32, tone_map: ToneMap) -> u8 {
 fn encode_scaled(c: f32, tone_map: ToneMap, scale: f32) -> u8 {
     let c = if c.is_finite() { c } else { 0.0 };
     match tone_map {
-        ToneMap::Clamp => (c.clamp(0.0, 1.0) * 255.0) as u8,
+        ToneMap::Clamp { .. } => ((c * scale).clamp(0.0, 1.0) * 255.0) as u8,
         ToneMap::Reinhard { .. } => {
             let x = (c * scale).max(0.0);
             (srgb_encode(x / (1.0 + x)) * 255.0).round() as u8
@@ -125,10 +129,12 @@ mod tests {
 
     #[test]
     fn course_conversion_clamps_and_truncates() {
-        assert_eq!(encode_channel(0.5, ToneMap::Clamp), 127);
-        assert_eq!(encode_channel(7.0, ToneMap::Clamp), 255);
-        assert_eq!(encode_channel(-1.0, ToneMap::Clamp), 0);
-        assert_eq!(encode_channel(f32::NAN, ToneMap::Clamp), 0);
+        assert_eq!(encode_channel(0.5, ToneMap::Clamp { exposure: 0.0 }), 127);
+        assert_eq!(encode_channel(7.0, ToneMap::Clamp { exposure: 0.0 }), 255);
+        assert_eq!(encode_channel(-1.0, ToneMap::Clamp { exposure: 0.0 }), 0);
+        assert_eq!(encode_channel(f32::NAN, ToneMap::Clamp { exposure: 0.0 }), 0);
+        // One stop down halves the value before clamping.
+        assert_eq!(encode_channel(1.0, ToneMap::Clamp { exposure: -1.0 }), 127);
     }
 
     #[test]

@@ -11,34 +11,31 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// image, and each pixel costs 24 bytes once converted.
 const MAX_TEXTURE_PIXELS: u64 = 1 << 25;
 
-/// Loads a PNG or BMP texture (8 or 16 bits per channel; alpha ignored).
+/// Loads a texture: PNG, JPEG, BMP, PPM/PGM/PBM or TGA, recognised by content whatever the
+/// extension says (TGA, which has no signature, by its extension); 8 or 16 bits per channel,
+/// alpha ignored.
 pub fn load_texture(path: &Path) -> Result<Texture> {
-    let image_error = |e: image::ImageError| Error::Image {
+    let image_error = |message: String| Error::Image {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        message,
+    };
+    let reader = || -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>> {
+        image::ImageReader::open(path)
+            .and_then(|r| r.with_guessed_format())
+            .map_err(|e| image_error(e.to_string()))
     };
     // The header's size is checked before anything is decoded.
-    let (w, h) = image::ImageReader::open(path)
-        .map_err(|e| Error::Image {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?
-        .into_dimensions()
-        .map_err(image_error)?;
+    let (w, h) = reader()?.into_dimensions().map_err(|e| image_error(e.to_string()))?;
     if u64::from(w) * u64::from(h) > MAX_TEXTURE_PIXELS {
-        return Err(Error::Image {
-            path: path.to_path_buf(),
-            message: format!("the image is {w}×{h}, too large: at most {MAX_TEXTURE_PIXELS} pixels are accepted"),
-        });
+        return Err(image_error(format!(
+            "the image is {w}×{h}, too large: at most {MAX_TEXTURE_PIXELS} pixels are accepted"
+        )));
     }
-    let img = image::open(path).map_err(image_error)?;
+    let img = reader()?.decode().map_err(|e| image_error(e.to_string()))?;
     let rgb = img.to_rgb32f();
     let (w, h) = (rgb.width() as usize, rgb.height() as usize);
     let texels = rgb.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
-    Texture::new(w, h, texels).ok_or_else(|| Error::Image {
-        path: path.to_path_buf(),
-        message: "the image is empty".into(),
-    })
+    Texture::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()))
 }
 
 /// The formats caustica writes, chosen by the output file's extension.
@@ -108,6 +105,40 @@ pub fn read_exr(path: &Path) -> Result<(usize, usize, Vec<Vec3>)> {
     Ok((rgb.width() as usize, rgb.height() as usize, pixels))
 }
 
+/// Checks, before any work, that a file can be written at `path` as [`write_atomically`] will:
+/// its folder exists and takes a new file (one is created there and removed), and `path` is
+/// not a folder.
+pub fn check_writable(path: &Path) -> Result<()> {
+    let folder = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let refuse = |why: String| {
+        Err(Error::InvalidSettings(format!(
+            "cannot write `{}`: {why}",
+            path.display()
+        )))
+    };
+    if !folder.is_dir() {
+        return refuse(format!("the folder `{}` does not exist", folder.display()));
+    }
+    if path.is_dir() {
+        return refuse("it is a folder".into());
+    }
+    let probe = temporary_path(path);
+    match std::fs::OpenOptions::new().write(true).create_new(true).open(&probe) {
+        Ok(_) => {
+            let _ = std::fs::remove_file(&probe);
+            Ok(())
+        }
+        Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => Ok(()),
+        Err(e) => refuse(format!(
+            "the folder `{}` does not take new files ({e})",
+            folder.display()
+        )),
+    }
+}
+
 /// Runs `write` on a temporary path in the target's directory, then renames it over `path`.
 pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> std::result::Result<(), String>) -> Result<()> {
     let tmp = temporary_path(path);
@@ -148,6 +179,49 @@ fn temporary_path(path: &Path) -> PathBuf {
 mod tests {
     use super::*;
 
+    /// Each texture format the course corpora use reads back the texels written (JPEG within its
+    /// loss), also under an extension that names another format (but TGA).
+    #[test]
+    fn every_texture_format_reads_back() {
+        let dir = std::env::temp_dir().join(format!("caustica-tex-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        // Two flat halves (red, blue) that JPEG keeps nearly exact away from the edge.
+        let (w, h) = (32u32, 16u32);
+        let image = image::RgbImage::from_fn(w, h, |x, _| {
+            if x < w / 2 {
+                image::Rgb([200, 40, 20])
+            } else {
+                image::Rgb([10, 60, 230])
+            }
+        });
+        let formats = [
+            ("png", image::ImageFormat::Png, 0.0),
+            ("jpg", image::ImageFormat::Jpeg, 6.0 / 255.0),
+            ("bmp", image::ImageFormat::Bmp, 0.0),
+            ("ppm", image::ImageFormat::Pnm, 0.0),
+            ("tga", image::ImageFormat::Tga, 0.0),
+        ];
+        for (ext, format, tolerance) in formats {
+            // TGA has no signature: only its extension tells it.
+            let misnamed = (ext != "tga").then(|| format!("{ext}-named.bmp"));
+            for name in std::iter::once(format!("t.{ext}")).chain(misnamed) {
+                let path = dir.join(&name);
+                image.save_with_format(&path, format).unwrap();
+                let tex = load_texture(&path).unwrap_or_else(|e| panic!("{name}: {e}"));
+                assert_eq!((tex.width(), tex.height()), (w as usize, h as usize), "{name}");
+                for (x, want) in [(4, [200, 40, 20]), (27, [10, 60, 230])] {
+                    let got = tex.lookup(crate::math::Vec2::new((x as f32 + 0.5) / w as f32, 0.5));
+                    let want = Vec3::from_array(want.map(|c: u8| c as f32 / 255.0));
+                    assert!(
+                        (got - want).abs().max_element() <= tolerance + 1e-6,
+                        "{name}: {got} vs {want}"
+                    );
+                }
+            }
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
     #[test]
     fn png_and_exr_round_trip_and_leave_no_temporary_file() {
         let dir = std::env::temp_dir().join(format!("caustica-io-{}", std::process::id()));
@@ -169,6 +243,10 @@ mod tests {
         assert_eq!(leftovers, 0);
         assert!(ImageFormat::from_path(Path::new("x.jpg")).is_err());
         assert!(load_texture(&dir.join("missing.png")).is_err());
+        assert!(check_writable(&dir.join("b.png")).is_ok());
+        assert!(check_writable(&dir.join("no-such-folder/b.png")).is_err());
+        assert!(check_writable(&dir).is_err(), "a folder is not a file");
+        assert!(!dir.join("b.png").exists());
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

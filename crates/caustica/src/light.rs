@@ -26,7 +26,7 @@ pub use soft::SoftLight;
 
 use emission::{camera_targets, Aim, Emitter, Target};
 
-use crate::math::{luminance, offset_origin, Ray, Vec3};
+use crate::math::{luminance, Ray, Vec3};
 use crate::sampling::{power_heuristic, sample_uniform_cone, Rng};
 use crate::scene::{ObjectRef, Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -490,7 +490,6 @@ impl LightSet {
     ) -> Option<DirectSample> {
         let (u_pick, u) = (rng.uniform(), rng.uniform2());
         let p = hit.point;
-        let ng = hit.geometric_normal;
         let (wi, distance, value) = match &self.lights[index] {
             Light::Point { position, color, .. } => {
                 let to = *position - p;
@@ -527,7 +526,7 @@ impl LightSet {
             light @ Light::Sun { direction, cos_max, .. } => {
                 let wi = sample_uniform_cone(u, -*direction, *cos_max);
                 let pdf = p_pick * self.sun_pdf(light);
-                if !scene.unoccluded(p, ng, wi, f32::INFINITY) {
+                if !scene.unoccluded(hit, wi, f32::INFINITY) {
                     return None;
                 }
                 return Some(DirectSample {
@@ -538,7 +537,7 @@ impl LightSet {
             }
             Light::Environment(env) => {
                 let s = env.sample(u)?;
-                if !scene.unoccluded(p, ng, s.wi, f32::INFINITY) {
+                if !scene.unoccluded(hit, s.wi, f32::INFINITY) {
                     return None;
                 }
                 let pdf = p_pick * s.pdf;
@@ -548,7 +547,7 @@ impl LightSet {
                     pdf,
                 });
             }
-            Light::Area(light) => return sample_area_direct(scene, light, p, ng, p_pick, (u_pick, u), wl),
+            Light::Area(light) => return sample_area_direct(scene, light, hit, p_pick, (u_pick, u), wl),
             // Rays never hit this light, so its sample takes no MIS weight (pdf 0, as a point light).
             Light::Soft(light) => {
                 let (s, pdf) = light.sample_towards(p, u)?;
@@ -560,7 +559,7 @@ impl LightSet {
                 (to / d, d, s.radiance / pdf)
             }
         };
-        if !scene.unoccluded(p, ng, wi, distance) {
+        if !scene.unoccluded(hit, wi, distance) {
             return None;
         }
         Some(DirectSample {
@@ -646,12 +645,12 @@ impl LightSet {
 fn sample_area_direct(
     scene: &Scene,
     light: &AreaLight,
-    p: Vec3,
-    ng: Vec3,
+    hit: &SurfaceHit,
     p_pick: f32,
     (u_pick, u): (f32, glam::Vec2),
     wl: &Wavelengths,
 ) -> Option<DirectSample> {
+    let p = hit.point;
     let drawn = light.sample_towards(scene, p, u_pick, u)?;
     let sample = drawn.point;
     let to = sample.point - p;
@@ -662,7 +661,7 @@ fn sample_area_direct(
     let wi = to / d;
     // The closest hit towards the sampled point must be that point: this tests visibility
     // and reads the emitted radiance there (textures included).
-    let origin = offset_origin(p, ng, wi);
+    let origin = hit.ray_origin(wi);
     let ray = Ray::new(origin, wi);
     let isect = scene.intersect(&ray, f32::INFINITY)?;
     if isect.prim != sample.prim || (isect.t - (sample.point - origin).length()).abs() > 1e-3 * (1.0 + d) {

@@ -197,6 +197,11 @@ impl Material {
         physical.try_map(|c| Ok::<Vec3, ()>(c.eval(textures, uv))).ok()
     }
 
+    /// Whether a caustic can show on it: some `diffuse` or `specular` value may be non-zero.
+    pub fn may_receive(&self) -> bool {
+        self.diffuse.may_be_nonzero() || self.specular.may_be_nonzero()
+    }
+
     /// Whether any emissive value is non-zero.
     pub fn is_emissive(&self) -> bool {
         self.emissive.may_be_nonzero()

@@ -195,6 +195,16 @@ pub fn offset_origin(p: Vec3, ng: Vec3, dir: Vec3) -> Vec3 {
     offset_along(p, n)
 }
 
+/// [`offset_origin`] for a point whose coordinates may be off by up to `error` each: it moves at
+/// least far enough along the normal to leave that box of uncertainty (pbrt's `OffsetRayOrigin`).
+#[inline]
+pub fn offset_origin_bounded(p: Vec3, ng: Vec3, dir: Vec3, error: Vec3) -> Vec3 {
+    let n = if ng.dot(dir) >= 0.0 { ng } else { -ng };
+    let by_magnitude = 1e-4 * (1.0 + p.abs().max_element()) * 0.0625;
+    let by_error = 2.0 * n.abs().dot(error);
+    p + n * by_magnitude.max(by_error)
+}
+
 /// Moves `p` off its surface to the side the unit normal `n` points to, by the same
 /// magnitude-relative amount as [`offset_origin`].
 #[inline]

@@ -7,13 +7,15 @@
 //! for the physical model's fourth wavelength), the incoming direction in 32-bit octahedral
 //! form, the receiver's normal in 16-bit octahedral form, and path flags.
 
+pub mod budget;
 pub mod kd_tree;
+pub mod kernel;
 pub mod map;
 pub mod picture;
 pub mod trace;
 
-pub use map::{EstimateSettings, PhotonMap};
-pub use trace::{PhotonSettings, PhotonStats};
+pub use budget::{NoCaustics, PhotonSettings, PhotonStats};
+pub use map::{EstimateSettings, Estimator, PhotonMap};
 
 use crate::math::{Vec2, Vec3, Vec4};
 

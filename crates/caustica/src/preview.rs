@@ -475,7 +475,7 @@ mod tests {
         let path = dir.join("p.exr");
         let settings = PreviewSettings {
             display: None,
-            file: Some((path.clone(), ToneMap::Clamp)),
+            file: Some((path.clone(), ToneMap::Clamp { exposure: 0.0 })),
             name: "p".into(),
             display_every: Duration::from_secs(3600),
             file_every: Duration::from_millis(5),

@@ -140,6 +140,8 @@ pub struct Intersection {
     uv: Vec2,
     /// The leaf of a CSG solid hit (0 otherwise).
     part: u32,
+    /// Shapes: the point on the surface in object space.
+    local_point: Vec3,
 }
 
 /// Everything shading needs at a surface point.
@@ -149,6 +151,9 @@ pub struct SurfaceHit {
     pub t: f32,
     /// World position.
     pub point: Vec3,
+    /// A bound on the rounding error of each coordinate of `point` (zero where the magnitude of
+    /// `point` bounds it: triangles).
+    pub point_error: Vec3,
     /// Unit geometric normal as the shape defines it (outward for closed shapes, §7).
     pub geometric_normal: Vec3,
     /// Unit shading normal (interpolated for meshes), on the geometric normal's side.
@@ -161,6 +166,15 @@ pub struct SurfaceHit {
     pub object: ObjectRef,
     /// The primitive hit (shapes first, then triangles).
     pub prim: u32,
+}
+
+impl SurfaceHit {
+    /// Where a ray leaving the surface in direction `dir` starts: moved off the surface to the
+    /// side `dir` points to, past the rounding error of the point.
+    #[inline]
+    pub fn ray_origin(&self, dir: Vec3) -> Vec3 {
+        crate::math::offset_origin_bounded(self.point, self.geometric_normal, dir, self.point_error)
+    }
 }
 
 impl Scene {
@@ -343,8 +357,8 @@ impl Scene {
     /// Whether nothing blocks the segment from a surface point towards `wi` for `distance`.
     /// Every surface blocks, glass included (the physical model's light through glass arrives
     /// as caustics).
-    pub fn unoccluded(&self, point: Vec3, geometric_normal: Vec3, wi: Vec3, distance: f32) -> bool {
-        let origin = crate::math::offset_origin(point, geometric_normal, wi);
+    pub fn unoccluded(&self, hit: &SurfaceHit, wi: Vec3, distance: f32) -> bool {
+        let (point, origin) = (hit.point, hit.ray_origin(wi));
         let t_max = if distance.is_finite() {
             (distance - (origin - point).length()) * (1.0 - 1e-5)
         } else {
@@ -398,6 +412,7 @@ impl Scene {
             normal_or_bary: Vec3::new(h.u, h.v, 0.0),
             uv: Vec2::ZERO,
             part: 0,
+            local_point: Vec3::ZERO,
         }
     }
 
@@ -411,6 +426,7 @@ impl Scene {
             normal_or_bary: hit.normal,
             uv: hit.uv,
             part: hit.part,
+            local_point: hit.local_point,
         })
     }
 
@@ -494,17 +510,21 @@ impl Scene {
             normal_or_bary: next.normal,
             uv: next.uv,
             part: next.part,
+            local_point: next.local_point,
         })
     }
 
     /// Full shading data for an intersection found along `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Intersection) -> SurfaceHit {
-        let point = ray.at(hit.t);
         let n_shapes = self.shapes.len() as u32;
         if hit.prim < n_shapes {
+            // From the point put on the surface in object space: `ray.at(t)` would carry the
+            // error of `t`, which a non-uniform scale can turn into shadow acne.
+            let (point, point_error) = self.shapes[hit.prim as usize].world_point(hit.local_point);
             return SurfaceHit {
                 t: hit.t,
                 point,
+                point_error,
                 geometric_normal: hit.normal_or_bary,
                 shading_normal: hit.normal_or_bary,
                 uv: hit.uv,
@@ -547,7 +567,8 @@ impl Scene {
         };
         SurfaceHit {
             t: hit.t,
-            point,
+            point: ray.at(hit.t),
+            point_error: Vec3::ZERO,
             geometric_normal,
             shading_normal,
             uv,
@@ -632,18 +653,28 @@ impl Scene {
 
     /// Whether an object can reflect or refract specularly (anywhere on it).
     pub fn object_is_specular(&self, object: ObjectRef) -> bool {
+        self.any_material_of(object, Material::is_specular)
+    }
+
+    /// Whether a caustic can show on an object: it is diffuse or glossy somewhere.
+    pub fn object_receives(&self, object: ObjectRef) -> bool {
+        self.any_material_of(object, Material::may_receive)
+    }
+
+    /// Whether any material the object uses (a mesh's per-vertex ones included) passes `test`.
+    fn any_material_of(&self, object: ObjectRef, test: impl Fn(&Material) -> bool) -> bool {
         match object {
             ObjectRef::Mesh(i) => {
                 let mesh = &self.meshes[i as usize];
                 match &mesh.vertex_materials {
-                    Some(ids) => ids.iter().any(|&id| self.materials[id as usize].is_specular()),
-                    None => self.materials[mesh.material as usize].is_specular(),
+                    Some(ids) => ids.iter().any(|&id| test(&self.materials[id as usize])),
+                    None => test(&self.materials[mesh.material as usize]),
                 }
             }
             ObjectRef::Shape(i) => self
                 .shape_material_ids(i as usize)
                 .iter()
-                .any(|&id| self.materials[id as usize].is_specular()),
+                .any(|&id| test(&self.materials[id as usize])),
         }
     }
 }

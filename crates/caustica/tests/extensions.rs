@@ -14,7 +14,7 @@ use std::path::Path;
 
 /// The course model's value along `ray` (no caustics).
 fn shade(scene: &Scene, ray: &Ray) -> Vec3 {
-    let none = |_: &_, _: &_, _: Vec3, _: Vec3, _: u32| Vec3::ZERO;
+    let none = |_: &_, _: &_, _: Vec3, _: Vec3, _: u32, _: f32| Vec3::ZERO;
     whitted::radiance(scene, &WhittedSettings::default(), ray, &none)
 }
 

@@ -454,7 +454,11 @@ fn exercise(text: &str, dir: &Path) -> (bool, bool) {
             max_emitted: 5_000,
             ..PhotonSettings::default()
         };
-        let _ = PhotonMap::trace(&scene, &photons, 10, common::control());
+        let estimate = caustica::photon::EstimateSettings {
+            k: 10,
+            ..Default::default()
+        };
+        let _ = PhotonMap::trace(&scene, &photons, &estimate, common::control());
         // And one pass of the physical model: area lights, BSDF sampling, photon scattering.
         let ppm = Ppm::new(
             &scene,

@@ -57,8 +57,7 @@ pub fn run(args: BenchArgs) -> Result<u8> {
             }
         }
     }
-    println!("| scene | settings | photons (s) | render (s) | total (s) | stored | peak memory (MB) |");
-    println!("|---|---|---:|---:|---:|---:|---:|");
+    crate::stdout::print("| scene | settings | photons (s) | render (s) | total (s) | stored | peak memory (MB) |\n|---|---|---:|---:|---:|---:|---:|\n")?;
     for case in &cases {
         let mut best: Option<Summary> = None;
         for _ in 0..args.repeat.max(1) {
@@ -68,7 +67,7 @@ pub fn run(args: BenchArgs) -> Result<u8> {
             }
         }
         let Some(s) = best else { continue };
-        println!(
+        crate::stdout::println(&format!(
             "| {} | {} | {:.3} | {:.3} | {:.3} | {} | {:.0} |",
             case.name,
             case.args.join(" "),
@@ -77,7 +76,7 @@ pub fn run(args: BenchArgs) -> Result<u8> {
             s.total,
             s.stored,
             s.peak_memory as f64 / 1e6
-        );
+        ))?;
     }
     Ok(0)
 }

@@ -81,13 +81,14 @@ pub fn run(args: CompareArgs) -> Result<u8> {
                 })
             })
             .collect();
-        println!("{}", serde_json::Value::Array(items));
+        crate::stdout::println(&serde_json::Value::Array(items).to_string())?;
     } else {
-        println!("| region | mean R, G, B | reference R, G, B | largest relative error |");
-        println!("|---|---|---|---:|");
+        let mut table = String::from(
+            "| region | mean R, G, B | reference R, G, B | largest relative error |\n|---|---|---|---:|\n",
+        );
         for (r, g, w, e) in &rows {
-            println!(
-                "| {} | {:.4}, {:.4}, {:.4} | {:.4}, {:.4}, {:.4} | {:.2}% |",
+            table += &format!(
+                "| {} | {:.4}, {:.4}, {:.4} | {:.4}, {:.4}, {:.4} | {:.2}% |\n",
                 r.name,
                 g.x,
                 g.y,
@@ -98,6 +99,7 @@ pub fn run(args: CompareArgs) -> Result<u8> {
                 100.0 * e
             );
         }
+        crate::stdout::print(&table)?;
     }
     Ok(0)
 }

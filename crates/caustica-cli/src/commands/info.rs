@@ -20,10 +20,10 @@ pub fn run(args: InfoArgs) -> Result<u8> {
             },
         };
         let text = serde_json::to_string(&info).map_err(|e| Error::InvalidSettings(e.to_string()))?;
-        println!("{text}");
+        crate::stdout::println(&text)?;
         return Ok(0);
     }
-    print!("{}", text(&args.scene.display().to_string(), &summary));
+    crate::stdout::print(&text(&args.scene.display().to_string(), &summary))?;
     Ok(0)
 }
 

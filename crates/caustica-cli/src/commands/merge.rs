@@ -2,13 +2,16 @@
 
 use crate::cli::MergeArgs;
 use caustica::film::ToneMap;
-use caustica::image_io::ImageFormat;
+use caustica::image_io::{check_writable, ImageFormat};
 use caustica::integrator::partial::merge_files;
 use caustica::{Error, Result};
 
 /// Runs the command; returns the exit code.
 pub fn run(args: MergeArgs) -> Result<u8> {
     ImageFormat::from_path(&args.output)?;
+    for path in std::iter::once(&args.output).chain(&args.partial) {
+        check_writable(path)?;
+    }
     if !args.exposure.is_finite() || args.exposure.abs() > 64.0 {
         return Err(Error::InvalidSettings(
             "--exposure must be a number of stops between -64 and 64".into(),

@@ -9,7 +9,7 @@ use caustica::integrator::config::thread_pool;
 use caustica::integrator::image_size;
 use caustica::integrator::session::check_image_size;
 use caustica::photon::picture::{draw_photons, write_ply};
-use caustica::photon::PhotonMap;
+use caustica::photon::{EstimateSettings, Estimator, PhotonMap};
 use caustica::progress::Control;
 use caustica::Result;
 use serde_json::json;
@@ -20,6 +20,9 @@ use std::time::Instant;
 pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let start = Instant::now();
     caustica::image_io::ImageFormat::from_path(&args.output)?;
+    for path in std::iter::once(&args.output).chain(&args.ply) {
+        caustica::image_io::check_writable(path)?;
+    }
     let settings = photon_settings(&args.photon, args.seed)?;
     let pool = thread_pool(args.threads)?;
     let bars = Bars::new(args.quiet || args.json);
@@ -37,12 +40,18 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
         cancel,
     };
     let t_photons = Instant::now();
-    let map = pool.install(|| PhotonMap::trace(&scene, &settings, 1, control));
+    // Only the photons are drawn: the cheapest map will do.
+    let estimate = EstimateSettings {
+        estimator: Estimator::Nearest,
+        k: 1,
+        ..EstimateSettings::default()
+    };
+    let map = pool.install(|| PhotonMap::trace(&scene, &settings, &estimate, control));
     let photon_seconds = t_photons.elapsed().as_secs_f64();
     // Checked right after tracing: a Ctrl-C while writing does not make the map partial.
     let complete = !cancel.load(Ordering::Relaxed);
     let film = draw_photons(&scene, map.photons(), width, height);
-    film.save(&args.output, ToneMap::Clamp)?;
+    film.save(&args.output, ToneMap::Clamp { exposure: 0.0 })?;
     if let Some(ply) = &args.ply {
         write_ply(ply, map.photons())?;
     }
@@ -56,8 +65,10 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
             "height": height,
             "photons_stored": s.stored,
             "photons_emitted": s.emitted,
+            "photons_landed": s.landed,
             "useful_fraction": s.useful_fraction(),
             "cap_reached": s.cap_reached,
+            "none_reason": s.none.map(|r| r.name()),
             "complete": complete,
             "seconds": {
                 "parse": loaded.parse_seconds,
@@ -67,15 +78,18 @@ pub fn run(args: PhotonArgs, cancel: &'static AtomicBool) -> Result<u8> {
             },
             "peak_memory_bytes": super::peak_memory_bytes(),
         });
-        println!("{summary}");
+        crate::stdout::println(&summary.to_string())?;
     } else if !args.quiet {
+        if s.none.is_some() {
+            eprintln!("{}", super::photon_lines(s, photon_seconds).join("\n"));
+        }
         eprintln!(
-            "{}{}: {} photons stored of {} emitted ({:.1}% useful){} — parse {:.2} s, build {:.2} s, photons {photon_seconds:.2} s, total {total:.2} s{}",
+            "{}{}: {} photons stored of {} emitted ({}){} — parse {:.2} s, build {:.2} s, photons {photon_seconds:.2} s, total {total:.2} s{}",
             args.output.display(),
             args.ply.as_ref().map_or(String::new(), |p| format!(" and {}", p.display())),
             s.stored,
             s.emitted,
-            100.0 * s.useful_fraction(),
+            super::landed_text(s),
             if s.cap_reached { ", emission cap reached" } else { "" },
             loaded.parse_seconds,
             loaded.build_seconds,

@@ -8,11 +8,12 @@ use crate::progress::Bars;
 use caustica::description::RenderHints;
 use caustica::film::ToneMap;
 use caustica::format::Format;
-use caustica::image_io::ImageFormat;
+use caustica::image_io::{check_writable, ImageFormat};
 use caustica::integrator::config::thread_pool;
 use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
 use caustica::light::Light;
+use caustica::photon::Estimator;
 use caustica::preview::{tev, Preview, PreviewReport, PreviewSettings};
 use caustica::progress::Control;
 use caustica::scene::Scene;
@@ -59,6 +60,10 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         k: args.k,
         radius: args.radius.or(scene.radius),
         cone_filter: args.cone_filter,
+        estimator: match args.estimate.as_str() {
+            "nearest" => Estimator::Nearest,
+            _ => Estimator::Kernels,
+        },
         no_estimate_reuse: args.no_estimate_reuse,
         passes: p.passes.clone().or(if p.time.is_none() && !course {
             scene.passes
@@ -111,6 +116,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     if let Some(o) = &args.output {
         ImageFormat::from_path(o)?;
     }
+    // A folder that is missing or read-only fails now, not after the render.
+    for path in args.output.iter().chain(&options.partial) {
+        check_writable(path)?;
+    }
     let display = args.preview.display.as_deref().map(tev::parse_address).transpose()?;
     let pool = thread_pool(args.threads)?;
     let quiet = args.quiet || args.json;
@@ -129,6 +138,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         (None, None, Some(named)) if ImageFormat::from_path(named).is_ok() => Some(named.clone()),
         (None, None, _) => Some("caustica.png".into()),
     };
+    // The default or the scene's own name, checked before any photon is traced.
+    if let Some(o) = output.as_ref().filter(|_| args.output.is_none()) {
+        check_writable(o)?;
+    }
     check_preview(&args, &output)?;
     if !quiet {
         for warning in scene.warnings() {
@@ -161,12 +174,13 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     }
     let mut session = RenderSession::new(scene, config.render_options(loaded.scene_id.clone())?)?;
     let (width, height) = session.size();
-    let tone_map = if progressive {
-        ToneMap::Reinhard {
-            exposure: options.exposure,
-        }
-    } else {
-        ToneMap::Clamp
+    let exposure = options.exposure;
+    let tone_map = match options.tone_map.as_deref() {
+        Some("reinhard") => ToneMap::Reinhard { exposure },
+        Some("linear") => ToneMap::Linear { exposure },
+        Some(_) => ToneMap::Clamp { exposure },
+        None if progressive => ToneMap::Reinhard { exposure },
+        None => ToneMap::Clamp { exposure },
     };
     let preview = if display.is_some() || args.preview.preview {
         let name = [&output, &options.partial]
@@ -228,20 +242,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let photon_stats = session.caustic_map().map(|m| m.stats.clone());
     if !quiet {
         if let Some(s) = &photon_stats {
-            eprintln!(
-                "photons: {} emitted, {} stored ({:.1}% useful) in {:.2} s{}",
-                s.emitted,
-                s.stored,
-                100.0 * s.useful_fraction(),
-                summary.photon_seconds,
-                if s.cap_reached {
-                    " — emission cap reached before the budget was stored"
-                } else {
-                    ""
-                }
-            );
-            if s.stored == 0 {
-                eprintln!("photons: none stored (the scene has no mirror or glass that lights reach): no caustics");
+            for line in super::photon_lines(s, summary.photon_seconds) {
+                eprintln!("{line}");
             }
         }
     }
@@ -304,6 +306,10 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "samples_per_pixel": aa * aa,
                 "photons_stored": photon_stats.as_ref().map_or(0, |s| s.stored),
                 "photons_emitted": photon_stats.as_ref().map_or(0, |s| s.emitted),
+                "photons_landed": photon_stats.as_ref().map_or(0, |s| s.landed),
+                "photons_useful_fraction": photon_stats.as_ref().map_or(0.0, |s| s.useful_fraction()),
+                "photons_cap_reached": photon_stats.as_ref().is_some_and(|s| s.cap_reached),
+                "photons_none_reason": photon_stats.as_ref().and_then(|s| s.none).map(|r| r.name()),
                 "complete": complete,
                 "seconds": {
                     "parse": parse_seconds,
@@ -316,7 +322,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "preview": preview_json(&preview_report),
             })
         };
-        println!("{summary}");
+        crate::stdout::println(&summary.to_string())?;
     } else if !args.quiet {
         if progressive {
             let written: Vec<String> = [&output, &options.partial]

@@ -45,12 +45,15 @@ pub fn intersect(ray: &Ray, t_max: f32) -> Option<LocalHit> {
     if !(t > 0.0 && t < t_max) {
         return None;
     }
-    let p = ray.at(t);
+    let mut p = ray.at(t);
     let sign = if p[axis] >= 0.0 { 1.0 } else { -1.0 };
+    // Exactly on the face.
+    p[axis] = 0.5 * sign;
     let mut normal = Vec3::ZERO;
     normal[axis] = sign;
     Some(LocalHit {
         t,
+        point: p,
         normal,
         uv: face_uv(p, axis, sign),
     })

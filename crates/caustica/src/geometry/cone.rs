@@ -1,7 +1,7 @@
 //! The cone: a surface of revolution about +z from z = 0 (bottom radius) to z = height (top
 //! radius), with optional end discs. A cylinder is the cone with equal radii.
 
-use super::{solve_quadratic_half_b, LocalHit};
+use super::{quadratic_roots, LocalHit};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -107,16 +107,29 @@ impl Cone {
         best
     }
 
+    /// The side's quadratic x² + y² − (r0 + s z)² along the ray from `o`: (half b, c).
+    fn side_coefficients(&self, o: Vec3, d: Vec3) -> (f32, f32) {
+        let s = self.slope();
+        let r_o = self.bottom_radius + s * o.z;
+        (o.x * d.x + o.y * d.y - s * d.z * r_o, o.x * o.x + o.y * o.y - r_o * r_o)
+    }
+
     fn intersect_side(&self, ray: &Ray, t_max: f32, with_uv: bool) -> Option<LocalHit> {
         let (o, d) = (ray.origin, ray.dir);
         let s = self.slope();
         let r0 = self.bottom_radius;
-        // x² + y² = (r0 + s z)²
-        let r_o = r0 + s * o.z;
         let a = d.x * d.x + d.y * d.y - s * s * d.z * d.z;
-        let half_b = o.x * d.x + o.y * d.y - s * d.z * r_o;
-        let c = o.x * o.x + o.y * o.y - r_o * r_o;
-        let (t0, t1) = solve_quadratic_half_b(a, half_b, c)?;
+        let (half_b, c) = self.side_coefficients(o, d);
+        // The discriminant is the same from every point of the ray: taken from the point where
+        // the quadratic turns (b = 0 there), it keeps the precision a far origin loses.
+        let turn = -half_b / a;
+        let disc = if turn.is_finite() {
+            let (half_b_turn, c_turn) = self.side_coefficients(o + d * turn, d);
+            half_b_turn * half_b_turn - a * c_turn
+        } else {
+            half_b * half_b - a * c
+        };
+        let (t0, t1) = quadratic_roots(a, half_b, c, disc)?;
         for t in [t0, t1] {
             if !(t > 0.0 && t < t_max) {
                 continue;
@@ -126,19 +139,26 @@ impl Cone {
             if p.z < 0.0 || p.z > self.height || radius < 0.0 {
                 continue;
             }
+            // Onto the side: the radius at this height, the direction around the axis kept.
+            let rho = (p.x * p.x + p.y * p.y).sqrt();
+            let point = if rho > 0.0 {
+                Vec3::new(p.x * (radius / rho), p.y * (radius / rho), p.z)
+            } else {
+                p
+            };
             let z_scale = if self.doubled_normal_z { 2.0 } else { 1.0 };
-            let mut normal = Vec3::new(p.x, p.y, -z_scale * s * radius);
+            let mut normal = Vec3::new(point.x, point.y, -z_scale * s * radius);
             if !self.capped && normal.dot(d) > 0.0 {
                 normal = -normal;
             }
             let uv = if with_uv {
-                let phi = p.y.atan2(p.x);
+                let phi = point.y.atan2(point.x);
                 let u = if phi < 0.0 { phi + 2.0 * PI } else { phi } / (2.0 * PI);
-                Vec2::new(u, p.z / self.height)
+                Vec2::new(u, point.z / self.height)
             } else {
                 Vec2::ZERO
             };
-            return Some(LocalHit { t, normal, uv });
+            return Some(LocalHit { t, point, normal, uv });
         }
         None
     }
@@ -158,6 +178,7 @@ fn intersect_disc(ray: &Ray, z: f32, radius: f32, nz: f32, t_max: f32) -> Option
     }
     Some(LocalHit {
         t,
+        point: Vec3::new(p.x, p.y, z),
         normal: Vec3::new(0.0, 0.0, nz),
         uv: Vec2::new(0.5 + 0.5 * p.x / radius, 0.5 + 0.5 * p.y / radius),
     })

@@ -31,6 +31,8 @@ pub fn intersect(ray: &Ray, t_max: f32, inner: f32) -> Option<LocalHit> {
     let v = (1.0 - r2.sqrt()) / (1.0 - inner).max(1e-6);
     Some(LocalHit {
         t,
+        // On the plane exactly, as the square does.
+        point: Vec3::new(p.x, p.y, 0.0),
         normal,
         uv: Vec2::new(u, v),
     })

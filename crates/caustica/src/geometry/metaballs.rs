@@ -215,6 +215,7 @@ impl Metaballs {
         let &(t, grad) = found.first()?;
         Some(LocalHit {
             t,
+            point: ray.origin + ray.dir * t,
             // g grows inwards: the outward normal is against its gradient.
             normal: -grad,
             uv: Vec2::ZERO,

@@ -60,6 +60,8 @@ pub struct Shape {
 pub struct ShapeHit {
     /// Ray parameter.
     pub t: f32,
+    /// The hit point on the surface, in object space ([`Shape::world_point`] places it).
+    pub local_point: Vec3,
     /// Unit world normal, oriented as the shape defines it (§7).
     pub normal: Vec3,
     /// Texture coordinates; zero unless the shape [`needs_uv`](Shape::needs_uv).
@@ -146,6 +148,8 @@ impl Shape {
             let c = csg.intersect(ray, t_max)?;
             return Some(ShapeHit {
                 t: c.t,
+                // The leaves put their own hits on their surfaces; this one goes back to world as is.
+                local_point: self.object_from_world.transform_point3(ray.origin + ray.dir * c.t),
                 normal: c.normal,
                 uv: c.uv,
                 part: c.part,
@@ -171,12 +175,35 @@ impl Shape {
         }
         Some(ShapeHit {
             t: hit.t,
+            local_point: hit.point,
             normal,
             uv: if self.needs_uv { hit.uv } else { Vec2::ZERO },
             part: 0,
         })
     }
 }
+
+impl Shape {
+    /// The world position of a surface point given in object space, and a bound on the rounding
+    /// error of each of its coordinates (γ₅ (|M|·|p| + |T|), as in pbrt: the transform's three
+    /// products and sums, and the point's own rounding). A shape far from the origin, or large,
+    /// has a point error larger than its coordinates alone suggest.
+    #[inline]
+    pub fn world_point(&self, local: Vec3) -> (Vec3, Vec3) {
+        let m = &self.world_from_object;
+        let point = m.transform_point3(local);
+        let a = local.abs();
+        let magnitude = m.x_axis.truncate().abs() * a.x
+            + m.y_axis.truncate().abs() * a.y
+            + m.z_axis.truncate().abs() * a.z
+            + m.w_axis.truncate().abs();
+        (point, magnitude * GAMMA_5)
+    }
+}
+
+/// γ₅ = 5u / (1 − 5u) for the unit roundoff u of f32: the relative error bound of five rounded
+/// operations.
+const GAMMA_5: f32 = 5.0 * (f32::EPSILON * 0.5) / (1.0 - 5.0 * (f32::EPSILON * 0.5));
 
 /// An upper bound on the largest singular value of `m`: the square root of a Gershgorin bound on
 /// the largest eigenvalue of `mᵀm` (exact for rotations and axis scales), with a little margin.

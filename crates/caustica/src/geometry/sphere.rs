@@ -1,6 +1,6 @@
 //! The unit sphere at the origin.
 
-use super::{solve_quadratic_half_b, LocalHit};
+use super::{quadratic_roots, LocalHit};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -13,16 +13,24 @@ pub fn bounds() -> Aabb {
 /// coordinates (two inverse trigonometric calls) only `with_uv`, zero otherwise.
 pub fn intersect(ray: &Ray, t_max: f32, with_uv: bool) -> Option<LocalHit> {
     let (o, d) = (ray.origin, ray.dir);
-    let (t0, t1) = solve_quadratic_half_b(d.dot(d), o.dot(d), o.dot(o) - 1.0)?;
+    let (a, half_b) = (d.dot(d), o.dot(d));
+    // The discriminant from the ray's point nearest the centre, l: a (1 − |l|)(1 + |l|) loses
+    // nothing to |o|² (pbrt-v4; Haines et al., Ray Tracing Gems ch. 7).
+    let l = o - d * (half_b / a);
+    let l_len = l.length();
+    let disc = a * ((1.0 - l_len) * (1.0 + l_len));
+    let (t0, t1) = quadratic_roots(a, half_b, o.dot(o) - 1.0, disc)?;
     let t = if t0 > 0.0 { t0 } else { t1 };
     if !(t > 0.0 && t < t_max) {
         return None;
     }
     let p = ray.at(t);
+    let point = p / p.length();
     Some(LocalHit {
         t,
-        normal: p,
-        uv: if with_uv { uv(p) } else { Vec2::ZERO },
+        point,
+        normal: point,
+        uv: if with_uv { uv(point) } else { Vec2::ZERO },
     })
 }
 

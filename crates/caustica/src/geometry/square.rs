@@ -24,6 +24,7 @@ pub fn intersect(ray: &Ray, t_max: f32) -> Option<LocalHit> {
     let normal = if ray.dir.z > 0.0 { -Vec3::Z } else { Vec3::Z };
     Some(LocalHit {
         t,
+        point: Vec3::new(p.x, p.y, 0.0),
         normal,
         uv: Vec2::new(p.x + 0.5, p.y + 0.5),
     })

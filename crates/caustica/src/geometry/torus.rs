@@ -95,6 +95,8 @@ impl Torus {
         let (normal, uv) = self.normal_and_uv(p, needs_uv);
         Some(LocalHit {
             t: t as f32,
+            // From the f64 root: on the surface to f32 rounding.
+            point: p.as_vec3(),
             normal,
             uv,
         })

@@ -13,7 +13,7 @@ use super::whitted::WhittedSettings;
 use super::{Integrator, WhittedOptions};
 use crate::description::{IntegratorHint, RenderHints};
 use crate::error::{Error, Result};
-use crate::photon::{EstimateSettings, PhotonSettings};
+use crate::photon::{EstimateSettings, Estimator, PhotonSettings};
 use std::path::PathBuf;
 use std::str::FromStr;
 
@@ -116,6 +116,8 @@ pub struct RenderConfig {
     pub radius: Option<f32>,
     /// `--cone-filter` (0: off).
     pub cone_filter: f32,
+    /// `--estimate`: the course model's caustic estimate.
+    pub estimator: Estimator,
     /// `--no-estimate-reuse`.
     pub no_estimate_reuse: bool,
     /// `--passes`: N or A..B.
@@ -154,6 +156,7 @@ impl Default for RenderConfig {
             k: 100,
             radius: None,
             cone_filter: 1.1,
+            estimator: Estimator::Kernels,
             no_estimate_reuse: false,
             passes: None,
             time: None,
@@ -274,6 +277,7 @@ impl RenderConfig {
                     k: self.k,
                     max_radius: self.radius,
                     cone_filter: (self.cone_filter != 0.0).then_some(self.cone_filter),
+                    estimator: self.estimator,
                     ..EstimateSettings::default()
                 },
                 aa: self.aa,
@@ -368,6 +372,9 @@ impl RenderConfig {
         }
         if self.no_estimate_reuse {
             ignored.push("--no-estimate-reuse");
+        }
+        if self.estimator != Estimator::Kernels {
+            ignored.push("--estimate");
         }
         ignored
     }

@@ -38,7 +38,7 @@ fn probe(scene: &Scene) -> Option<(String, bool)> {
     let settings = WhittedSettings::default();
     let camera = scene.camera();
     let no_caustics =
-        |_: &crate::scene::SurfaceHit, _: &crate::material::SurfaceParams, _: Vec3, _: Vec3, _: u32| Vec3::ZERO;
+        |_: &crate::scene::SurfaceHit, _: &crate::material::SurfaceParams, _: Vec3, _: Vec3, _: u32, _: f32| Vec3::ZERO;
     let mut hits = Vec::new();
     for j in 0..GRID {
         for i in 0..GRID {

@@ -3,7 +3,7 @@
 //! (power heuristic) where the caller also counts the emitters and sky its BSDF samples reach.
 
 use crate::bsdf::{Bsdf, BsdfSample};
-use crate::math::{offset_origin, Ray, Vec3};
+use crate::math::{Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -57,7 +57,7 @@ pub fn bsdf_can_reach_light(scene: &Scene) -> bool {
 /// direct lighting by MIS (the caller multiplies by `sample.weight`).
 pub fn direct_by_bsdf(scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample, wl: &Wavelengths) -> Spectrum {
     let lights = scene.lights();
-    let ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+    let ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
     match scene.intersect(&ray, f32::INFINITY) {
         None => lights.escaped_weighted(sample.wi, Some(sample.pdf), wl),
         Some(isect) => {

@@ -22,7 +22,7 @@ use super::specular_chain::camera_chain;
 use super::tiles::sample_pass;
 use super::Progressive;
 use crate::bsdf::{Bsdf, Transport};
-use crate::math::{offset_origin, Ray, Vec3};
+use crate::math::{Ray, Vec3};
 use crate::photon::is_caustic;
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count;
@@ -147,7 +147,7 @@ impl<'a> Gi<'a> {
                     + maps.caustic.radiance_within(hit.point, bsdf, wo, r, dispersed)
             },
             |hit, sample, path_length, dispersed, rng| {
-                let origin = offset_origin(hit.point, hit.geometric_normal, sample.wi);
+                let origin = hit.ray_origin(sample.wi);
                 let gather = Gather {
                     from: Some((hit.point, sample.pdf)),
                     path_length,
@@ -209,7 +209,7 @@ impl<'a> Gi<'a> {
                 let mut l = direct_light(scene, &hit, &bsdf, wo, self.mis, wl, rng);
                 l += maps.caustic.radiance_within(hit.point, &bsdf, wo, r, dispersed);
                 if let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) {
-                    let next = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+                    let next = Ray::new(hit.ray_origin(sample.wi), sample.wi);
                     let mut weight = sample.weight;
                     let mut next_dispersed = dispersed;
                     if sample.dispersive {
@@ -232,7 +232,7 @@ impl<'a> Gi<'a> {
             if sample.dispersive {
                 wl.terminate_secondary(&mut beta, &mut dispersed);
             }
-            ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
         }
         emitted_first
     }

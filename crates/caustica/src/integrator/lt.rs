@@ -14,7 +14,7 @@ use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::Progressive;
 use crate::bsdf::{Bsdf, Transport};
 use crate::camera::Camera;
-use crate::math::{offset_origin, Ray, Vec3};
+use crate::math::{Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
@@ -198,7 +198,7 @@ impl<'a> LightTracer<'a> {
             if sample.dispersive {
                 wl.terminate_secondary(&mut power, &mut dispersed);
             }
-            ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
         }
     }
 
@@ -220,7 +220,7 @@ impl<'a> LightTracer<'a> {
             return None;
         }
         let cos = s.to_eye.dot(ng).abs() * wo.dot(ns).abs() / wo_ng;
-        if !self.scene.unoccluded(hit.point, ng, s.to_eye, s.distance) {
+        if !self.scene.unoccluded(hit, s.to_eye, s.distance) {
             return None;
         }
         let g = cos / (s.distance * s.distance);

@@ -6,7 +6,7 @@
 
 use super::direct::{direct_light, emitted, power_heuristic};
 use crate::bsdf::{Bsdf, Transport};
-use crate::math::{offset_origin, Ray, Vec3};
+use crate::math::{Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -95,7 +95,7 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengt
             }
             beta /= q;
         }
-        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+        ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
     }
     if l.is_finite() {
         l

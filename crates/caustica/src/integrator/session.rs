@@ -14,7 +14,7 @@ use super::whitted;
 use super::{image_size, ImageSettings, Integrator, Progressive};
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::photon::PhotonMap;
+use crate::photon::{PhotonMap, PhotonSettings};
 use crate::progress::Control;
 use crate::scene::Scene;
 use std::time::Instant;
@@ -218,12 +218,12 @@ impl<'a> RenderSession<'a> {
             return;
         }
         let start = Instant::now();
-        self.caustic_map = Some(PhotonMap::trace(
-            self.scene,
-            &options.photons,
-            options.estimate.k,
-            control,
-        ));
+        // Photons follow the camera rays' rule inside glass.
+        let photons = PhotonSettings {
+            internal_reflection: options.whitted.internal_reflection,
+            ..options.photons.clone()
+        };
+        self.caustic_map = Some(PhotonMap::trace(self.scene, &photons, &options.estimate, control));
         self.photon_seconds += start.elapsed().as_secs_f64();
     }
 

@@ -2,7 +2,7 @@
 //! and glass to the smooth surfaces where photons are gathered.
 
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
-use crate::math::{offset_origin, Ray, Vec3};
+use crate::math::{Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -70,7 +70,7 @@ where
         if sample.dispersive {
             wl.terminate_secondary(&mut beta, &mut terminated);
         }
-        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, sample.wi), sample.wi);
+        ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
     }
     l
 }

@@ -38,24 +38,35 @@ const MAX_CROSSINGS_PER_SHAPE: usize = 4;
 /// Recursion stops once a path's weight falls below this: it could not change an 8-bit pixel.
 const MIN_PATH_WEIGHT: f32 = 1.0 / 1024.0;
 
-/// Radiance along `ray` (unit direction). `caustic(hit, params, wo, n, depth)` adds light
-/// estimated from photons at a surface point, given its material values, the direction to the
-/// viewer, the normal facing it and the recursion depth (0 for the camera ray's own hit).
+/// Radiance along `ray` (unit direction). `caustic(hit, params, wo, n, depth, length)` adds
+/// light estimated from photons at a surface point, given its material values, the direction to
+/// the viewer, the normal facing it, the recursion depth (0 for the camera ray's own hit) and
+/// the length of the path from the camera.
 pub fn radiance<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, caustic: &C) -> Vec3
 where
-    C: Fn(&SurfaceHit, &SurfaceParams, Vec3, Vec3, u32) -> Vec3,
+    C: Fn(&SurfaceHit, &SurfaceParams, Vec3, Vec3, u32, f32) -> Vec3,
 {
-    trace(scene, settings, ray, 0, Vec3::ONE, caustic)
+    trace(scene, settings, ray, 0, 0.0, Vec3::ONE, caustic)
 }
 
-fn trace<C>(scene: &Scene, settings: &WhittedSettings, ray: &Ray, depth: u32, weight: Vec3, caustic: &C) -> Vec3
+#[allow(clippy::too_many_arguments)]
+fn trace<C>(
+    scene: &Scene,
+    settings: &WhittedSettings,
+    ray: &Ray,
+    depth: u32,
+    length: f32,
+    weight: Vec3,
+    caustic: &C,
+) -> Vec3
 where
-    C: Fn(&SurfaceHit, &SurfaceParams, Vec3, Vec3, u32) -> Vec3,
+    C: Fn(&SurfaceHit, &SurfaceParams, Vec3, Vec3, u32, f32) -> Vec3,
 {
     let Some(isect) = scene.intersect(ray, f32::INFINITY) else {
         return scene.lights().background(ray.dir);
     };
     let hit = scene.surface(ray, &isect);
+    let length = length + isect.t * ray.dir.length();
     let p = &scene.phong(&hit);
     let d = ray.dir;
     let wo = -d;
@@ -76,7 +87,11 @@ where
     };
     if local.diffuse != Vec3::ZERO || local.specular != Vec3::ZERO {
         color += direct_light(scene, &hit, &local, n, wo);
-        color += caustic(&hit, p, wo, n, depth);
+        // Inside glass the shadow rays (filtered by kt) already bring all the light the course
+        // model gives there; photons are not stored on that side either.
+        if !inside_transmissive {
+            color += caustic(&hit, p, wo, n, depth, length);
+        }
     }
 
     if depth >= settings.max_depth {
@@ -86,8 +101,8 @@ where
         let w = weight * p.reflective;
         if w.max_element() >= MIN_PATH_WEIGHT {
             let dir = reflect(d, n);
-            let origin = offset_origin(hit.point, hit.geometric_normal, dir);
-            color += p.reflective * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w, caustic);
+            let origin = hit.ray_origin(dir);
+            color += p.reflective * trace(scene, settings, &Ray::new(origin, dir), depth + 1, length, w, caustic);
         }
     }
     if p.transmissive != Vec3::ZERO {
@@ -101,9 +116,18 @@ where
                 let (eta, n_in) = refraction_geometry(index, entering, hit.shading_normal);
                 // Total internal reflection turns the transmitted ray back inside (as photons do).
                 let dir = refract(d, n_in, eta).unwrap_or_else(|| reflect(d, n_in));
-                let origin = offset_origin(hit.point, hit.geometric_normal, dir);
+                let origin = hit.ray_origin(dir);
                 let kt = p.transmissive * mask;
-                color += kt * trace(scene, settings, &Ray::new(origin, dir), depth + 1, w * mask, caustic);
+                color += kt
+                    * trace(
+                        scene,
+                        settings,
+                        &Ray::new(origin, dir),
+                        depth + 1,
+                        length,
+                        w * mask,
+                        caustic,
+                    );
             }
         }
     }
@@ -140,7 +164,7 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
             continue;
         }
         let shadow = match light.shadow_targets(hit.point) {
-            None => transmittance(scene, hit.point, hit.geometric_normal, ls.wi, ls.distance),
+            None => transmittance_from(scene, hit.ray_origin(ls.wi), hit.point, ls.wi, ls.distance),
             // A light with a size: the mean over shadow rays to points spread over it.
             Some(targets) => {
                 let (mut sum, mut n) = (Vec3::ZERO, 0.0f32);
@@ -148,7 +172,8 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
                     let to = q - hit.point;
                     let d = to.length();
                     if d > 0.0 {
-                        sum += transmittance(scene, hit.point, hit.geometric_normal, to / d, d);
+                        let wi = to / d;
+                        sum += transmittance_from(scene, hit.ray_origin(wi), hit.point, wi, d);
                     }
                     n += 1.0;
                 }
@@ -166,7 +191,11 @@ fn direct_light(scene: &Scene, hit: &SurfaceHit, params: &SurfaceParams, n: Vec3
 /// The product of the `transmissive` colours of everything between `point` and a light at
 /// `distance` along `wi` (zero when an opaque object is in the way).
 pub fn transmittance(scene: &Scene, point: Vec3, geometric_normal: Vec3, wi: Vec3, distance: f32) -> Vec3 {
-    let origin = offset_origin(point, geometric_normal, wi);
+    transmittance_from(scene, offset_origin(point, geometric_normal, wi), point, wi, distance)
+}
+
+/// [`transmittance`] along the shadow ray from `origin`, which is `point` moved off its surface.
+fn transmittance_from(scene: &Scene, origin: Vec3, point: Vec3, wi: Vec3, distance: f32) -> Vec3 {
     let ray = Ray::new(origin, wi);
     let t_max = if distance.is_finite() {
         (distance - (origin - point).length()) * (1.0 - 1e-5)
@@ -226,6 +255,8 @@ pub fn render(
 ) -> (crate::film::Film, bool) {
     let camera = scene.camera();
     let reuse = settings.reuse_caustic_estimates;
+    // A pixel's width at unit distance along a camera path.
+    let pixel_angle = super::radius::pixel_angle(camera, image.height);
     super::tiles::render_tiles(image, control, "render", |sx, sy, _rng, pixel: &mut PixelCaustic| {
         let ray = camera.generate_ray(sx, sy);
         let Some((map, estimate)) = caustics else {
@@ -233,7 +264,7 @@ pub fn render(
                 scene,
                 settings,
                 &ray,
-                &|_: &SurfaceHit, _: &SurfaceParams, _: Vec3, _: Vec3, _: u32| Vec3::ZERO,
+                &|_: &SurfaceHit, _: &SurfaceParams, _: Vec3, _: Vec3, _: u32, _: f32| Vec3::ZERO,
             );
         };
         let cache = std::cell::Cell::new(*pixel);
@@ -241,13 +272,14 @@ pub fn render(
             scene,
             settings,
             &ray,
-            &|hit: &SurfaceHit, p: &SurfaceParams, wo: Vec3, n: Vec3, depth: u32| {
+            &|hit: &SurfaceHit, p: &SurfaceParams, wo: Vec3, n: Vec3, depth: u32, length: f32| {
                 if p.diffuse == Vec3::ZERO && p.specular == Vec3::ZERO {
                     return Vec3::ZERO;
                 }
+                let pixel_width = pixel_angle * length;
                 let slot = depth as usize;
                 if !reuse || slot >= CACHED_DEPTHS || p.specular != Vec3::ZERO {
-                    return map.radiance(scene, hit, p, n, wo, estimate);
+                    return map.radiance(scene, hit, p, n, wo, estimate, pixel_width);
                 }
                 let mut entries = cache.get();
                 let mut nearby = None;
@@ -257,7 +289,7 @@ pub fn render(
                     }
                     nearby = (prim == hit.prim && r > 0.0).then_some(r);
                 }
-                let (flux, r) = map.irradiance_near(scene, hit, n, estimate, nearby);
+                let (flux, r) = map.irradiance_near(scene, hit, n, estimate, pixel_width, nearby);
                 if entries.entries[slot].is_none() {
                     entries.entries[slot] = Some((hit.prim, hit.point, r, flux));
                     cache.set(entries);

@@ -423,7 +423,7 @@ pub fn camera_targets(scene: &Scene) -> Vec<Target> {
                     break;
                 }
                 seen.insert(hit.object);
-                ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, ray.dir), ray.dir);
+                ray = Ray::new(hit.ray_origin(ray.dir), ray.dir);
             }
         }
     }

@@ -350,6 +350,19 @@ impl KdTree {
         max_dist2: f32,
         out: &mut Vec<Neighbor>,
     ) -> f32 {
+        self.k_nearest_where(items, p, k, max_dist2, |_| true, out)
+    }
+
+    /// [`KdTree::k_nearest_unordered`] among the items that pass `keep`.
+    pub fn k_nearest_where<T: KdPoint>(
+        &self,
+        items: &[T],
+        p: Vec3,
+        k: usize,
+        max_dist2: f32,
+        keep: impl Fn(&T) -> bool,
+        out: &mut Vec<Neighbor>,
+    ) -> f32 {
         out.clear();
         assert_eq!(items.len(), self.len(), "items are not the tree's slice");
         if k == 0 || p.is_nan() || max_dist2.is_nan() || max_dist2 < 0.0 {
@@ -365,6 +378,7 @@ impl KdTree {
             cap,
             bound: strict_bound(max_dist2),
             out,
+            keep,
         };
         search(self, q.p, &mut q);
         if out.len() > k {
@@ -397,7 +411,7 @@ impl KdTree {
 }
 
 /// State of one k-NN query. `bound` is strict: a candidate must have `dist2 < bound`.
-struct Knn<'a, T> {
+struct Knn<'a, T, K> {
     items: &'a [T],
     p: [f32; 3],
     k: usize,
@@ -405,6 +419,8 @@ struct Knn<'a, T> {
     cap: usize,
     bound: f32,
     out: &'a mut Vec<Neighbor>,
+    /// Which items may be neighbours at all.
+    keep: K,
 }
 
 /// A subtree waiting to be searched: `size` internal nodes from `node`, leftmost leaf `leaf`,
@@ -502,7 +518,7 @@ fn search(tree: &KdTree, p: [f32; 3], v: &mut impl Visitor) {
     }
 }
 
-impl<T: KdPoint> Visitor for Knn<'_, T> {
+impl<T: KdPoint, K: Fn(&T) -> bool> Visitor for Knn<'_, T, K> {
     #[inline(always)]
     fn bound(&self) -> f32 {
         self.bound
@@ -523,7 +539,7 @@ impl<T: KdPoint> Visitor for Knn<'_, T> {
                     slot: (start + i) as u32,
                     dist2: d2,
                 };
-                found += usize::from(d2 < self.bound);
+                found += usize::from(d2 < self.bound && (self.keep)(it));
             }
             if found > 0 {
                 self.extend(&buf[..found]);
@@ -532,7 +548,7 @@ impl<T: KdPoint> Visitor for Knn<'_, T> {
     }
 }
 
-impl<T: KdPoint> Knn<'_, T> {
+impl<T: KdPoint, K> Knn<'_, T, K> {
     /// Adds candidates. When their count first reaches `k` the bound drops to their maximum,
     /// and whenever it reaches `2k` a selection keeps the `k` nearest and tightens the bound:
     /// O(1) amortised per candidate, against O(log k) mispredicted sifts for a heap.
@@ -611,6 +627,157 @@ fn sift_down(h: &mut [Neighbor], mut i: usize) {
         i = c;
     }
     h[i] = x;
+}
+
+/// Each item's own radius, and per subtree the bounds of the balls those radii span around its
+/// items: what a query needs to find every item whose ball reaches a point (variable-kernel
+/// density estimates).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Reach {
+    radius: Vec<f32>,
+    inner: Vec<PointBounds>,
+    leaves: Vec<PointBounds>,
+}
+
+impl Reach {
+    /// The radius of item `slot` (in tree order).
+    #[inline]
+    pub fn radius(&self, slot: u32) -> f32 {
+        self.radius[slot as usize]
+    }
+
+    /// Heap bytes it owns.
+    pub fn heap_bytes(&self) -> usize {
+        self.radius.capacity() * 4
+            + (self.inner.capacity() + self.leaves.capacity()) * std::mem::size_of::<PointBounds>()
+    }
+}
+
+impl KdTree {
+    /// The reach of `radius` (one per item, in tree order) over this tree's subtrees.
+    pub fn reach<T: KdPoint>(&self, items: &[T], radius: Vec<f32>) -> Reach {
+        assert!(items.len() == self.len() && radius.len() == self.len());
+        let mut reach = Reach {
+            radius,
+            inner: vec![PointBounds::default(); self.nodes.len()],
+            leaves: vec![PointBounds::default(); self.leaves.len()],
+        };
+        let root = Subtree {
+            size: self.nodes.len() as u32,
+            len: self.len,
+            ..Subtree::default()
+        };
+        reach_rec(items, &mut reach, root);
+        reach
+    }
+
+    /// Calls `f(slot, dist2)` for every item whose ball (its radius in `reach`, or `floor` if
+    /// larger) holds `p` strictly inside, in tree order. A NaN query point finds nothing.
+    pub fn for_each_reaching<T: KdPoint>(
+        &self,
+        reach: &Reach,
+        items: &[T],
+        p: Vec3,
+        floor: f32,
+        mut f: impl FnMut(u32, f32),
+    ) {
+        assert!(items.len() == self.len() && reach.radius.len() == self.len());
+        if p.is_nan() || self.len == 0 {
+            return;
+        }
+        let q = p.to_array();
+        let floor2 = strict_bound(floor.max(0.0) * floor.max(0.0));
+        let mut stack = [Subtree::default(); SEARCH_STACK];
+        let mut sp = 1;
+        stack[0] = Subtree {
+            size: self.nodes.len() as u32,
+            len: self.len,
+            ..Subtree::default()
+        };
+        while sp > 0 {
+            sp -= 1;
+            let cur = stack[sp];
+            // A subtree matters if some ball around its items, or the floor's ball around `p`,
+            // reaches across.
+            let (balls, points) = if cur.size == 0 {
+                (&reach.leaves[cur.leaf as usize], &self.leaves[cur.leaf as usize])
+            } else {
+                (&reach.inner[cur.node as usize], &self.inner[cur.node as usize])
+            };
+            if balls.dist2(q) > 0.0 && points.dist2(q) >= floor2 {
+                continue;
+            }
+            if cur.size == 0 {
+                for slot in cur.lo..cur.lo + cur.len {
+                    let d2 = dist2(items[slot as usize].position().to_array(), q);
+                    let r = reach.radius[slot as usize];
+                    if d2 < r * r || d2 < floor2 {
+                        f(slot, d2);
+                    }
+                }
+                continue;
+            }
+            let (left, right) = children(cur);
+            stack[sp] = right;
+            stack[sp + 1] = left;
+            sp += 2;
+        }
+    }
+}
+
+/// The two children of an inner subtree, as [`search`] lays them out.
+#[inline]
+fn children(cur: Subtree) -> (Subtree, Subtree) {
+    let child = cur.size / 2;
+    let half = cur.len / 2;
+    let left = Subtree {
+        node: cur.node + 1,
+        size: child,
+        leaf: 2 * cur.leaf,
+        lo: cur.lo,
+        len: half,
+        ..cur
+    };
+    let right = Subtree {
+        node: cur.node + 1 + child,
+        size: child,
+        leaf: 2 * cur.leaf + 1,
+        lo: cur.lo + half,
+        len: cur.len - half,
+        ..cur
+    };
+    (left, right)
+}
+
+/// Fills the ball bounds of `cur` and below; returns those of `cur`.
+fn reach_rec<T: KdPoint>(items: &[T], reach: &mut Reach, cur: Subtree) -> PointBounds {
+    if cur.size == 0 {
+        let mut b = PointBounds::default();
+        let range = cur.lo as usize..(cur.lo + cur.len) as usize;
+        for (item, &radius) in items[range.clone()].iter().zip(&reach.radius[range]) {
+            let p = item.position().to_array();
+            // A little wider than the radius, so rounding never leaves out a ball that reaches.
+            let r = radius * (1.0 + 1e-5) + f32::MIN_POSITIVE;
+            if p.iter().any(|c| c.is_nan()) || r.is_nan() {
+                continue;
+            }
+            for ((lo, hi), c) in b.lo.iter_mut().zip(&mut b.hi).zip(p) {
+                *lo = lo.min(c - r);
+                *hi = hi.max(c + r);
+            }
+        }
+        reach.leaves[cur.leaf as usize] = b;
+        return b;
+    }
+    let (left, right) = children(cur);
+    let (l, r) = (reach_rec(items, reach, left), reach_rec(items, reach, right));
+    let mut b = l;
+    for a in 0..3 {
+        b.lo[a] = b.lo[a].min(r.lo[a]);
+        b.hi[a] = b.hi[a].max(r.hi[a]);
+    }
+    reach.inner[cur.node as usize] = b;
+    b
 }
 
 /// State of one fixed-radius query.

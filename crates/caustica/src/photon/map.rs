@@ -10,15 +10,18 @@
 //! lie off its tangent plane, do not count — light cannot bleed through a thin wall or round a
 //! corner.
 //!
-//! - The course model ([`PhotonMap::radiance`]): the k nearest photons within a largest radius,
-//!   an optional cone filter (eq. 7), the course's Phong reflectance, and photons that other
-//!   geometry hides from the point left out.
+//! - The course model ([`PhotonMap::radiance`]): by default each photon spread over its own
+//!   kernel, as wide as its distance to its k-th nearest photon ([`super::kernel`]); or the k
+//!   nearest photons within a largest radius ([`Estimator::Nearest`]); an optional cone filter
+//!   (eq. 7), the course's Phong reflectance, and photons that other geometry hides from the
+//!   point left out.
 //! - The physical model: the photons within a fixed radius (progressive photon mapping,
 //!   [`PhotonMap::radiance_within`]) or the k nearest (Jensen's global and caustic maps,
 //!   [`PhotonMap::radiance_nearest`]), with the BSDF the camera paths use.
 
-use super::kd_tree::{KdTree, Neighbor};
-use super::trace::{trace_photons, PhotonSettings, PhotonStats};
+use super::budget::{trace_photons, PhotonSettings, PhotonStats};
+use super::kd_tree::{KdTree, Neighbor, Reach};
+use super::kernel::{self, Gather};
 use super::{Photon, DISPERSED};
 use crate::bsdf::Bsdf;
 use crate::material::SurfaceParams;
@@ -29,13 +32,29 @@ use crate::spectrum::{Spectrum, SAMPLES};
 use std::cell::RefCell;
 use std::f32::consts::PI;
 
+/// The course model's two radiance estimates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Estimator {
+    /// Each photon spread over a kernel as wide as its distance to its k-th nearest photon on the
+    /// same surface ([`super::kernel`]): the default.
+    Kernels,
+    /// Jensen's: the k nearest photons around the point, within the largest radius.
+    Nearest,
+}
+
 /// How the radiance estimate gathers photons.
 #[derive(Clone, Debug, PartialEq)]
 pub struct EstimateSettings {
-    /// Photons per estimate (k nearest).
+    /// Which estimate.
+    pub estimator: Estimator,
+    /// Photons per estimate: the k nearest, or the neighbour that sets a kernel's width.
     pub k: usize,
-    /// Largest gather radius; `None` picks one from the photon density ([`PhotonMap::auto_radius`]).
+    /// Largest gather (or kernel) radius; `None` picks one from the photons
+    /// ([`PhotonMap::auto_radius`]).
     pub max_radius: Option<f32>,
+    /// Least kernel radius, in pixel widths where the camera path meets the surface (the
+    /// kernel estimate only).
+    pub min_pixels: f32,
     /// Cone filter constant (Jensen's k ≥ 1); `None` for a plain box (uniform) filter.
     pub cone_filter: Option<f32>,
     /// Least cosine between a photon's stored normal and the receiver's normal.
@@ -47,8 +66,10 @@ pub struct EstimateSettings {
 impl Default for EstimateSettings {
     fn default() -> Self {
         EstimateSettings {
+            estimator: Estimator::Kernels,
             k: 100,
             max_radius: None,
+            min_pixels: MIN_PIXELS,
             cone_filter: Some(1.1),
             min_normal_cosine: MIN_NORMAL_COSINE,
             max_plane_distance: MAX_PLANE_DISTANCE,
@@ -58,6 +79,12 @@ impl Default for EstimateSettings {
 
 /// Least cosine between a photon's stored normal and the receiver's normal.
 const MIN_NORMAL_COSINE: f32 = 0.7;
+/// Least kernel radius in pixel widths: a kernel one pixel across (a wider one cut the lens
+/// spot's peak by a quarter against a 5M-photon reference).
+const MIN_PIXELS: f32 = 0.5;
+/// The automatic largest kernel radius, as a fraction of the diagonal of the photons' bounds: wide
+/// enough for a few sparse photons to spread into a glow across a wall.
+const KERNEL_REACH: f32 = 1.0 / 8.0;
 /// Largest distance off the receiver's tangent plane, as a fraction of the gather radius.
 const MAX_PLANE_DISTANCE: f32 = 0.25;
 
@@ -66,6 +93,8 @@ pub struct PhotonMap {
     photons: Vec<Photon>,
     tree: KdTree,
     auto_radius: f32,
+    /// The photons' kernels, for the kernel estimate.
+    reach: Option<Reach>,
     /// What the photon pass did.
     pub stats: PhotonStats,
 }
@@ -79,10 +108,10 @@ thread_local! {
 }
 
 impl PhotonMap {
-    /// Traces photons through `scene` and builds the map.
-    pub fn trace(scene: &Scene, settings: &PhotonSettings, estimate_k: usize, control: Control) -> PhotonMap {
+    /// Traces photons through `scene` and builds the map for `estimate`.
+    pub fn trace(scene: &Scene, settings: &PhotonSettings, estimate: &EstimateSettings, control: Control) -> PhotonMap {
         let (photons, stats) = trace_photons(scene, settings, control);
-        PhotonMap::from_photons(photons, stats, estimate_k)
+        PhotonMap::from_photons(photons, stats, estimate)
     }
 
     /// Builds the map over `photons` (reordering them), without an automatic radius.
@@ -92,20 +121,40 @@ impl PhotonMap {
             photons,
             tree,
             auto_radius: 0.0,
+            reach: None,
             stats: PhotonStats::default(),
         }
     }
 
-    /// Builds the map over photons (reordering them); the automatic radius is chosen for `k`.
-    pub fn from_photons(mut photons: Vec<Photon>, stats: PhotonStats, k: usize) -> PhotonMap {
+    /// Builds the map over photons (reordering them) for `estimate`: the automatic radius for
+    /// its k and, for the kernel estimate, every photon's kernel.
+    pub fn from_photons(mut photons: Vec<Photon>, stats: PhotonStats, estimate: &EstimateSettings) -> PhotonMap {
         let tree = KdTree::build(&mut photons);
         let mut map = PhotonMap {
             photons,
             tree,
             auto_radius: 0.0,
+            reach: None,
             stats,
         };
-        map.auto_radius = map.density_radius(k);
+        let k = estimate.k.max(1);
+        match estimate.estimator {
+            Estimator::Nearest => map.auto_radius = map.density_radius(k),
+            Estimator::Kernels => {
+                let bounds = map
+                    .photons
+                    .iter()
+                    .fold(crate::math::Aabb::EMPTY, |b, p| b.with_point(p.position));
+                map.auto_radius = if bounds.is_empty() {
+                    0.0
+                } else {
+                    KERNEL_REACH * bounds.extent().length()
+                };
+                let max_radius = estimate.max_radius.unwrap_or(map.auto_radius);
+                let radii = kernel::kernel_radii(&map.tree, &map.photons, k, max_radius, estimate.min_normal_cosine);
+                map.reach = Some(map.tree.reach(&map.photons, radii));
+            }
+        }
         map
     }
 
@@ -119,9 +168,11 @@ impl PhotonMap {
         self.photons.len()
     }
 
-    /// Heap bytes the map owns: the photons and the tree.
+    /// Heap bytes the map owns: the photons, the tree and the kernels.
     pub fn heap_bytes(&self) -> usize {
-        self.photons.capacity() * std::mem::size_of::<Photon>() + self.tree.heap_bytes()
+        self.photons.capacity() * std::mem::size_of::<Photon>()
+            + self.tree.heap_bytes()
+            + self.reach.as_ref().map_or(0, Reach::heap_bytes)
     }
 
     /// Whether the map holds no photon.
@@ -129,10 +180,11 @@ impl PhotonMap {
         self.photons.is_empty()
     }
 
-    /// The automatic largest gather radius: twice the median distance to the k-th nearest
-    /// photon, measured around 256 photons spread through the map. Where photons are dense the
-    /// k nearest lie well inside it; where they are sparse it stops the gather from reaching
-    /// across the scene.
+    /// The automatic largest radius. For the k-nearest estimate, twice the median distance to
+    /// the k-th nearest photon, measured around 256 photons spread through the map: where photons
+    /// are dense the k nearest lie well inside it; where they are sparse it stops the gather from
+    /// reaching across the scene. For the kernel estimate, an eighth of the diagonal of the
+    /// photons' bounds.
     pub fn auto_radius(&self) -> f32 {
         self.auto_radius
     }
@@ -142,8 +194,11 @@ impl PhotonMap {
     }
 
     /// Reflected radiance at a surface point with material values `params` towards `wo` from
-    /// the photons nearby; `n` is the unit normal facing `wo`. Where other geometry comes within the gather radius, photons the
-    /// point cannot see in a straight line (behind a wall, across a ring's rim) are left out.
+    /// the photons nearby; `n` is the unit normal facing `wo`, and `pixel` the width of a pixel
+    /// where the camera path meets the point (0 when no camera looks). Where other geometry
+    /// comes within the gather radius, photons the point cannot see in a straight line (behind
+    /// a wall, across a ring's rim) are left out.
+    #[allow(clippy::too_many_arguments)]
     pub fn radiance(
         &self,
         scene: &Scene,
@@ -152,29 +207,42 @@ impl PhotonMap {
         n: Vec3,
         wo: Vec3,
         settings: &EstimateSettings,
+        pixel: f32,
     ) -> Vec3 {
-        self.gather(scene, hit, n, settings, None, |wi| params.phong_reflectance(n, wo, wi))
-            .0
+        self.gather(scene, hit, n, settings, pixel, None, |wi| {
+            params.phong_reflectance(n, wo, wi)
+        })
+        .0
     }
 
     /// Photon flux per area arriving at a surface point from the side `n` faces (the reflected
-    /// radiance of a white Lambertian receiver, kd = 1), and the gather radius used. Multiplied
-    /// by kd it equals [`PhotonMap::radiance`] on any receiver without a specular lobe.
-    pub fn irradiance(&self, scene: &Scene, hit: &SurfaceHit, n: Vec3, settings: &EstimateSettings) -> (Vec3, f32) {
-        self.irradiance_near(scene, hit, n, settings, None)
+    /// radiance of a white Lambertian receiver, kd = 1), and the gather radius used (the
+    /// narrowest kernel for the kernel estimate). Multiplied by kd it equals
+    /// [`PhotonMap::radiance`] on any receiver without a specular lobe.
+    pub fn irradiance(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        n: Vec3,
+        settings: &EstimateSettings,
+        pixel: f32,
+    ) -> (Vec3, f32) {
+        self.irradiance_near(scene, hit, n, settings, pixel, None)
     }
 
     /// [`PhotonMap::irradiance`] given the gather radius of an estimate made nearby, which
-    /// narrows the photon search; the result is the same (the search widens if it must).
+    /// narrows the k-nearest photon search; the result is the same (the search widens if it
+    /// must).
     pub fn irradiance_near(
         &self,
         scene: &Scene,
         hit: &SurfaceHit,
         n: Vec3,
         settings: &EstimateSettings,
+        pixel: f32,
         radius_nearby: Option<f32>,
     ) -> (Vec3, f32) {
-        self.gather(scene, hit, n, settings, radius_nearby, |wi| {
+        self.gather(scene, hit, n, settings, pixel, radius_nearby, |wi| {
             if n.dot(wi) > 0.0 {
                 Vec3::ONE
             } else {
@@ -183,17 +251,18 @@ impl PhotonMap {
         })
     }
 
-    /// Σ f(ωi) Φ w / (π r² norm) over the accepted photons near `hit`, and the radius r.
+    /// The estimate `settings` asks for at `hit`, and its radius.
+    #[allow(clippy::too_many_arguments)]
     fn gather(
         &self,
         scene: &Scene,
         hit: &SurfaceHit,
         n: Vec3,
         settings: &EstimateSettings,
+        pixel: f32,
         radius_nearby: Option<f32>,
         reflectance: impl Fn(Vec3) -> Vec3,
     ) -> (Vec3, f32) {
-        let point = hit.point;
         if self.photons.is_empty() || settings.k == 0 {
             return (Vec3::ZERO, 0.0);
         }
@@ -201,6 +270,48 @@ impl PhotonMap {
         if max_r.is_nan() || max_r <= 0.0 {
             return (Vec3::ZERO, 0.0);
         }
+        match (settings.estimator, &self.reach) {
+            (Estimator::Kernels, Some(reach)) => {
+                let gather = Gather {
+                    scene,
+                    hit,
+                    n,
+                    min_radius: settings.min_pixels * pixel,
+                    max_radius: max_r,
+                    cone_filter: settings.cone_filter,
+                    min_normal_cosine: settings.min_normal_cosine,
+                    max_plane_distance: settings.max_plane_distance,
+                };
+                NEIGHBORS.with(|cell| {
+                    kernel::estimate(
+                        &gather,
+                        &self.tree,
+                        reach,
+                        &self.photons,
+                        &mut cell.borrow_mut(),
+                        reflectance,
+                    )
+                })
+            }
+            (Estimator::Kernels, None) => panic!("the photon map was built without kernels"),
+            (Estimator::Nearest, _) => self.gather_nearest(scene, hit, n, settings, max_r, radius_nearby, reflectance),
+        }
+    }
+
+    /// Σ f(ωi) Φ w / (π r² norm) over the accepted photons among the k nearest to `hit`
+    /// within `max_r`, and the radius r.
+    #[allow(clippy::too_many_arguments)]
+    fn gather_nearest(
+        &self,
+        scene: &Scene,
+        hit: &SurfaceHit,
+        n: Vec3,
+        settings: &EstimateSettings,
+        max_r: f32,
+        radius_nearby: Option<f32>,
+        reflectance: impl Fn(Vec3) -> Vec3,
+    ) -> (Vec3, f32) {
+        let point = hit.point;
         NEIGHBORS.with(|cell| {
             let mut neighbors = cell.borrow_mut();
             let full = max_r * max_r;
@@ -276,7 +387,7 @@ impl PhotonMap {
             diffuse: Vec3::ONE,
             ..SurfaceParams::default()
         };
-        self.radiance(scene, &hit, &white, n, n, settings)
+        self.radiance(scene, &hit, &white, n, n, settings, 0.0)
     }
 
     /// Reflected radiance at `point` towards `wo` from the photons within radius `r` (physical

@@ -14,249 +14,24 @@
 //!   wherever they meet a smooth (diffuse or glossy) surface, their history in their flags;
 //!   Russian roulette keeps each photon's flux nearly constant.
 //!
-//! Two drivers emit: [`trace_photons`] stores a budget of caustic photons per light (course),
-//! [`trace_count`] emits a fixed number from lights chosen by power (physical). Both are
-//! deterministic whatever the thread count: photon `i` draws from its own random stream and
-//! batches are concatenated in order.
+//! Two drivers emit: [`super::budget::trace_photons`] stores a budget of caustic photons shared
+//! between the lights (course), [`trace_count`] emits a fixed number from lights chosen by power
+//! (physical). Both are deterministic whatever the thread count: photon `i` draws from its own
+//! random stream and batches are concatenated in order.
 
 use super::{Photon, DIFFUSE, DISPERSED, REFLECTED, REFRACTED};
 use crate::bsdf::{Bsdf, Transport};
-use crate::light::emission::{caustic_targets, Aim, Emitter, Target};
 use crate::light::{distance_attenuation, Light};
 use crate::material::{channel_indices, refraction_geometry};
-use crate::math::{offset_origin, reflect, refract, Ray, Vec3};
+use crate::math::{reflect, refract, Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 use rayon::prelude::*;
-use std::time::Instant;
 
-/// How photons are shot and stored.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PhotonSettings {
-    /// Photons to store (shared between lights by power unless `per_light` is set).
-    pub target_stored: usize,
-    /// Stop emitting after this many photons in all, stored or not.
-    pub max_emitted: u64,
-    /// Aim photons at the bounding spheres of reflective and transmissive objects.
-    pub aim: bool,
-    /// Seed of the photon streams.
-    pub seed: u64,
-    /// Longest specular chain followed.
-    pub max_bounces: u32,
-    /// Store every photon at its first surface instead (a map of direct light, for checks).
-    pub first_hit: bool,
-    /// Photons to store for each light, overriding the shared budget.
-    pub per_light: Option<Vec<usize>>,
-}
-
-impl Default for PhotonSettings {
-    fn default() -> Self {
-        PhotonSettings {
-            target_stored: 200_000,
-            max_emitted: 0,
-            aim: true,
-            seed: 0,
-            max_bounces: 32,
-            first_hit: false,
-            per_light: None,
-        }
-    }
-}
-
-impl PhotonSettings {
-    /// The emission cap in force: the set one, or 200 photons per photon to store.
-    pub fn emission_cap(&self) -> u64 {
-        if self.max_emitted > 0 {
-            self.max_emitted
-        } else {
-            (self.target_stored as u64).saturating_mul(200).max(1_000_000)
-        }
-    }
-}
-
-/// What the photon pass did, per light and in all.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct PhotonStats {
-    /// Photons emitted.
-    pub emitted: u64,
-    /// Photons stored.
-    pub stored: u64,
-    /// Whether some light stopped at the emission cap before storing its share.
-    pub cap_reached: bool,
-    /// Per light: (emitted, stored).
-    pub per_light: Vec<(u64, u64)>,
-    /// Wall-clock seconds of the pass.
-    pub seconds: f64,
-}
-
-impl PhotonStats {
-    /// Stored photons per emitted photon.
-    pub fn useful_fraction(&self) -> f64 {
-        if self.emitted == 0 {
-            0.0
-        } else {
-            self.stored as f64 / self.emitted as f64
-        }
-    }
-}
-
-const BATCH: u64 = 4096;
-
-/// Traces caustic photons from every course light until the budget is stored or the cap is
-/// reached.
-pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control) -> (Vec<Photon>, PhotonStats) {
-    let start = Instant::now();
-    let targets = caustic_targets(scene);
-    let aim = settings.aim && !settings.first_hit;
-    let bounds = scene.bounds();
-    let lights: Vec<&Light> = scene.lights().course_lights().collect();
-    let emitters: Vec<Option<Emitter>> = lights
-        .iter()
-        .map(|light| {
-            if !settings.first_hit && targets.is_empty() {
-                return None;
-            }
-            Emitter::new(
-                light,
-                aim.then_some(Aim {
-                    targets: &targets,
-                    spread: 0.0,
-                }),
-                Target::around(&bounds),
-            )
-        })
-        .collect();
-    let total_power: f32 = emitters.iter().flatten().map(Emitter::power).sum();
-    let shares: Vec<usize> = match &settings.per_light {
-        Some(counts) => (0..lights.len()).map(|i| counts.get(i).copied().unwrap_or(0)).collect(),
-        None => emitters
-            .iter()
-            .map(|e| match e {
-                Some(e) if total_power > 0.0 => {
-                    ((settings.target_stored as f64) * (e.power() / total_power) as f64).round() as usize
-                }
-                _ => 0,
-            })
-            .collect(),
-    };
-    let total_share: usize = shares.iter().sum::<usize>().max(1);
-    let cap = settings.emission_cap();
-    control.progress.start("photons", shares.iter().sum::<usize>() as u64);
-    let mut photons = Vec::new();
-    let mut stats = PhotonStats::default();
-    for (index, (emitter, &share)) in emitters.iter().zip(&shares).enumerate() {
-        let Some(emitter) = emitter else {
-            stats.per_light.push((0, 0));
-            continue;
-        };
-        let light_cap = ((cap as f64) * share as f64 / total_share as f64).ceil().max(1.0) as u64;
-        let model = CourseModel {
-            light: lights[index],
-            first_hit: settings.first_hit,
-        };
-        let run = trace_light(scene, &model, emitter, index, share, light_cap, settings, control);
-        stats.emitted += run.emitted;
-        stats.stored += run.photons.len() as u64;
-        stats.cap_reached |= run.cap_reached;
-        stats.per_light.push((run.emitted, run.photons.len() as u64));
-        photons.extend(run.photons);
-    }
-    control.progress.finish();
-    stats.seconds = start.elapsed().as_secs_f64();
-    (photons, stats)
-}
-
-struct LightRun {
-    photons: Vec<Photon>,
-    emitted: u64,
-    cap_reached: bool,
-}
-
-/// Emits from one light in deterministic batches; the result is the shortest prefix of emitted
-/// photons (by index) that stores `share` photons, so it does not depend on the thread count.
-#[allow(clippy::too_many_arguments)]
-fn trace_light(
-    scene: &Scene,
-    model: &CourseModel,
-    emitter: &Emitter,
-    light_index: usize,
-    share: usize,
-    cap: u64,
-    settings: &PhotonSettings,
-    control: Control,
-) -> LightRun {
-    let mut photons: Vec<Photon> = Vec::new();
-    let mut emitted = 0u64;
-    let stream = (light_index as u64) << 40;
-    let mut reported = 0u64;
-    while photons.len() < share && emitted < cap && !control.cancelled() {
-        // Size the round from the yield so far: enough to finish, never absurdly many batches.
-        let yield_so_far = if emitted > 0 {
-            photons.len() as f64 / emitted as f64
-        } else {
-            0.0
-        };
-        let needed = if yield_so_far > 0.0 {
-            ((share - photons.len()) as f64 / yield_so_far * 1.1) as u64
-        } else {
-            BATCH * 8
-        };
-        let batches = needed
-            .div_ceil(BATCH)
-            .clamp(1, 256)
-            .min((cap - emitted).div_ceil(BATCH));
-        let results: Vec<(Vec<Photon>, Vec<u32>)> = (0..batches)
-            .into_par_iter()
-            .map(|b| {
-                let first = emitted + b * BATCH;
-                let count = BATCH.min(cap - first.min(cap));
-                trace_batch(first..first + count, |i, out| {
-                    let mut rng = Rng::new(settings.seed, stream | i);
-                    if let Some(photon) = emitter.sample(model.light, scene, &Wavelengths::Rgb, &mut rng) {
-                        trace_path(
-                            scene,
-                            model,
-                            photon.ray,
-                            photon.flux,
-                            settings.max_bounces,
-                            &mut rng,
-                            out,
-                        );
-                    }
-                })
-            })
-            .collect();
-        for (batch, ends) in results {
-            let needed = share - photons.len();
-            if batch.len() >= needed {
-                let last = ends
-                    .iter()
-                    .position(|&e| e as usize >= needed)
-                    .unwrap_or(ends.len() - 1);
-                photons.extend_from_slice(&batch[..ends[last] as usize]);
-                emitted += last as u64 + 1;
-                break;
-            }
-            photons.extend_from_slice(&batch);
-            emitted += ends.len() as u64;
-        }
-        let done = photons.len().min(share) as u64;
-        control.progress.advance(done - reported);
-        reported = done;
-    }
-    let scale = if emitted > 0 { 1.0 / emitted as f32 } else { 0.0 };
-    photons.par_iter_mut().for_each(|p| {
-        let power = p.power() * scale;
-        p.set_power(power);
-    });
-    LightRun {
-        cap_reached: photons.len() < share && emitted >= cap,
-        photons,
-        emitted,
-    }
-}
+/// Photons traced by one parallel task.
+pub(crate) const BATCH: u64 = 4096;
 
 /// Emits `count` photons from lights chosen by power, under the physical model at the
 /// wavelengths `wl`, from stream `stream` of `seed`, and returns those stored, their flux
@@ -297,7 +72,7 @@ pub fn trace_count(
 
 /// Runs `photon(i, out)` for each photon index of a batch; returns what they stored and, for
 /// each photon, the number stored up to and including it.
-fn trace_batch(
+pub(crate) fn trace_batch(
     indices: std::ops::Range<u64>,
     mut photon: impl FnMut(u64, &mut Vec<Photon>),
 ) -> (Vec<Photon>, Vec<u32>) {
@@ -360,7 +135,7 @@ pub fn trace_path<M: PhotonModel>(
         let Some(dir) = model.interact(scene, &hit, &ray, &mut photon, rng, out) else {
             return;
         };
-        ray = Ray::new(offset_origin(hit.point, hit.geometric_normal, dir), dir);
+        ray = Ray::new(hit.ray_origin(dir), dir);
     }
 }
 
@@ -370,6 +145,9 @@ pub struct CourseModel<'a> {
     pub light: &'a Light,
     /// Store every photon at its first surface instead (a map of direct light, for checks).
     pub first_hit: bool,
+    /// Reflect by `reflective` inside glass too, not only by total internal reflection (as the
+    /// Whitted renderer's setting of the same name).
+    pub internal_reflection: bool,
 }
 
 impl PhotonModel for CourseModel<'_> {
@@ -390,7 +168,10 @@ impl PhotonModel for CourseModel<'_> {
         } else {
             hit.shading_normal
         };
-        let receives = p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO;
+        // Inside glass the light is what the course's shadow rays already bring through it
+        // (filtered by kt): a photon stored there would count it twice.
+        let inside_transmissive = !entering && p.transmissive != Vec3::ZERO;
+        let receives = (p.diffuse != Vec3::ZERO || p.specular != Vec3::ZERO) && !inside_transmissive;
         if receives && (photon.flags != 0 || self.first_hit) {
             let stored = photon.power.truncate() * falloff_scale(self.light, photon.length);
             out.push(Photon::new(hit.point, stored, d, facing, photon.flags));
@@ -398,7 +179,14 @@ impl PhotonModel for CourseModel<'_> {
         if self.first_hit {
             return None;
         }
-        let pr = p.reflective.max_element().max(0.0);
+        // Inside glass photons reflect as the camera's rays do: only by total internal
+        // reflection, unless internal reflection is asked for (so no chain inside can gain power).
+        let reflects = self.internal_reflection || !inside_transmissive;
+        let pr = if reflects {
+            p.reflective.max_element().max(0.0)
+        } else {
+            0.0
+        };
         let pt = p.transmissive.max_element().max(0.0);
         let norm = (pr + pt).max(1.0);
         let (pr, pt) = (pr / norm, pt / norm);

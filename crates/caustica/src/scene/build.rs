@@ -487,7 +487,7 @@ impl Builder {
                         format!("cannot read the texture `{}`: {reason}", path.display()),
                         span.clone(),
                     )
-                    .with_help("texture paths are resolved against the scene file's folder; PNG and BMP are supported")
+                    .with_help("texture paths are resolved against the scene file's folder; PNG, JPEG, BMP, PPM and TGA are read")
                 })?;
                 let id = self.textures.len() as u32;
                 self.textures.push(texture);
