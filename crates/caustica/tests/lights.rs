@@ -141,3 +141,34 @@ fn spot_light_lights_its_cone() {
     let step = spot_solid_angle(cos(20.0), cos(30.0), 0.0);
     assert!(step > inner && step < outer && rel(step, 0.5 * (inner + outer)) < 0.01);
 }
+
+/// A sun of small angular size casts the caustic of a glass ball that a directional light of
+/// the same irradiance casts (its photons aimed at the ball in view, the directional light's
+/// spread over the scene); a wide sun (8°) blurs the focus.
+#[test]
+fn a_sun_caustic_tends_to_the_directional_light_limit() {
+    let caustic = |light: &str| {
+        let s = scene(&format!(
+            "SBT-raytracer 1.0
+camera {{ position = (0, 6, 0.001); viewdir = (0, -1, 0); updir = (0, 0, -1); fov = 30; }}
+{light}
+translate(0, 1.5, 0, sphere {{ material = {{ transmissive = (1, 1, 1); index = 1.5; }} }})
+rotate(1, 0, 0, -1.5707963, scale(20, square {{ material = {{ diffuse = (0.8, 0.8, 0.8); }} }}))"
+        ));
+        let image = render(&s, "ppm", 64, 16, 100_000);
+        // The ball (radius 1, n 1.5) focuses 1.5 below its centre: on the floor. The camera
+        // looks straight down through it: the whole view, and the focus at its centre.
+        (region(&image, (0, 63), (0, 63)), region(&image, (31, 32), (31, 32)))
+    };
+    let (directional, directional_focus) = caustic("directional_light { direction = (0, -1, 0); color = (1, 1, 1); }");
+    let (sun, _) = caustic("sun_light { direction = (0, -1, 0); color = (1, 1, 1); angle = 0.53; }");
+    let (_, wide_focus) = caustic("sun_light { direction = (0, -1, 0); color = (1, 1, 1); angle = 8; }");
+    assert!(
+        (sun - directional).abs().max_element() < 0.01 * directional.max_element(),
+        "sun {sun} vs directional {directional}"
+    );
+    assert!(
+        wide_focus.x < 0.9 * directional_focus.x,
+        "{wide_focus} {directional_focus}"
+    );
+}
