@@ -91,6 +91,20 @@ pub enum Light {
     Soft(SoftLight),
 }
 
+/// The course reading of light from `position` at `p`: its colour under the course falloff.
+fn from_point(p: Vec3, position: Vec3, color: Vec3, attenuation: [f32; 3]) -> Option<LightSample> {
+    let to_light = position - p;
+    let distance = to_light.length();
+    if distance == 0.0 || !distance.is_finite() {
+        return None;
+    }
+    Some(LightSample {
+        wi: to_light / distance,
+        distance,
+        intensity: color * distance_attenuation(attenuation, distance),
+    })
+}
+
 /// What a light sends to a point under the course model: the unit direction towards the light,
 /// the distance to it (infinite for a directional light) and the incident colour before shadowing.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -112,18 +126,7 @@ impl Light {
                 position,
                 color,
                 attenuation,
-            } => {
-                let to_light = position - p;
-                let distance = to_light.length();
-                if distance == 0.0 || !distance.is_finite() {
-                    return None;
-                }
-                Some(LightSample {
-                    wi: to_light / distance,
-                    distance,
-                    intensity: color * distance_attenuation(attenuation, distance),
-                })
-            }
+            } => from_point(p, position, color, attenuation),
             Light::Spot {
                 position,
                 direction,
@@ -151,18 +154,7 @@ impl Light {
                 distance: f32::INFINITY,
                 intensity: color,
             }),
-            Light::Soft(ref soft) => {
-                let to_light = soft.center() - p;
-                let distance = to_light.length();
-                if distance == 0.0 || !distance.is_finite() {
-                    return None;
-                }
-                Some(LightSample {
-                    wi: to_light / distance,
-                    distance,
-                    intensity: soft.color * distance_attenuation(soft.attenuation, distance),
-                })
-            }
+            Light::Soft(ref soft) => from_point(p, soft.center(), soft.color, soft.attenuation),
             Light::Environment(_) | Light::Area(_) => None,
         }
     }
