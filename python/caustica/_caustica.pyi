@@ -19,7 +19,7 @@ class RenderOptions(TypedDict, total=False):
     """The options of `caustica render`, `-` written `_`; the defaults are the command line's."""
 
     model: Literal["course", "physical"] | None
-    integrator: Literal["whitted", "path", "ppm", "gi", "lt"] | None
+    integrator: Literal["whitted", "path", "ppm", "gi", "lt", "vcm"] | None
     width: int
     height: int | None
     aa: int
@@ -41,6 +41,7 @@ class RenderOptions(TypedDict, total=False):
     footprint: float
     alpha: float
     no_camera_specular: bool
+    vertex_connections: bool
     spectral: bool | None
     no_spectral: bool
     cone_quirks: bool
@@ -130,7 +131,7 @@ class Progressive:
         """(width, height) of the image."""
     @property
     def integrator(self) -> str:
-        """whitted, path, ppm, gi or lt."""
+        """whitted, path, ppm, gi, lt or vcm."""
     @property
     def fingerprint(self) -> str:
         """What must agree for two runs' sums to merge."""

@@ -37,6 +37,7 @@ pub const RENDER: &[&str] = &[
     "footprint",
     "alpha",
     "no_camera_specular",
+    "vertex_connections",
     "spectral",
     "no_spectral",
     "cone_quirks",
@@ -128,7 +129,10 @@ pub fn parse(
             "depth" => c.depth = v.optional(Value::whole)?,
             "threads" => options.threads = v.optional(Value::whole)?,
             "seed" => c.seed = v.whole()?,
-            "photons" => c.photons = v.whole()?,
+            "photons" => {
+                c.photons = v.whole()?;
+                c.light_paths = Some(c.photons as u64);
+            }
             "max_emitted" => c.max_emitted = v.optional(Value::whole)?,
             "photons_per_light" => c.photons_per_light = v.optional(Value::counts)?,
             "no_aim" => c.no_aim = v.flag()?,
@@ -154,6 +158,7 @@ pub fn parse(
             "footprint" => c.footprint = v.number()? as f32,
             "alpha" => c.alpha = v.number()? as f32,
             "no_camera_specular" => c.no_camera_specular = v.flag()?,
+            "vertex_connections" => c.vertex_connections = v.flag()?,
             "spectral" => spectral = v.optional(Value::flag)?,
             "no_spectral" => no_spectral = v.flag()?,
             "save_every" => options.save_every = v.number()?,

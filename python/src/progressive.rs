@@ -231,7 +231,7 @@ impl Progressive {
         (self.width, self.height)
     }
 
-    /// The integrator's name: whitted, path, ppm, gi or lt.
+    /// The integrator's name: whitted, path, ppm, gi, lt or vcm.
     #[getter]
     fn integrator(&self) -> &'static str {
         self.integrator

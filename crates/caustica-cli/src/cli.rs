@@ -248,10 +248,11 @@ pub struct ProgressiveOptions {
     /// for .ray and .obj, physical for .pbrt and glTF].
     #[arg(long, value_parser = ["course", "physical"])]
     pub model: Option<String>,
-    /// Integrator: whitted (course model), or path, ppm, gi, lt (physical model; ppm by default
-    /// there, or what a pbrt-v4 scene names). lt is light tracing: mirrors, glass and lights seen
-    /// by the camera are black.
-    #[arg(long, value_parser = ["whitted", "path", "ppm", "gi", "lt"])]
+    /// Integrator: whitted (course model), or path, ppm, gi, lt, vcm (physical model; ppm by
+    /// default there, or what a pbrt-v4 scene names). lt is light tracing: mirrors, glass and
+    /// lights seen by the camera are black. vcm is vertex connection and merging: all of them,
+    /// weighted against each other.
+    #[arg(long, value_parser = ["whitted", "path", "ppm", "gi", "lt", "vcm"])]
     pub integrator: Option<String>,
     /// Passes to render: N (passes 0..N) or A..B (passes A to B−1 of a run split across
     /// machines) [default: 64 unless --time is given, or a pbrt-v4 scene's pixelsamples].
@@ -291,6 +292,11 @@ pub struct ProgressiveOptions {
     /// ppm: Knaus–Zwicker α in (0, 1); the radius² shrinks by (i + α)/(i + 1) each pass.
     #[arg(long, default_value_t = 2.0 / 3.0)]
     pub alpha: f32,
+    /// vcm: also connect every camera vertex to every vertex of one light subpath
+    /// (bidirectional path tracing's inner connections); off by default: on the Cornell box
+    /// race they cost more than they gain.
+    #[arg(long)]
+    pub vertex_connections: bool,
 }
 
 #[derive(Args, Debug)]

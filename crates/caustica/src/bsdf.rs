@@ -354,6 +354,17 @@ impl Bsdf {
         pdf
     }
 
+    /// Solid-angle pdf with which the smooth lobes would draw `wo` had the path arrived from
+    /// `wi`: the reverse density bidirectional methods weight with. The lobes are reciprocal
+    /// and chosen with fixed probabilities, so reflection swaps the arguments; transmission
+    /// is Lambertian either way.
+    pub fn pdf_reverse(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.ng.dot(wi) < 0.0 {
+            return self.pick[5] * self.frame.z.dot(wo).abs() / PI;
+        }
+        self.pdf(wi, wo)
+    }
+
     /// Draws a direction: `u_lobe` picks the lobe (and Fresnel's choice), `u` the direction.
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: glam::Vec2, mode: Transport) -> Option<BsdfSample> {
         let n = self.frame.z;

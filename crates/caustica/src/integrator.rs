@@ -4,9 +4,9 @@
 //!
 //! - [`whitted`]: the course model: the course's Whitted ray tracer plus caustics from a photon
 //!   map, rendered in one go.
-//! - [`path`], [`ppm`], [`gi`], [`lt`]: the physical model, rendered in independent passes that
-//!   converge: a path tracer, progressive photon mapping, Jensen's photon mapping with final
-//!   gathering, light tracing.
+//! - [`path`], [`ppm`], [`gi`], [`lt`], [`vcm`]: the physical model, rendered in independent
+//!   passes that converge: a path tracer, progressive photon mapping, Jensen's photon mapping
+//!   with final gathering, light tracing, vertex connection and merging.
 
 pub mod config;
 pub mod darkness;
@@ -20,6 +20,7 @@ pub mod radius;
 pub mod session;
 pub mod specular_chain;
 pub mod tiles;
+pub mod vcm;
 pub mod whitted;
 
 pub use config::RenderConfig;
@@ -35,6 +36,7 @@ use lt::LtSettings;
 use path::PathSettings;
 use ppm::PpmSettings;
 use radius::InitialRadius;
+use vcm::VcmSettings;
 use whitted::WhittedSettings;
 
 /// An integrator and its settings.
@@ -50,6 +52,8 @@ pub enum Integrator {
     Gi(GiSettings),
     /// Light tracing: photons splatted onto the film through the pinhole.
     Lt(LtSettings),
+    /// Vertex connection and merging: every strategy above, weighted against each other.
+    Vcm(VcmSettings),
 }
 
 /// Everything the course model's render uses.
@@ -88,6 +92,7 @@ impl Integrator {
             Integrator::Ppm(_) => "ppm",
             Integrator::Gi(_) => "gi",
             Integrator::Lt(_) => "lt",
+            Integrator::Vcm(_) => "vcm",
         }
     }
 
@@ -134,6 +139,15 @@ impl Integrator {
             Integrator::Lt(s) => {
                 check_depth(s.max_depth)?;
                 check_photons_per_pass(self.name(), s.photons_per_pass)
+            }
+            Integrator::Vcm(s) => {
+                check_depth(s.max_depth)?;
+                check_alpha(s.alpha)?;
+                check_radius(s.initial_radius)?;
+                match s.light_paths_per_pass {
+                    Some(n) => check_photons_per_pass(self.name(), n),
+                    None => Ok(()),
+                }
             }
         }
     }

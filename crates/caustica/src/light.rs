@@ -420,6 +420,12 @@ impl LightSet {
         (self.scene_center, self.scene_radius)
     }
 
+    /// The light next-event estimation takes by power when it does not sample every light,
+    /// with its probability.
+    pub(crate) fn pick_for_direct(&self, u: f32) -> Option<(usize, f32)> {
+        self.pick(u)
+    }
+
     fn pick(&self, u: f32) -> Option<(usize, f32)> {
         let i = self
             .cdf
@@ -437,7 +443,7 @@ impl LightSet {
     }
 
     /// The probability that next-event estimation takes light `index` at a point.
-    fn direct_probability(&self, index: usize) -> f32 {
+    pub(crate) fn direct_probability(&self, index: usize) -> f32 {
         match self.probabilities[index] {
             p if p > 0.0 && self.samples_every_light() => 1.0,
             p => p,
@@ -471,7 +477,7 @@ impl LightSet {
     }
 
     /// Samples light `index`, taken with probability `p_pick`, for the point `hit`.
-    fn sample_light(
+    pub(crate) fn sample_light(
         &self,
         index: usize,
         p_pick: f32,
@@ -622,14 +628,22 @@ impl LightSet {
     /// emissive point `hit` (its light's), for weighting BSDF samples that hit it; 0 when the
     /// object hit is not a light.
     pub fn pdf_direct(&self, from: Vec3, hit: &SurfaceHit) -> f32 {
+        let Some((number, light)) = self.area_light_of(hit) else {
+            return 0.0;
+        };
+        self.direct_probability(number) * light.pdf_towards(from, hit.point, hit.geometric_normal)
+    }
+
+    /// The emissive object hit at `hit` and its light number, if it emits.
+    pub fn area_light_of(&self, hit: &SurfaceHit) -> Option<(usize, &AreaLight)> {
         let number = match hit.object {
             ObjectRef::Shape(s) => self.shape_light[s as usize],
             ObjectRef::Mesh(m) => self.mesh_light[m as usize],
-        };
-        let Some(Light::Area(light)) = self.lights.get(number as usize) else {
-            return 0.0;
-        };
-        self.direct_probability(number as usize) * light.pdf_towards(from, hit.point, hit.geometric_normal)
+        } as usize;
+        match self.lights.get(number) {
+            Some(Light::Area(light)) => Some((number, light)),
+            _ => None,
+        }
     }
 }
 

@@ -54,6 +54,7 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         depth,
         seed: args.seed,
         photons: args.photon.photons.unwrap_or(scene.photons),
+        light_paths: args.photon.photons.map(|p| p as u64),
         max_emitted: args.photon.max_emitted,
         photons_per_light: args.photon.photons_per_light.clone(),
         no_aim: args.photon.no_aim,
@@ -74,6 +75,7 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         footprint: p.footprint,
         alpha: p.alpha,
         no_camera_specular: p.no_camera_specular,
+        vertex_connections: p.vertex_connections,
         spectral: match (p.spectral, p.no_spectral) {
             (true, _) => Some(true),
             (_, true) => Some(false),
@@ -271,6 +273,9 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         Integrator::Ppm(s) => s.photons_per_pass,
         Integrator::Gi(s) => s.photons_per_pass,
         Integrator::Lt(s) => s.photons_per_pass,
+        Integrator::Vcm(s) => s
+            .light_paths_per_pass
+            .unwrap_or_else(|| caustica::integrator::vcm::default_light_paths(width, height)),
         _ => 0,
     };
     if args.json {

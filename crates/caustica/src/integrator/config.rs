@@ -9,6 +9,7 @@ use super::path::PathSettings;
 use super::ppm::PpmSettings;
 use super::radius::InitialRadius;
 use super::session::{PassPlan, RenderOptions};
+use super::vcm::VcmSettings;
 use super::whitted::WhittedSettings;
 use super::{Integrator, WhittedOptions};
 use crate::description::{IntegratorHint, RenderHints};
@@ -53,6 +54,8 @@ pub enum IntegratorKind {
     Gi,
     /// Light tracing.
     Lt,
+    /// Vertex connection and merging.
+    Vcm,
 }
 
 impl IntegratorKind {
@@ -64,6 +67,7 @@ impl IntegratorKind {
             IntegratorKind::Ppm => "ppm",
             IntegratorKind::Gi => "gi",
             IntegratorKind::Lt => "lt",
+            IntegratorKind::Vcm => "vcm",
         }
     }
 }
@@ -78,8 +82,9 @@ impl FromStr for IntegratorKind {
             "ppm" => Ok(IntegratorKind::Ppm),
             "gi" => Ok(IntegratorKind::Gi),
             "lt" => Ok(IntegratorKind::Lt),
+            "vcm" => Ok(IntegratorKind::Vcm),
             other => Err(Error::InvalidSettings(format!(
-                "unknown integrator `{other}`: expected whitted, path, ppm, gi or lt"
+                "unknown integrator `{other}`: expected whitted, path, ppm, gi, lt or vcm"
             ))),
         }
     }
@@ -104,6 +109,9 @@ pub struct RenderConfig {
     pub seed: u64,
     /// `--photons`: caustic photons to store (course), photons emitted per pass (physical).
     pub photons: usize,
+    /// `--photons` as given (not the scene's or the default): vcm's light subpaths per pass
+    /// (eight per pixel when unset).
+    pub light_paths: Option<u64>,
     /// `--max-emitted`.
     pub max_emitted: Option<u64>,
     /// `--photons-per-light`.
@@ -130,6 +138,8 @@ pub struct RenderConfig {
     pub alpha: f32,
     /// `--no-camera-specular`.
     pub no_camera_specular: bool,
+    /// `--vertex-connections` (vcm).
+    pub vertex_connections: bool,
     /// `--spectral` / `--no-spectral` (physical model): light at sampled wavelengths or in RGB;
     /// by default spectral exactly when the scene has a dispersive glass.
     pub spectral: Option<bool>,
@@ -150,6 +160,7 @@ impl Default for RenderConfig {
             depth: None,
             seed: 0,
             photons: 200_000,
+            light_paths: None,
             max_emitted: None,
             photons_per_light: None,
             no_aim: false,
@@ -163,6 +174,7 @@ impl Default for RenderConfig {
             footprint: 2.0,
             alpha: 2.0 / 3.0,
             no_camera_specular: false,
+            vertex_connections: false,
             spectral: None,
             max_memory: 4096,
             partial: None,
@@ -217,7 +229,8 @@ impl RenderConfig {
                 )))
             }
             (Some(Model::Physical), Some(IntegratorKind::Whitted)) => Err(Error::InvalidSettings(
-                "the whitted integrator renders the course model; with --model physical use path, ppm, gi or lt".into(),
+                "the whitted integrator renders the course model; with --model physical use path, ppm, gi, lt or vcm"
+                    .into(),
             )),
             (Some(Model::Physical), None) => Ok(IntegratorKind::Ppm),
             (_, Some(kind)) => Ok(kind),
@@ -248,8 +261,8 @@ impl RenderConfig {
     /// The integrator with its settings (checked).
     pub fn integrator(&self) -> Result<Integrator> {
         let kind = self.integrator_kind()?;
-        // path and lt store no photons.
-        if !matches!(kind, IntegratorKind::Path | IntegratorKind::Lt) {
+        // path, lt and vcm store no photon map.
+        if !matches!(kind, IntegratorKind::Path | IntegratorKind::Lt | IntegratorKind::Vcm) {
             check_photon_memory(self.photon_total(), self.max_memory)?;
         }
         let progressive = kind != IntegratorKind::Whitted;
@@ -308,6 +321,17 @@ impl RenderConfig {
             IntegratorKind::Lt => Integrator::Lt(LtSettings {
                 photons_per_pass,
                 max_depth: depth,
+                spectral: self.spectral,
+            }),
+            IntegratorKind::Vcm => Integrator::Vcm(VcmSettings {
+                light_paths_per_pass: self.light_paths,
+                alpha: self.alpha,
+                initial_radius: match self.radius {
+                    Some(r) => InitialRadius::World(r),
+                    None => InitialRadius::Pixels(self.footprint),
+                },
+                max_depth: depth,
+                connections: self.vertex_connections,
                 spectral: self.spectral,
             }),
         };

@@ -96,6 +96,17 @@ impl Sensor {
         }
     }
 
+    /// The importance We of a unit direction leaving the eye (0 behind the image plane): also
+    /// the solid-angle density of that direction among one sample per pixel.
+    pub fn importance(&self, dir: Vec3) -> f32 {
+        let cos = dir.dot(self.normal);
+        if cos <= 0.0 {
+            0.0
+        } else {
+            self.scale / (cos * cos * cos)
+        }
+    }
+
     /// Where `p` lands on the film of `camera` (`None`: outside the view or behind the eye).
     ///
     /// A pixel's value is the mean radiance over its square of screen coordinates (sx, sy),

@@ -10,6 +10,7 @@ use super::lt::LightTracer;
 use super::partial::Accumulator;
 use super::path::PathTracer;
 use super::ppm::Ppm;
+use super::vcm::Vcm;
 use super::whitted;
 use super::{image_size, ImageSettings, Integrator, Progressive};
 use crate::error::{Error, Result};
@@ -167,6 +168,7 @@ impl<'a> RenderSession<'a> {
             Integrator::Ppm(s) => Some(Box::new(Ppm::new(scene, s.clone(), width, height, seed))),
             Integrator::Gi(s) => Some(Box::new(Gi::new(scene, s.clone(), width, height, seed))),
             Integrator::Lt(s) => Some(Box::new(LightTracer::new(scene, s.clone(), width, height, seed))),
+            Integrator::Vcm(s) => Some(Box::new(Vcm::new(scene, s.clone(), width, height, seed))),
         };
         let fingerprint = format!(
             "scene {} size {width}x{height} seed {seed} {:?}",

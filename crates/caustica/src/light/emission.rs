@@ -491,13 +491,7 @@ fn emit_from_area(
     wl: &Wavelengths,
 ) -> Option<EmittedPhoton> {
     let sample = light.sample(scene, u_pick, u)?;
-    let le = match (light.uniform, wl.is_spectral()) {
-        (true, false) => light.radiance.extend(0.0),
-        (true, true) => scene
-            .material_spectra(scene.object_material(light.object))
-            .emission(light.radiance, wl),
-        (false, _) => wl.unbounded(emission_at(scene, &sample)),
-    };
+    let le = area_radiance(light, scene, &sample, wl);
     // A face at random (the outer one of a closed lamp that absorbs its own inward light), then
     // a cosine-weighted direction: pdf ½·cos/π, or cos/π.
     let (side, u2, faces) = if light.outward_only {
@@ -567,6 +561,18 @@ fn emit_from_soft(
         ray: Ray::new(s.point, dir),
         flux: wl.unbounded(s.radiance) * (cos * light.area() / pdf),
     })
+}
+
+/// The radiance an emissive object sends from its sampled point `sample`, at the wavelengths
+/// `wl`.
+pub(crate) fn area_radiance(light: &AreaLight, scene: &Scene, sample: &AreaSample, wl: &Wavelengths) -> Spectrum {
+    match (light.uniform, wl.is_spectral()) {
+        (true, false) => light.radiance.extend(0.0),
+        (true, true) => scene
+            .material_spectra(scene.object_material(light.object))
+            .emission(light.radiance, wl),
+        (false, _) => wl.unbounded(emission_at(scene, sample)),
+    }
 }
 
 /// The emitted radiance at a sampled light point, read from its material by a short ray.

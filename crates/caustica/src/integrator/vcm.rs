@@ -1,0 +1,715 @@
+//! Vertex connection and merging (Georgiev et al., "Light transport simulation with vertex
+//! connection and merging", 2012; Hachisuka et al.'s unified path sampling, 2012): every pass
+//! traces light subpaths and one camera subpath per pixel, and joins them in every way a path
+//! can be made — the camera path hitting an emitter, next-event estimation, light tracing
+//! (a light vertex joined to the eye), connections between the two subpaths' vertices, and
+//! merging (a camera vertex gathering the light vertices within a radius that shrinks pass by
+//! pass, as in progressive photon mapping) — each weighted against all the others by multiple
+//! importance sampling ([`mis`]).
+//!
+//! Departures from the textbook, each leaving a strategy out for a class of paths where it is
+//! the worst estimator (the weights of those paths still sum to one, see [`mis`]):
+//! - merging happens only at the first smooth surface the camera path meets (as in
+//!   progressive photon mapping): deeper, a merge stands on one sampled bounce of the camera
+//!   path and is as noisy as path tracing, yet the balance heuristic would weigh it like the
+//!   first;
+//! - where the eye sees a caustic directly (the surface before the one the camera ray meets is
+//!   a mirror or glass), merging is left out there too, so light tracing keeps the caustic's
+//!   sharp focus instead of sharing it with a blurring kernel;
+//! - direct light (light tracing and merging at the surface light reaches first) is left to
+//!   next-event estimation (noiseless for a point light) and to emitters that camera paths hit.
+//!
+//! Merging still smooths indirect light and the caustics seen by a mirror or through glass.
+//! Determinism: light subpaths are traced in fixed batches and added in index order.
+
+pub mod emitters;
+pub mod grid;
+pub mod mis;
+
+use super::lt::Sensor;
+use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
+use super::radius::{radius_factor, InitialRadius};
+use super::tiles::shade_tiles;
+use super::Progressive;
+use crate::bsdf::{Bsdf, Transport};
+use crate::math::{Ray, Vec3};
+use crate::progress::Control;
+use crate::sampling::{power_heuristic, Rng};
+use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, Wavelengths, SAMPLES};
+use emitters::Emitters;
+use grid::HashGrid;
+use mis::{ConnectionPdfs, DirectPdfs, Factors, Partial};
+use rayon::prelude::*;
+
+/// Settings of vertex connection and merging.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VcmSettings {
+    /// Light subpaths per pass (`None`: [`LIGHT_PATHS_PER_PIXEL`] per pixel, at most
+    /// [`MAX_DEFAULT_LIGHT_PATHS`]).
+    pub light_paths_per_pass: Option<u64>,
+    /// Knaus & Zwicker's α in (0, 1): how fast the merging radius shrinks.
+    pub alpha: f32,
+    /// The first pass's merging radius: a number of pixels as wide as they are at the distance
+    /// from the eye to the scene's centre, or a world radius.
+    pub initial_radius: InitialRadius,
+    /// Bounces: light reaches the eye from at most this many surfaces plus one.
+    pub max_depth: u32,
+    /// Connect every smooth camera vertex to every vertex of one light subpath (bidirectional
+    /// path tracing's inner connections). Off, the strategies are the camera path's own (hitting
+    /// emitters, next-event estimation), light tracing and merging, and camera paths cost far
+    /// less; on the Cornell box race that wins (BENCHMARKS.md).
+    pub connections: bool,
+    /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
+    /// dispersive glass).
+    pub spectral: Option<bool>,
+}
+
+impl Default for VcmSettings {
+    fn default() -> Self {
+        VcmSettings {
+            light_paths_per_pass: None,
+            alpha: 0.75,
+            initial_radius: InitialRadius::Pixels(1.0),
+            max_depth: 64,
+            connections: false,
+            spectral: None,
+        }
+    }
+}
+
+/// Light subpaths per pixel and pass by default: light tracing carries the caustics, so it gets
+/// most of the time (measured on the Cornell box race, BENCHMARKS.md).
+pub const LIGHT_PATHS_PER_PIXEL: u64 = 8;
+/// The default's cap, so that a large image's pass stays within memory (about 100 bytes per
+/// stored light vertex, one or two per path).
+pub const MAX_DEFAULT_LIGHT_PATHS: u64 = 4_000_000;
+
+/// Light subpaths per batch: the unit of parallel work and of the fixed order of addition.
+const BATCH: u64 = 1024;
+/// Seed offset of the light subpaths (apart from the photon mappers' streams).
+const LIGHT_SEED: u64 = PHOTON_SEED ^ 0x0076_636d;
+/// Camera bounces before Russian roulette may end a camera path.
+const ROULETTE_DEPTH: u32 = 3;
+
+/// A vertex of a light subpath on a smooth surface.
+#[derive(Clone, Copy, Debug)]
+struct LightVertex {
+    hit: SurfaceHit,
+    /// Unit direction back towards the previous vertex.
+    wo: Vec3,
+    /// Light arriving here over the density of the subpath so far (flux of one light path).
+    throughput: Spectrum,
+    partial: Partial,
+    /// Segments from the light.
+    length: u32,
+    /// The subpath kept only its hero wavelength.
+    dispersed: bool,
+    /// The surface before it has only delta lobes (a mirror or glass): a caustic vertex.
+    after_specular: bool,
+}
+
+/// What merging reads of a light vertex: a fraction of a [`LightVertex`], so that a pass's
+/// hundreds of thousands of them stay small.
+#[derive(Clone, Copy, Debug)]
+struct MergeVertex {
+    wo: Vec3,
+    normal: Vec3,
+    throughput: Spectrum,
+    partial: Partial,
+    length: u32,
+    dispersed: bool,
+    after_specular: bool,
+}
+
+/// The light subpaths of one pass (or of one batch of it).
+#[derive(Default)]
+struct LightPaths {
+    /// The vertices of the subpaths camera paths connect to (the first one per pixel): path
+    /// `i`'s are `vertices[ends[i]..ends[i + 1]]`.
+    vertices: Vec<LightVertex>,
+    ends: Vec<u32>,
+    /// Every vertex that may be merged (light reached it after a bounce), and where it is.
+    merge_points: Vec<Vec3>,
+    merge_vertices: Vec<MergeVertex>,
+    /// What light tracing adds to each pixel, in batch order.
+    splats: Vec<(u32, Vec3)>,
+}
+
+/// One pass's light subpaths, arranged for the camera paths.
+struct PassData {
+    paths: LightPaths,
+    grid: HashGrid,
+    /// The mergeable light vertices in the grid's order.
+    merge_vertices: Vec<MergeVertex>,
+    factors: Factors,
+    radius: f32,
+}
+
+/// What a camera vertex needs to join light to.
+struct CameraVertex<'h> {
+    hit: &'h SurfaceHit,
+    bsdf: &'h Bsdf,
+    wo: Vec3,
+    throughput: Spectrum,
+    partial: Partial,
+    length: u32,
+    dispersed: bool,
+}
+
+/// The renderer over a whole image.
+pub struct Vcm<'a> {
+    scene: &'a Scene,
+    settings: VcmSettings,
+    width: usize,
+    height: usize,
+    seed: u64,
+    sensor: Sensor,
+    emitters: Emitters,
+    spectral: bool,
+    /// Longest path in segments (eye to light).
+    max_length: u32,
+    /// The first pass's merging radius in scene units.
+    radius: f32,
+    light_paths: u64,
+}
+
+impl<'a> Vcm<'a> {
+    /// A renderer for `scene` at `width`×`height`.
+    pub fn new(scene: &'a Scene, settings: VcmSettings, width: usize, height: usize, seed: u64) -> Vcm<'a> {
+        let camera = scene.camera();
+        let radius = match settings.initial_radius {
+            InitialRadius::World(r) => r,
+            InitialRadius::Pixels(px) => {
+                let distance = (scene.lights().scene_sphere().0 - camera.eye).length().max(1e-6);
+                px * super::radius::pixel_angle(camera, height) * distance
+            }
+        };
+        Vcm {
+            scene,
+            sensor: Sensor::new(camera, width, height),
+            emitters: Emitters::new(scene.lights()),
+            spectral: settings_spectral(&settings.spectral, scene),
+            max_length: settings.max_depth.saturating_add(2),
+            radius,
+            light_paths: settings
+                .light_paths_per_pass
+                .unwrap_or_else(|| default_light_paths(width, height))
+                .max(1),
+            settings,
+            width,
+            height,
+            seed,
+        }
+    }
+
+    /// Traces light subpath `index` of pass `pass`: stores its smooth vertices and joins each
+    /// to the eye.
+    fn trace_light(&self, pass: u64, index: u64, f: &Factors, wl: &Wavelengths, out: &mut LightPaths) {
+        let connected = self.settings.connections && index < self.pixels() as u64;
+        let scene = self.scene;
+        let mut rng = Rng::new(self.seed ^ LIGHT_SEED, (pass << 40) ^ index);
+        let Some(emission) = self.emitters.emit(scene, wl, &mut rng) else {
+            return;
+        };
+        let mut throughput = emission.throughput;
+        let mut partial = Partial::default();
+        let mut ray = emission.ray;
+        let mut previous = emission.ray.origin;
+        let mut dispersed = false;
+        let mut after_specular = false;
+        for length in 1..self.max_length {
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                return;
+            };
+            let hit = scene.surface(&ray, &isect);
+            let wo = -ray.dir;
+            let bsdf = Bsdf::at(scene, &hit, wo, wl);
+            if length == 1 {
+                // Next-event estimation's density of the light point depends on where it is
+                // seen from (a sphere is sampled by its cone).
+                let direct = self.emitters.direct_pdf(scene, &emission, hit.point);
+                partial = Partial::light(f, emission.emission_pdf, direct, emission.cos, emission.delta);
+            }
+            partial.arrive((hit.point - previous).length_squared(), bsdf.normal().dot(wo).abs());
+            if !self.settings.connections && length > 1 {
+                // The sum's first term stands for a connection that makes this vertex.
+                partial.vcm = 0.0;
+            }
+            if bsdf.is_smooth() {
+                let vertex = LightVertex {
+                    hit,
+                    wo,
+                    throughput,
+                    partial,
+                    length,
+                    dispersed,
+                    after_specular,
+                };
+                self.trace_to_eye(&vertex, &bsdf, f, wl, &mut out.splats);
+                // Light reaching a vertex first is never merged (see the module's notes).
+                if length > 1 {
+                    out.merge_points.push(hit.point);
+                    out.merge_vertices.push(MergeVertex {
+                        wo,
+                        normal: hit.geometric_normal,
+                        throughput,
+                        partial,
+                        length,
+                        dispersed,
+                        after_specular,
+                    });
+                }
+                if connected {
+                    out.vertices.push(vertex);
+                }
+            }
+            after_specular = !bsdf.is_smooth();
+            // A further vertex must still reach the eye within the longest path.
+            if length + 2 > self.max_length {
+                return;
+            }
+            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance) else {
+                return;
+            };
+            let cos_out = bsdf.normal().dot(sample.wi).abs();
+            if sample.specular {
+                partial.scatter_specular(cos_out);
+            } else {
+                // A light vertex with a smooth vertex after it is never the camera path's first
+                // smooth one: no merging here.
+                partial.scatter(f, sample.pdf, bsdf.pdf_reverse(wo, sample.wi), cos_out, false);
+            }
+            // The photon tracer's roulette: the subpath's weight stays nearly constant.
+            let q = sample.weight.max_element().min(1.0);
+            if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                return;
+            }
+            throughput *= sample.weight / q;
+            if sample.dispersive {
+                wl.terminate_secondary(&mut throughput, &mut dispersed);
+            }
+            previous = hit.point;
+            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+        }
+    }
+
+    /// Light tracing: the light vertex seen by the eye, splatted onto its pixel.
+    fn trace_to_eye(&self, v: &LightVertex, bsdf: &Bsdf, f: &Factors, wl: &Wavelengths, splats: &mut Vec<(u32, Vec3)>) {
+        // Direct light is the camera strategies' (see the module's notes).
+        if v.length == 1 || v.length + 1 > self.max_length {
+            return;
+        }
+        let Some(s) = self.sensor.sample(self.scene.camera(), v.hit.point) else {
+            return;
+        };
+        let value = bsdf.eval(v.wo, s.to_eye);
+        if value == Spectrum::ZERO {
+            return;
+        }
+        let (ns, ng) = (v.hit.shading_normal, v.hit.geometric_normal);
+        let wo_ng = v.wo.dot(ng).abs();
+        if wo_ng <= 0.0 || !self.scene.unoccluded(&v.hit, s.to_eye, s.distance) {
+            return;
+        }
+        let inv_d2 = 1.0 / (s.distance * s.distance);
+        // The adjoint BSDF's shading-normal correction, as in light tracing.
+        let cos = s.to_eye.dot(ng).abs() * v.wo.dot(ns).abs() / wo_ng;
+        let camera_pdf = s.importance * bsdf.normal().dot(s.to_eye).abs() * inv_d2;
+        let weight = mis::light_tracing(
+            f,
+            &v.partial,
+            camera_pdf,
+            bsdf.pdf_reverse(v.wo, s.to_eye),
+            v.length > 1 && !v.after_specular,
+        );
+        let splat = v.throughput * value * (cos * inv_d2 * s.importance * weight / self.light_paths as f32);
+        let rgb = wl.to_rgb(splat);
+        if rgb.is_finite() {
+            splats.push((s.pixel as u32, rgb));
+        }
+    }
+
+    /// The light subpaths of pass `pass`, traced in batches in parallel and kept in index order.
+    fn light_paths(&self, pass: u64, f: &Factors, wl: &Wavelengths, control: Control) -> Option<LightPaths> {
+        let count = self.light_paths;
+        let batches: Vec<Option<LightPaths>> = (0..count.div_ceil(BATCH))
+            .into_par_iter()
+            .map(|b| {
+                if control.cancelled() {
+                    return None;
+                }
+                let mut out = LightPaths::default();
+                for i in b * BATCH..((b + 1) * BATCH).min(count) {
+                    self.trace_light(pass, i, f, wl, &mut out);
+                    out.ends.push(out.vertices.len() as u32);
+                }
+                Some(out)
+            })
+            .collect();
+        let batches: Vec<LightPaths> = batches.into_iter().collect::<Option<_>>()?;
+        let total = |len: fn(&LightPaths) -> usize| batches.iter().map(len).sum::<usize>();
+        let mut all = LightPaths {
+            vertices: Vec::with_capacity(total(|b| b.vertices.len())),
+            ends: Vec::with_capacity(count as usize + 1),
+            merge_points: Vec::with_capacity(total(|b| b.merge_points.len())),
+            merge_vertices: Vec::with_capacity(total(|b| b.merge_vertices.len())),
+            splats: Vec::with_capacity(total(|b| b.splats.len())),
+        };
+        all.ends.push(0);
+        for batch in batches {
+            let base = all.vertices.len() as u32;
+            all.ends.extend(batch.ends.iter().map(|e| base + e));
+            all.vertices.extend(batch.vertices);
+            all.merge_points.extend(batch.merge_points);
+            all.merge_vertices.extend(batch.merge_vertices);
+            all.splats.extend(batch.splats);
+        }
+        Some(all)
+    }
+
+    fn pixels(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// Radiance along the camera ray `ray`, joined to the pass's light subpaths (`own`: the
+    /// one this pixel connects to).
+    fn camera_path(&self, ray: Ray, pass: &PassData, own: usize, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
+        let f = &pass.factors;
+        let scene = self.scene;
+        let lights = scene.lights();
+        let camera_pdf = self.sensor.importance(ray.dir);
+        if camera_pdf <= 0.0 {
+            return Spectrum::ZERO;
+        }
+        let mut partial = Partial::camera(f, camera_pdf);
+        let mut ray = ray;
+        let mut throughput = wl.grey(1.0);
+        let mut l = Spectrum::ZERO;
+        let mut previous = ray.origin;
+        let mut dispersed = false;
+        // The last bounce's density, for the sky and suns (None: seen directly or by a mirror).
+        let mut last_pdf: Option<f32> = None;
+        // The sums as they would be without merging at the first vertex, taken if the second
+        // turns out to be a mirror or glass (the eye then sees a caustic there).
+        let mut without_first_merge = Partial::default();
+        // The sums without merging at the last vertex, for an emitter hit next (light reaches
+        // that vertex first).
+        let mut without_last_merge = Partial::default();
+        // Whether a smooth surface came before: merging is a strategy at the first only.
+        let mut smooth_before = false;
+        for length in 1..=self.max_length {
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                l += throughput * lights.escaped_weighted(ray.dir, last_pdf, wl);
+                break;
+            };
+            let hit = scene.surface(&ray, &isect);
+            let wo = -ray.dir;
+            let d2 = (hit.point - previous).length_squared();
+            let bsdf = Bsdf::at(scene, &hit, wo, wl);
+            let cos_in = bsdf.normal().dot(wo).abs();
+            partial.arrive(d2, cos_in);
+            let le = scene.emission_spectrum(&hit, wl);
+            if le != Spectrum::ZERO {
+                without_last_merge.arrive(d2, cos_in);
+                l += throughput * le * self.emitter_weight(&hit, &without_last_merge, previous, wo, d2, length);
+            }
+            if length == 2 && !bsdf.is_smooth() {
+                without_first_merge.arrive(d2, cos_in);
+                partial = without_first_merge;
+            }
+            if !self.settings.connections && length > 1 {
+                // The sum's first term stands for a connection that makes this vertex (for an
+                // emitter, next-event estimation, counted above).
+                partial.vcm = 0.0;
+            }
+            if length >= self.max_length || bsdf.is_black() {
+                break;
+            }
+            let merges_here = bsdf.is_smooth() && !smooth_before;
+            if bsdf.is_smooth() {
+                smooth_before = true;
+                let v = CameraVertex {
+                    hit: &hit,
+                    bsdf: &bsdf,
+                    wo,
+                    throughput,
+                    partial,
+                    length,
+                    dispersed,
+                };
+                l += self.direct(&v, f, wl, rng);
+                let paths = &pass.paths;
+                if self.settings.connections && own + 1 < paths.ends.len() {
+                    let (start, end) = (paths.ends[own] as usize, paths.ends[own + 1] as usize);
+                    for z in &paths.vertices[start..end] {
+                        l += self.connect(&v, z, f, wl, merges_here);
+                    }
+                }
+                if merges_here && f.merge > 0.0 {
+                    l += self.merge(&v, pass);
+                }
+            }
+            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
+                break;
+            };
+            let cos_out = bsdf.normal().dot(sample.wi).abs();
+            if sample.specular {
+                partial.scatter_specular(cos_out);
+                without_last_merge = partial;
+                if length == 1 {
+                    without_first_merge = partial;
+                }
+                last_pdf = None;
+            } else {
+                let reverse = bsdf.pdf_reverse(wo, sample.wi);
+                without_last_merge = partial;
+                without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
+                if length == 1 && merges_here {
+                    without_first_merge = without_last_merge;
+                    // An emitter hit next is direct light at the first vertex: no light tracing
+                    // there either (its term is the sum's first at the eye's first vertex).
+                    without_last_merge = Partial { vcm: 0.0, ..partial };
+                    without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
+                }
+                partial.scatter(f, sample.pdf, reverse, cos_out, merges_here);
+                last_pdf = Some(sample.pdf);
+            }
+            throughput *= sample.weight;
+            if sample.dispersive {
+                wl.terminate_secondary(&mut throughput, &mut dispersed);
+            }
+            if length >= ROULETTE_DEPTH {
+                let q = throughput.max_element().min(0.95);
+                if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                    break;
+                }
+                throughput /= q;
+            }
+            previous = hit.point;
+            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+        }
+        if l.is_finite() {
+            l
+        } else {
+            Spectrum::ZERO
+        }
+    }
+
+    /// The weight of an emitter the camera path hit after `length` segments.
+    fn emitter_weight(&self, hit: &SurfaceHit, camera: &Partial, from: Vec3, wo: Vec3, d2: f32, length: u32) -> f32 {
+        if length == 1 {
+            return 1.0;
+        }
+        let lights = self.scene.lights();
+        let Some((number, light)) = lights.area_light_of(hit) else {
+            return 1.0;
+        };
+        if !self.emitters.emits(number) {
+            return 1.0;
+        }
+        let normal = hit.geometric_normal;
+        let direct =
+            lights.direct_probability(number) * light.pdf_towards(from, hit.point, normal) * normal.dot(wo).abs() / d2;
+        let emission = self.emitters.emission_pdf(number, light, normal, wo);
+        mis::emitter_hit(camera, direct, emission)
+    }
+
+    /// Next-event estimation at a camera vertex: every light when there are few, else one by
+    /// power (as the path tracer).
+    fn direct(&self, v: &CameraVertex, f: &Factors, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
+        if v.length + 1 > self.max_length {
+            return Spectrum::ZERO;
+        }
+        let lights = self.scene.lights();
+        let mut l = Spectrum::ZERO;
+        let mut one = |number: usize, pick: f32, rng: &mut Rng| {
+            if self.emitters.emits(number) {
+                let Some(s) = self.emitters.sample_direct(self.scene, number, v.hit, wl, rng) else {
+                    return;
+                };
+                let value = v.bsdf.eval(v.wo, s.wi);
+                if value == Spectrum::ZERO {
+                    return;
+                }
+                let cos_here = v.bsdf.normal().dot(s.wi).abs();
+                let pdfs = DirectPdfs {
+                    bsdf: v.bsdf.pdf(v.wo, s.wi),
+                    bsdf_reverse: v.bsdf.pdf_reverse(v.wo, s.wi),
+                    direct: s.direct_pdf,
+                    emission: s.emission_pdf,
+                    cos_here,
+                    cos_light: s.cos_light,
+                    delta: s.delta,
+                };
+                // Light reaches this vertex first: merging is no strategy here, and light tracing
+                // none either if it is the eye's first (the sum's first term there).
+                let camera = if v.length == 1 {
+                    Partial { vcm: 0.0, ..v.partial }
+                } else {
+                    v.partial
+                };
+                l += v.throughput * value * s.contribution * (cos_here * mis::direct(f, &camera, &pdfs, false));
+            } else if let Some(s) = lights.sample_light(number, pick, self.scene, v.hit, wl, rng) {
+                // Far lights and lights with a size: the camera's strategies only.
+                let value = v.bsdf.eval(v.wo, s.wi);
+                let weight = if s.pdf > 0.0 {
+                    power_heuristic(s.pdf, v.bsdf.pdf(v.wo, s.wi))
+                } else {
+                    1.0
+                };
+                l += v.throughput * value * s.contribution * (v.bsdf.normal().dot(s.wi).abs() * weight);
+            }
+        };
+        if lights.samples_every_light() {
+            for number in 0..lights.len() {
+                if lights.direct_probability(number) > 0.0 {
+                    one(number, 1.0, rng);
+                }
+            }
+        } else if let Some((number, pick)) = lights.pick_for_direct(rng.uniform()) {
+            one(number, pick, rng);
+        }
+        l
+    }
+
+    /// A connection between a camera vertex and a light vertex (`camera_merges`: merging is a
+    /// strategy at the camera vertex).
+    fn connect(
+        &self,
+        v: &CameraVertex,
+        z: &LightVertex,
+        f: &Factors,
+        wl: &Wavelengths,
+        camera_merges: bool,
+    ) -> Spectrum {
+        if v.length + z.length + 1 > self.max_length {
+            return Spectrum::ZERO;
+        }
+        let to = z.hit.point - v.hit.point;
+        let d2 = to.length_squared();
+        if !(d2 > 0.0 && d2.is_finite()) {
+            return Spectrum::ZERO;
+        }
+        let dir = to / d2.sqrt();
+        let camera_f = v.bsdf.eval(v.wo, dir);
+        if camera_f == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        let light_bsdf = Bsdf::at(self.scene, &z.hit, z.wo, wl);
+        let light_f = light_bsdf.eval(z.wo, -dir);
+        if light_f == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        let cos_camera = v.bsdf.normal().dot(dir).abs();
+        let cos_light = light_bsdf.normal().dot(dir).abs();
+        let pdfs = ConnectionPdfs {
+            camera_to_light: v.bsdf.pdf(v.wo, dir) * cos_light / d2,
+            camera_reverse: v.bsdf.pdf_reverse(v.wo, dir),
+            light_to_camera: light_bsdf.pdf(z.wo, -dir) * cos_camera / d2,
+            light_reverse: light_bsdf.pdf_reverse(z.wo, -dir),
+        };
+        // The camera vertex is smooth, so merging is no strategy at the light vertex.
+        let weight = mis::connection(f, &v.partial, &z.partial, &pdfs, (camera_merges, false));
+        let (ng_c, ng_l) = (v.hit.geometric_normal, z.hit.geometric_normal);
+        let side_c = if ng_c.dot(dir) >= 0.0 { ng_c } else { -ng_c };
+        let side_l = if ng_l.dot(dir) <= 0.0 { ng_l } else { -ng_l };
+        if !self.scene.segment_clear(v.hit.point, side_c, z.hit.point, side_l) {
+            return Spectrum::ZERO;
+        }
+        let g = cos_camera * cos_light / d2;
+        v.throughput * camera_f * light_f * z.throughput * (g * weight * both_dispersed(v.dispersed, z.dispersed))
+    }
+
+    /// Merging: the light vertices within the radius of a camera vertex, as a density estimate.
+    fn merge(&self, v: &CameraVertex, pass: &PassData) -> Spectrum {
+        let mut sum = Spectrum::ZERO;
+        let ng = v.hit.geometric_normal;
+        let f = &pass.factors;
+        pass.grid.query(v.hit.point, pass.radius, |slot| {
+            let z = &pass.merge_vertices[slot];
+            if v.length + z.length > self.max_length || (v.length == 1 && z.after_specular) {
+                return;
+            }
+            // Light on another face (a wall's far side, a corner) is not light here.
+            if z.normal.dot(ng) < 0.7 {
+                return;
+            }
+            let value = v.bsdf.eval(v.wo, z.wo);
+            if value == Spectrum::ZERO {
+                return;
+            }
+            let weight = mis::merge(
+                f,
+                &v.partial,
+                &z.partial,
+                v.bsdf.pdf(v.wo, z.wo),
+                v.bsdf.pdf_reverse(v.wo, z.wo),
+            );
+            sum += value * z.throughput * (weight * both_dispersed(v.dispersed, z.dispersed));
+        });
+        v.throughput * sum / (std::f32::consts::PI * pass.radius * pass.radius * self.light_paths as f32)
+    }
+}
+
+/// Light subpaths per pass when not given, for a `width`×`height` image.
+pub fn default_light_paths(width: usize, height: usize) -> u64 {
+    ((width * height) as u64 * LIGHT_PATHS_PER_PIXEL).clamp(1, MAX_DEFAULT_LIGHT_PATHS)
+}
+
+/// Both subpaths kept only the hero wavelength, so each scaled it by the number of wavelengths:
+/// one of the factors goes.
+fn both_dispersed(a: bool, b: bool) -> f32 {
+    if a && b {
+        1.0 / SAMPLES as f32
+    } else {
+        1.0
+    }
+}
+
+impl Progressive for Vcm<'_> {
+    fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
+        let wl = pass_wavelengths(self.spectral, self.seed, pass);
+        if self.scene.lights().is_empty() {
+            return Some(vec![Vec3::ZERO; self.width * self.height]);
+        }
+        let radius = self.radius * radius_factor(pass, self.settings.alpha);
+        let f = Factors::new(radius, self.light_paths as f32);
+        let paths = if self.emitters.is_empty() {
+            LightPaths::default()
+        } else {
+            self.light_paths(pass, &f, &wl, control)?
+        };
+        let grid = HashGrid::new(&paths.merge_points, radius);
+        let merge_vertices = grid.order().iter().map(|&i| paths.merge_vertices[i as usize]).collect();
+        let pass_data = PassData {
+            paths,
+            grid,
+            merge_vertices,
+            factors: f,
+            radius,
+        };
+        let camera = self.scene.camera();
+        let (w, h) = (self.width, self.height);
+        let (mut film, complete) = shade_tiles(w, h, control, false, |x, y| {
+            let pixel = y * w + x;
+            let mut rng = Rng::new(self.seed, (pass << 32) ^ pixel as u64);
+            let (jx, jy) = (rng.uniform(), rng.uniform());
+            let ray = camera.generate_ray((x as f32 + jx) / w as f32, 1.0 - (y as f32 + jy) / h as f32);
+            let own = pixel % self.light_paths as usize;
+            let v = wl.to_rgb(self.camera_path(ray, &pass_data, own, &wl, &mut rng));
+            if v.is_finite() {
+                v
+            } else {
+                Vec3::ZERO
+            }
+        });
+        if !complete {
+            return None;
+        }
+        for &(pixel, value) in &pass_data.paths.splats {
+            film[pixel as usize] += value;
+        }
+        Some(film)
+    }
+}
