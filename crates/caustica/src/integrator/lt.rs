@@ -26,8 +26,10 @@ use rayon::prelude::*;
 pub struct LtSettings {
     /// Photons emitted per pass.
     pub photons_per_pass: u64,
-    /// Longest photon path in bounces: light reaches the eye from at most N + 1 surfaces, the
-    /// same paths as `ppm`'s photons.
+    /// `--depth` N: photons make at most N bounces before the surface they are seen on, so
+    /// light reaches the eye after scattering at no more than N + 1 surfaces
+    /// ([`scattering_surfaces`](super::config::scattering_surfaces)), the same paths as
+    /// `ppm`'s photons.
     pub max_depth: u32,
     /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
     /// dispersive glass).
