@@ -12,7 +12,7 @@
 
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::Progressive;
-use crate::bsdf::{Bsdf, Transport};
+use crate::bsdf::{adjoint_correction, Bsdf, Transport};
 use crate::camera::Camera;
 use crate::math::{Ray, Vec3};
 use crate::progress::Control;
@@ -191,12 +191,15 @@ impl<'a> LightTracer<'a> {
             let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance) else {
                 return;
             };
-            // The photon tracer's roulette: flux stays nearly constant along the path.
-            let q = sample.weight.max_element().min(1.0);
+            // As the photon tracer: Veach's correction for interpolated normals (1 on flat
+            // geometry), then its roulette, so flux stays nearly constant along the path.
+            let correction = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi);
+            let weight = sample.weight * correction.unwrap_or(0.0);
+            let q = weight.max_element().min(1.0);
             if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
                 return;
             }
-            power *= sample.weight / q;
+            power *= weight / q;
             if sample.dispersive {
                 wl.terminate_secondary(&mut power, &mut dispersed);
             }

@@ -20,7 +20,7 @@
 //! random stream and batches are concatenated in order.
 
 use super::{Photon, DIFFUSE, DISPERSED, MAX_BOUNCES_LEFT, REFLECTED, REFRACTED};
-use crate::bsdf::{Bsdf, Transport};
+use crate::bsdf::{adjoint_correction, Bsdf, Transport};
 use crate::light::{distance_attenuation, Light};
 use crate::material::{channel_indices, refraction_geometry};
 use crate::math::{reflect, refract, Ray, Vec3};
@@ -277,12 +277,16 @@ impl PhotonModel for PhysicalModel {
             ));
         }
         let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)?;
+        // Photons carry flux the adjoint way: with an interpolated normal the sample's weight
+        // needs Veach's correction (1 on flat geometry).
+        let correction = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi);
+        let weight = sample.weight * correction.unwrap_or(0.0);
         // Survive with the probability of the throughput kept, so flux stays nearly constant.
-        let q = sample.weight.max_element().min(1.0);
+        let q = weight.max_element().min(1.0);
         if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
             return None;
         }
-        photon.power *= sample.weight / q;
+        photon.power *= weight / q;
         if sample.dispersive && photon.flags & DISPERSED == 0 {
             let mut terminated = false;
             self.wl.terminate_secondary(&mut photon.power, &mut terminated);
