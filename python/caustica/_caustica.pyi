@@ -23,7 +23,7 @@ class RenderOptions(TypedDict, total=False):
     width: int
     height: int | None
     aa: int
-    depth: int | None
+    depth: int | None  # bounces after the first surface seen: light from at most depth + 1 surfaces
     threads: int | None
     seed: int
     photons: int

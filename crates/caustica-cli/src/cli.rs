@@ -180,8 +180,9 @@ pub struct RenderArgs {
     /// N×N stratified, jittered samples per pixel.
     #[arg(long, default_value_t = 1)]
     pub aa: u32,
-    /// Maximum reflection/refraction depth [default: 5 for whitted, 64 bounces for path, ppm, gi, lt;
-    /// a pbrt-v4 scene's maxdepth].
+    /// Bounces after the first surface the eye sees: light reaches the eye after scattering at
+    /// no more than N + 1 surfaces (whitted: N reflection/refraction rays) [default: 5 for
+    /// whitted, 64 for path, ppm, gi, lt; a pbrt-v4 scene's maxdepth − 1].
     #[arg(long)]
     pub depth: Option<u32>,
     /// Worker threads (default: all cores).

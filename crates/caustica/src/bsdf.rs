@@ -432,6 +432,27 @@ impl Bsdf {
     }
 }
 
+/// Veach's correction of the adjoint BSDF for shading normals (thesis, §5.3): a particle
+/// carrying importance-transport flux (a photon) that arrives from `wo` and leaves towards
+/// `wi` (both unit, away from the surface) must be multiplied by f·|wo·ns|·|wi·ng| / (|wo·ng|·pdf),
+/// not by [`BsdfSample::weight`]'s f·|wi·ns| / pdf, for its density to give the radiance that
+/// camera paths compute with the shading normal `ns` (`ng`: the geometric normal). This returns
+/// the ratio of the two, |wo·ns|·|wi·ng| / (|wo·ng|·|wi·ns|), for every lobe, delta lobes
+/// included; exactly 1 where the shading normal is the geometric one, and `None` where it is
+/// undefined (a direction in the surface's plane): the particle is dropped there.
+#[inline]
+pub fn adjoint_correction(ns: Vec3, ng: Vec3, wo: Vec3, wi: Vec3) -> Option<f32> {
+    if ns == ng {
+        return Some(1.0);
+    }
+    let denominator = wo.dot(ng).abs() * wi.dot(ns).abs();
+    if denominator.is_nan() || denominator <= 0.0 {
+        return None;
+    }
+    let c = wo.dot(ns).abs() * wi.dot(ng).abs() / denominator;
+    c.is_finite().then_some(c)
+}
+
 impl Bsdf {
     /// The sample of a smooth lobe in direction `wi`, weighted by the whole mixture.
     fn smooth_sample(&self, wo: Vec3, wi: Vec3) -> Option<BsdfSample> {
@@ -668,6 +689,24 @@ mod tests {
 
     /// ∫ f cos dω by importance sampling equals the albedo: kd for Lambert, ks for normalised
     /// Phong at normal incidence (any exponent), and the weights average to the same.
+    /// Veach's factor is exactly 1 on flat geometry, 1 for a photon leaving the way it came,
+    /// the ratio of the cosines otherwise, and undefined for a photon arriving in the plane.
+    #[test]
+    fn adjoint_correction_is_one_on_flat_geometry() {
+        let ng = Vec3::Z;
+        let ns = Vec3::new(0.5, 0.0, 0.75f32.sqrt());
+        let wo = Vec3::new(0.3, -0.2, 0.9).normalize();
+        let wi = Vec3::new(-0.6, 0.1, 0.5).normalize();
+        assert_eq!(adjoint_correction(ng, ng, wo, wi), Some(1.0));
+        assert_eq!(adjoint_correction(-ng, -ng, wo, -wi), Some(1.0));
+        let same = adjoint_correction(ns, ng, wo, wo).unwrap();
+        assert!((same - 1.0).abs() < 1e-6, "{same}");
+        let c = adjoint_correction(ns, ng, wo, wi).unwrap();
+        let expected = wo.dot(ns) * wi.dot(ng) / (wo.dot(ng) * wi.dot(ns));
+        assert!((c - expected).abs() < 1e-6 * expected, "{c} vs {expected}");
+        assert_eq!(adjoint_correction(ns, ng, Vec3::X, wi), None);
+    }
+
     #[test]
     fn smooth_lobes_conserve_energy_and_weights_match_eval() {
         let n = Vec3::Z;

@@ -38,7 +38,7 @@ pub struct RenderHints {
     pub physical: bool,
     /// The integrator the file names.
     pub integrator: Option<IntegratorHint>,
-    /// Longest path in bounces (pbrt's `maxdepth`).
+    /// pbrt's `maxdepth`: the most scattering events on a path (`--depth` is one less).
     pub max_depth: Option<u32>,
     /// Samples per pixel (pbrt's `pixelsamples`): passes of the physical integrators.
     pub samples: Option<u32>,

@@ -122,7 +122,8 @@ impl Integrator {
                 check_k(o.estimate.k)?;
                 check_photons(o.photons.target_stored)
             }
-            Integrator::Path(s) => check_depth(s.max_depth),
+            // The path tracer's limit counts scattering surfaces: `--depth` + 1.
+            Integrator::Path(s) => check_depth(s.max_depth.saturating_sub(1)),
             Integrator::Ppm(s) => {
                 check_depth(s.max_depth)?;
                 check_alpha(s.alpha)?;
@@ -179,10 +180,11 @@ fn check_photons_per_pass(name: &str, count: u64) -> Result<()> {
     check_photons(usize::try_from(count).unwrap_or(usize::MAX))
 }
 
+/// `--depth` of a physical integrator: 0 (direct light only) to 1024.
 fn check_depth(depth: u32) -> Result<()> {
-    if depth == 0 || depth > 1024 {
+    if depth > 1024 {
         return Err(Error::InvalidSettings(
-            "--depth must be between 1 and 1024 for the physical integrators".into(),
+            "--depth must be between 0 and 1024 for the physical integrators".into(),
         ));
     }
     Ok(())

@@ -53,17 +53,30 @@ pub const DIFFUSE: u8 = 4;
 /// is left, its power already multiplied by the number of wavelengths. A camera path that
 /// dispersed too has made that multiplication itself, so it divides such photons by it again.
 pub const DISPERSED: u8 = 8;
+/// The four flags of a photon's history; the high four bits of `flags` hold the bounces it had
+/// left ([`Photon::bounces_left`]).
+pub const HISTORY: u8 = REFLECTED | REFRACTED | DIFFUSE | DISPERSED;
+/// The most bounces left a photon records: more read as this many.
+pub const MAX_BOUNCES_LEFT: u8 = 15;
+
+/// The least [`Photon::bounces_left`] a photon gathered at a surface needs when the camera path
+/// may scatter at `surfaces_left` more surfaces beyond it and photons made at most
+/// `max_bounces`: it may then have bounced `surfaces_left` times at most.
+#[inline]
+pub fn needed_bounces_left(max_bounces: u32, surfaces_left: u32) -> u8 {
+    max_bounces.saturating_sub(surfaces_left).min(MAX_BOUNCES_LEFT as u32) as u8
+}
 
 /// Whether a photon arrived straight from its light.
 #[inline]
 pub fn is_direct(photon: &Photon) -> bool {
-    photon.flags == 0
+    photon.flags & HISTORY == 0
 }
 
 /// Whether a photon's path was specular only: light, then mirrors and glass (L S+ D).
 #[inline]
 pub fn is_caustic(photon: &Photon) -> bool {
-    photon.flags != 0 && photon.flags & DIFFUSE == 0
+    photon.flags & HISTORY != 0 && photon.flags & DIFFUSE == 0
 }
 
 /// A stored photon.
@@ -76,7 +89,8 @@ pub struct Photon {
     direction: [u16; 2],
     normal: [u8; 2],
     exponent: u8,
-    /// [`REFLECTED`], [`REFRACTED`], [`DIFFUSE`], [`DISPERSED`].
+    /// [`REFLECTED`], [`REFRACTED`], [`DIFFUSE`], [`DISPERSED`] in the low bits; the high four
+    /// hold [`Photon::bounces_left`] (physical model).
     pub flags: u8,
 }
 
@@ -121,6 +135,15 @@ impl Photon {
     #[inline]
     pub fn direction(&self) -> Vec3 {
         decode_oct(Vec2::new(self.direction[0] as f32, self.direction[1] as f32) / 65535.0)
+    }
+
+    /// How many more bounces `--depth` would have let the photon make, at most
+    /// [`MAX_BOUNCES_LEFT`] (physical model; 0 under the course model): a photon gathered past
+    /// the first surface a camera path meets must not bring light from more surfaces than that
+    /// path may still count (Jensen's final gather, [`crate::integrator::gi`]).
+    #[inline]
+    pub fn bounces_left(&self) -> u8 {
+        self.flags >> 4
     }
 
     /// The packed normal: equal codes decode to equal normals.

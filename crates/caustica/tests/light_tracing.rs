@@ -138,7 +138,7 @@ const REGIONS: [Region; 7] = [
 ];
 
 /// The reference's particle tracer stops at 10 path segments; photons of at most 8 bounces meet
-/// at most 9 surfaces before the eye (tests/physical.rs, REFERENCE_PHOTON_DEPTH).
+/// at most 9 surfaces before the eye: `--depth` 8 (tests/physical.rs, REFERENCE_DEPTH).
 const REFERENCE_PHOTON_DEPTH: u32 = 8;
 
 /// On the point-light Cornell box light tracing reaches the focus of the glass sphere's caustic

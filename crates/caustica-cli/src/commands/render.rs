@@ -35,14 +35,11 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
     } else {
         (scene.model, scene.integrator)
     };
-    // The scene's depth is for its own integrator; passes and photons for any physical one.
-    let depth = args.depth.or(if integrator == scene.integrator {
-        scene.depth
-    } else {
-        None
-    });
     // The scene's samples per pixel are passes of a physical integrator; the course model has none.
     let course = model == Some(Model::Course) || integrator == Some(IntegratorKind::Whitted);
+    // The scene's depth, passes and photons are for any physical integrator: `--depth` means
+    // the same bounces in each of them.
+    let depth = args.depth.or(if course { None } else { scene.depth });
     // With only --width, the height follows the camera rather than the scene's film.
     let height = args.height.or(if args.width.is_none() { scene.height } else { None });
     Ok(RenderConfig {

@@ -103,7 +103,9 @@ pub struct RenderConfig {
     pub height: Option<usize>,
     /// `--aa`.
     pub aa: u32,
-    /// `--depth` (5 for whitted, 64 for the physical integrators).
+    /// `--depth`: bounces after the first surface the eye sees, so light reaches the eye after
+    /// scattering at no more than depth + 1 surfaces ([`scattering_surfaces`]); 5 for whitted, 64 for
+    /// the physical integrators.
     pub depth: Option<u32>,
     /// `--seed`.
     pub seed: u64,
@@ -186,9 +188,9 @@ impl RenderConfig {
     /// The defaults with a scene file's own settings applied (pbrt-v4's `Film`, `Sampler` and
     /// `Integrator`): a front end starts here and then sets the options its user gave.
     ///
-    /// pbrt's `maxdepth` N counts scattering events, so its paths have N + 1 segments: `path`
-    /// gets depth N and `ppm` N − 1 (their depths count N + 1 and N + 2 segments,
-    /// docs/radiometry.md).
+    /// pbrt's `maxdepth` N counts scattering events (its paths have up to N + 1 segments), so
+    /// every physical integrator gets `--depth` N − 1 ([`scattering_surfaces`] of it is N);
+    /// pbrt's `maxdepth` 0, light seen only where it is emitted, has no `--depth` and becomes 0.
     pub fn for_scene(hints: &RenderHints) -> RenderConfig {
         let mut config = RenderConfig::default();
         if let Some(w) = hints.width {
@@ -203,10 +205,7 @@ impl RenderConfig {
             });
         }
         if let Some(n) = hints.max_depth {
-            config.depth = Some(match config.integrator {
-                Some(IntegratorKind::Path) => n,
-                _ => n.saturating_sub(1).max(1),
-            });
+            config.depth = Some(n.saturating_sub(1));
         }
         if let Some(n) = hints.samples.filter(|&n| n > 0) {
             config.passes = Some(n.to_string());
@@ -296,7 +295,9 @@ impl RenderConfig {
                 aa: self.aa,
             }),
             IntegratorKind::Path => Integrator::Path(PathSettings {
-                max_depth: depth,
+                // The path tracer counts the surfaces a camera path scatters at, not the bounces
+                // after the first one: `--depth` N allows it N + 1, as photons of N bounces meet.
+                max_depth: scattering_surfaces(depth),
                 specular_camera_paths,
                 spectral: self.spectral,
                 ..PathSettings::default()
@@ -426,6 +427,17 @@ impl RenderConfig {
     }
 }
 
+/// The surfaces light may scatter at on its way to the eye under `--depth` `depth`: the
+/// first surface the eye sees and `depth` bounces after it. This is what `--depth` means for
+/// every integrator: whitted follows `depth` reflection and refraction rays, photons (`ppm`,
+/// `gi`, `lt`) make at most `depth` bounces before the surface they are seen on, and the path
+/// tracer, whose own limit counts scattering surfaces, gets this many. So `path --depth 8` and
+/// `ppm --depth 8` carry light from at most 9 surfaces, as pbrt's `maxdepth` 9 or Mitsuba's
+/// `max_depth` 10 (which counts path segments) do.
+pub const fn scattering_surfaces(depth: u32) -> u32 {
+    depth.saturating_add(1)
+}
+
 /// Refuses photon counts whose map would exceed `max_memory` MB (`--max-memory`), before any
 /// work.
 pub fn check_photon_memory(total: usize, max_memory: u64) -> Result<()> {
@@ -448,4 +460,57 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         .num_threads(threads.unwrap_or(0))
         .build()
         .map_err(|e| Error::InvalidSettings(format!("cannot start worker threads: {e}")))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn depths(config: &RenderConfig) -> u32 {
+        match config.integrator().unwrap() {
+            Integrator::Whitted(o) => o.whitted.max_depth,
+            Integrator::Path(s) => s.max_depth,
+            Integrator::Ppm(s) => s.max_depth,
+            Integrator::Gi(s) => s.max_depth,
+            Integrator::Lt(s) => s.max_depth,
+        }
+    }
+
+    /// `--depth` 8 lets light scatter at 9 surfaces in every physical integrator: photons make
+    /// 8 bounces, the path tracer's own limit (surfaces) is 9. pbrt's `maxdepth` 9 (scattering
+    /// events) is `--depth` 8 whatever the integrator; whitted keeps its 5 by default.
+    #[test]
+    fn depth_is_bounces_after_the_first_surface_everywhere() {
+        let with = |kind, depth| RenderConfig {
+            integrator: Some(kind),
+            depth,
+            ..RenderConfig::default()
+        };
+        assert_eq!(depths(&with(IntegratorKind::Path, Some(8))), 9);
+        assert_eq!(depths(&with(IntegratorKind::Path, Some(0))), 1);
+        assert_eq!(depths(&with(IntegratorKind::Path, None)), 65);
+        for kind in [IntegratorKind::Ppm, IntegratorKind::Gi, IntegratorKind::Lt] {
+            assert_eq!(depths(&with(kind, Some(8))), 8);
+            assert_eq!(depths(&with(kind, None)), 64);
+        }
+        assert_eq!(depths(&with(IntegratorKind::Whitted, None)), 5);
+        assert!(with(IntegratorKind::Ppm, Some(1025)).integrator().is_err());
+        assert!(with(IntegratorKind::Path, Some(1025)).integrator().is_err());
+        assert!(with(IntegratorKind::Path, Some(1024)).integrator().is_ok());
+        for (hint, kind) in [
+            (IntegratorHint::Path, IntegratorKind::Path),
+            (IntegratorHint::Ppm, IntegratorKind::Ppm),
+        ] {
+            let hints = |n| RenderHints {
+                physical: true,
+                integrator: Some(hint),
+                max_depth: Some(n),
+                ..RenderHints::default()
+            };
+            let config = RenderConfig::for_scene(&hints(9));
+            assert_eq!((config.integrator, config.depth), (Some(kind), Some(8)));
+            assert_eq!(RenderConfig::for_scene(&hints(1)).depth, Some(0), "direct light only");
+            assert_eq!(RenderConfig::for_scene(&hints(0)).depth, Some(0));
+        }
+    }
 }

@@ -23,9 +23,9 @@ use super::tiles::sample_pass;
 use super::Progressive;
 use crate::bsdf::{Bsdf, Transport};
 use crate::math::{Ray, Vec3};
-use crate::photon::is_caustic;
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count;
+use crate::photon::{is_caustic, needed_bounces_left};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -43,7 +43,10 @@ pub struct GiSettings {
     pub caustic_radius: InitialRadius,
     /// Knaus & Zwicker's α for the caustic radius.
     pub alpha: f32,
-    /// Longest specular chain, and longest photon path.
+    /// `--depth` N: light reaches the eye after scattering at no more than N + 1 surfaces
+    /// ([`scattering_surfaces`](super::config::scattering_surfaces)), counting the mirrors and
+    /// glass of the camera path, the surfaces its final gather meets and the bounces of the
+    /// photons it reads there ([`Photon::bounces_left`](crate::photon::Photon::bounces_left)).
     pub max_depth: u32,
     /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
     /// through glass is black, as in a particle tracer's image — for comparing with one).
@@ -141,18 +144,22 @@ impl<'a> Gi<'a> {
             s.specular_camera_paths,
             wl,
             rng,
-            |hit, bsdf, wo, path_length, dispersed, rng| {
+            |hit, bsdf, wo, path_length, dispersed, left, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
+                let min_left = needed_bounces_left(s.max_depth, left);
                 direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
-                    + maps.caustic.radiance_within(hit.point, bsdf, wo, r, dispersed)
+                    + maps
+                        .caustic
+                        .radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
             },
-            |hit, sample, path_length, dispersed, rng| {
+            |hit, sample, path_length, dispersed, left, rng| {
                 let origin = hit.ray_origin(sample.wi);
                 let gather = Gather {
                     from: Some((hit.point, sample.pdf)),
                     path_length,
                     dispersed,
                     level: 0,
+                    left,
                 };
                 sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
             },
@@ -165,7 +172,10 @@ impl<'a> Gi<'a> {
     /// [`EXACT_LEVELS`] times the light there is computed like at the first surface instead.
     /// Emission the ray meets straight away (an emitter or the sky) counts weighted against the
     /// light sample of the point it left (`from`: that point and the ray's pdf; none when the
-    /// ray left by a specular lobe, whose lights the caustic map counts).
+    /// ray left by a specular lobe, whose lights the caustic map counts). Each surface the ray
+    /// meets uses one of the surfaces `--depth` leaves the path (`at.left`), and photons read
+    /// at one have bounced no more often than the path may still scatter beyond it: at
+    /// `--depth` N light never comes from more than N + 1 surfaces, as in the other integrators.
     fn gather(&self, maps: &GiMaps, ray: Ray, at: Gather, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
         let scene = self.scene;
         let lights = scene.lights();
@@ -178,7 +188,8 @@ impl<'a> Gi<'a> {
         // Emission at the first surface (or sky) the ray meets, weighted against the light sample.
         let mut emitted_first = Spectrum::ZERO;
         let mut direct_from = at.from.filter(|_| self.mis);
-        for _ in 0..=s.max_depth {
+        let mut left = at.left;
+        loop {
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
                 if let Some((_, pdf)) = direct_from {
                     return lights.escaped_weighted(ray.dir, Some(pdf), wl);
@@ -195,19 +206,29 @@ impl<'a> Gi<'a> {
                     emitted_first = le * power_heuristic(pdf, lights.pdf_direct(point, &hit));
                 }
             }
+            // Past the surfaces `--depth` allows, only what this one emits counts.
+            if left == 0 {
+                break;
+            }
+            left -= 1;
             let bsdf = Bsdf::at(scene, &hit, wo, wl);
             if bsdf.is_black() {
                 break;
             }
             if bsdf.is_smooth() {
+                let min_left = needed_bounces_left(s.max_depth, left);
                 if at.level >= EXACT_LEVELS || segment > maps.global_radius {
                     let r = maps.global_radius * 0.5 * maps.caustic_factor;
-                    let global = maps.global.radiance_within(hit.point, &bsdf, wo, r, dispersed);
+                    let global = maps
+                        .global
+                        .radiance_within(hit.point, &bsdf, wo, (r, min_left), dispersed);
                     return emitted_first + beta * global;
                 }
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
                 let mut l = direct_light(scene, &hit, &bsdf, wo, self.mis, wl, rng);
-                l += maps.caustic.radiance_within(hit.point, &bsdf, wo, r, dispersed);
+                l += maps
+                    .caustic
+                    .radiance_within(hit.point, &bsdf, wo, (r, min_left), dispersed);
                 if let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) {
                     let next = Ray::new(hit.ray_origin(sample.wi), sample.wi);
                     let mut weight = sample.weight;
@@ -220,6 +241,7 @@ impl<'a> Gi<'a> {
                         path_length,
                         dispersed: next_dispersed,
                         level: at.level + 1,
+                        left,
                     };
                     l += weight * self.gather(maps, next, deeper, wl, rng);
                 }
@@ -240,13 +262,15 @@ impl<'a> Gi<'a> {
 
 /// Where a gather ray starts: the point and pdf it left by (for weighting the emission it meets
 /// straight away; none after a specular lobe), the camera path's length so far, whether the
-/// camera path has dispersed, and how many gathers deep it is.
+/// camera path has dispersed, how many gathers deep it is, and at how many more surfaces the
+/// path may scatter beyond the one it leaves.
 #[derive(Clone, Copy, Debug)]
 struct Gather {
     from: Option<(Vec3, f32)>,
     path_length: f32,
     dispersed: bool,
     level: u32,
+    left: u32,
 }
 
 /// Gather bounces computed exactly, rather than read from the global map, for close surfaces.

@@ -12,7 +12,7 @@
 
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::Progressive;
-use crate::bsdf::{Bsdf, Transport};
+use crate::bsdf::{adjoint_correction, Bsdf, Transport};
 use crate::camera::Camera;
 use crate::math::{Ray, Vec3};
 use crate::progress::Control;
@@ -26,8 +26,10 @@ use rayon::prelude::*;
 pub struct LtSettings {
     /// Photons emitted per pass.
     pub photons_per_pass: u64,
-    /// Longest photon path in bounces: light reaches the eye from at most N + 1 surfaces, the
-    /// same paths as `ppm`'s photons.
+    /// `--depth` N: photons make at most N bounces before the surface they are seen on, so
+    /// light reaches the eye after scattering at no more than N + 1 surfaces
+    /// ([`scattering_surfaces`](super::config::scattering_surfaces)), the same paths as
+    /// `ppm`'s photons.
     pub max_depth: u32,
     /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
     /// dispersive glass).
@@ -200,12 +202,15 @@ impl<'a> LightTracer<'a> {
             let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance) else {
                 return;
             };
-            // The photon tracer's roulette: flux stays nearly constant along the path.
-            let q = sample.weight.max_element().min(1.0);
+            // As the photon tracer: Veach's correction for interpolated normals (1 on flat
+            // geometry), then its roulette, so flux stays nearly constant along the path.
+            let correction = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi);
+            let weight = sample.weight * correction.unwrap_or(0.0);
+            let q = weight.max_element().min(1.0);
             if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
                 return;
             }
-            power *= sample.weight / q;
+            power *= weight / q;
             if sample.dispersive {
                 wl.terminate_secondary(&mut power, &mut dispersed);
             }

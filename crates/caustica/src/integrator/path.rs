@@ -14,7 +14,10 @@ use crate::spectrum::{Spectrum, Wavelengths};
 /// Settings of the path tracer.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PathSettings {
-    /// Longest path, in bounces.
+    /// Most surfaces a camera path scatters at, the first one it meets included: light reaches
+    /// the eye from at most this many (0: only emission seen directly). Unlike the other
+    /// integrators' `max_depth` this counts surfaces, not bounces after the first: `--depth` N
+    /// sets it to N + 1 ([`scattering_surfaces`](super::config::scattering_surfaces)).
     pub max_depth: u32,
     /// Bounces before Russian roulette may end a path.
     pub roulette_depth: u32,
@@ -29,7 +32,8 @@ pub struct PathSettings {
 impl Default for PathSettings {
     fn default() -> Self {
         PathSettings {
-            max_depth: 64,
+            // `--depth`'s default, 64.
+            max_depth: super::config::scattering_surfaces(64),
             roulette_depth: 3,
             specular_camera_paths: true,
             spectral: None,

@@ -15,9 +15,9 @@ use super::specular_chain::camera_chain;
 use super::tiles::sample_pass;
 use super::Progressive;
 use crate::math::{Ray, Vec3};
-use crate::photon::is_direct;
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count;
+use crate::photon::{is_direct, needed_bounces_left};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -32,7 +32,10 @@ pub struct PpmSettings {
     pub alpha: f32,
     /// Radius of the first pass.
     pub initial_radius: InitialRadius,
-    /// Longest specular chain from the camera, and longest photon path.
+    /// `--depth` N: light reaches the eye after scattering at no more than N + 1 surfaces
+    /// ([`scattering_surfaces`](super::config::scattering_surfaces)): camera paths follow at
+    /// most N mirrors and glass to a smooth surface, and photons gathered there after k of
+    /// them have made at most N − k bounces.
     pub max_depth: u32,
     /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
     /// through glass is black, as in a particle tracer's image — for comparing with one).
@@ -142,12 +145,13 @@ impl<'a> Ppm<'a> {
             self.settings.specular_camera_paths,
             wl,
             rng,
-            |hit, bsdf, wo, path_length, dispersed, rng| {
+            |hit, bsdf, wo, path_length, dispersed, left, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
+                let min_left = needed_bounces_left(self.settings.max_depth, left);
                 direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
-                    + map.radiance_within(hit.point, bsdf, wo, r, dispersed)
+                    + map.radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
             },
-            |hit, sample, _, _, _| {
+            |hit, sample, _, _, _, _| {
                 if self.mis {
                     sample.weight * direct_by_bsdf(self.scene, hit, sample, wl)
                 } else {

@@ -7,11 +7,14 @@ use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 
-/// Follows a camera ray through mirrors and glass at the wavelengths `wl`, adding the emission
-/// it meets. At each smooth surface it adds `beta · at_smooth(hit, bsdf, wo, path length)`;
-/// where the surface's BSDF then samples a smooth lobe the chain ends with
-/// `beta · beyond(hit, sample, path length)` (the BSDF half of direct light for photon mapping,
-/// a final gather for Jensen's method). With `through_specular` off, a camera ray that meets a
+/// Follows a camera ray through at most `max_depth` mirrors and glass at the wavelengths `wl`,
+/// adding the emission it meets. At each smooth surface it adds
+/// `beta · at_smooth(hit, bsdf, wo, path length, dispersed, left)`; where the surface's BSDF
+/// then samples a smooth lobe the chain ends with
+/// `beta · beyond(hit, sample, path length, dispersed, left)` (the BSDF half of direct light
+/// for photon mapping, a final gather for Jensen's method). `left` is how many more surfaces
+/// light may have scattered at beyond this one (`--depth` less the mirrors and glass before
+/// it): photons gathered here may have bounced that often at most. With `through_specular` off, a camera ray that meets a
 /// mirror or glass first stops there. A dispersive glass leaves the hero wavelength alone; both
 /// closures are told whether that happened (photons that dispersed too must then not count the
 /// hero's weight twice, see [`crate::photon::DISPERSED`]).
@@ -27,8 +30,8 @@ pub fn camera_chain<S, B>(
     mut beyond: B,
 ) -> Spectrum
 where
-    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, &mut Rng) -> Spectrum,
-    B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, &mut Rng) -> Spectrum,
+    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, &mut Rng) -> Spectrum,
+    B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum,
 {
     let mut ray = ray;
     let mut beta = wl.grey(1.0);
@@ -51,19 +54,18 @@ where
             break;
         }
         if bsdf.is_smooth() {
-            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, rng);
-        }
-        if depth == max_depth {
-            break;
+            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, max_depth - depth, rng);
         }
         let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
             break;
         };
         if !sample.specular {
-            l += beta * beyond(&hit, &sample, path_length, terminated, rng);
+            // Even at the last depth: light that comes straight from an emitter has scattered
+            // at this surface only (the BSDF half of its direct light).
+            l += beta * beyond(&hit, &sample, path_length, terminated, max_depth - depth, rng);
             break;
         }
-        if depth == 0 && !through_specular {
+        if depth == max_depth || depth == 0 && !through_specular {
             break;
         }
         beta *= sample.weight;

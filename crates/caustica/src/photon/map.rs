@@ -391,8 +391,16 @@ impl PhotonMap {
     }
 
     /// Reflected radiance at `point` towards `wo` from the photons within radius `r` (physical
-    /// model); `dispersed` says the camera path left its secondary wavelengths behind.
-    pub fn radiance_within(&self, point: Vec3, bsdf: &Bsdf, wo: Vec3, r: f32, dispersed: bool) -> Spectrum {
+    /// model) that had at least `min_left` bounces left ([`Photon::bounces_left`]; 0: all);
+    /// `dispersed` says the camera path left its secondary wavelengths behind.
+    pub fn radiance_within(
+        &self,
+        point: Vec3,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        (r, min_left): (f32, u8),
+        dispersed: bool,
+    ) -> Spectrum {
         if self.photons.is_empty() || r.is_nan() || r <= 0.0 {
             return Spectrum::ZERO;
         }
@@ -400,7 +408,7 @@ impl PhotonMap {
         let mut sum = Spectrum::ZERO;
         self.tree.for_each_within(&self.photons, point, r * r, |slot, _| {
             let photon = &self.photons[slot as usize];
-            if accepts(photon, point, n, r, bsdf.transmits_smoothly()) {
+            if photon.bounces_left() >= min_left && accepts(photon, point, n, r, bsdf.transmits_smoothly()) {
                 sum += bsdf.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
             }
         });

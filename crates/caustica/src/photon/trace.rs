@@ -19,8 +19,8 @@
 //! (physical). Both are deterministic whatever the thread count: photon `i` draws from its own
 //! random stream and batches are concatenated in order.
 
-use super::{Photon, DIFFUSE, DISPERSED, REFLECTED, REFRACTED};
-use crate::bsdf::{Bsdf, Transport};
+use super::{Photon, DIFFUSE, DISPERSED, MAX_BOUNCES_LEFT, REFLECTED, REFRACTED};
+use crate::bsdf::{adjoint_correction, Bsdf, Transport};
 use crate::light::{distance_attenuation, Light};
 use crate::material::{channel_indices, refraction_geometry};
 use crate::math::{reflect, refract, Ray, Vec3};
@@ -60,7 +60,7 @@ pub fn trace_count(
                 let mut rng = Rng::new(seed, (stream << 40) ^ i);
                 if let Some(emitted) = lights.emit(scene, wl, &mut rng) {
                     let flux = emitted.flux * scale;
-                    let model = PhysicalModel { wl: *wl };
+                    let model = PhysicalModel { wl: *wl, max_bounces };
                     trace_path(scene, &model, emitted.ray, flux, max_bounces, &mut rng, out);
                 }
             });
@@ -94,6 +94,8 @@ pub struct PhotonState {
     pub flags: u8,
     /// Length of the path so far.
     pub length: f32,
+    /// Bounces made so far (surfaces met before the one it is at).
+    pub bounces: u32,
 }
 
 /// What a shading model does with a photon at a surface.
@@ -125,13 +127,15 @@ pub fn trace_path<M: PhotonModel>(
         power,
         flags: 0,
         length: 0.0,
+        bounces: 0,
     };
-    for _ in 0..=max_bounces {
+    for bounces in 0..=max_bounces {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
             return;
         };
         let hit = scene.surface(&ray, &isect);
         photon.length += isect.t * ray.dir.length();
+        photon.bounces = bounces;
         let Some(dir) = model.interact(scene, &hit, &ray, &mut photon, rng, out) else {
             return;
         };
@@ -243,6 +247,8 @@ pub fn falloff_scale(light: &Light, path_length: f32) -> f32 {
 pub struct PhysicalModel {
     /// The wavelengths (or RGB channels) the photons carry.
     pub wl: Wavelengths,
+    /// The bounces a photon may make (`--depth`): what it has left is stored with it.
+    pub max_bounces: u32,
 }
 
 impl PhotonModel for PhysicalModel {
@@ -258,21 +264,29 @@ impl PhotonModel for PhysicalModel {
         let wo = -ray.dir;
         let bsdf = Bsdf::at(scene, hit, wo, &self.wl);
         if bsdf.is_smooth() {
+            let left = self
+                .max_bounces
+                .saturating_sub(photon.bounces)
+                .min(MAX_BOUNCES_LEFT as u32) as u8;
             out.push(Photon::with_spectrum(
                 hit.point,
                 photon.power,
                 ray.dir,
                 bsdf.normal(),
-                photon.flags,
+                photon.flags | left << 4,
             ));
         }
         let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)?;
+        // Photons carry flux the adjoint way: with an interpolated normal the sample's weight
+        // needs Veach's correction (1 on flat geometry).
+        let correction = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi);
+        let weight = sample.weight * correction.unwrap_or(0.0);
         // Survive with the probability of the throughput kept, so flux stays nearly constant.
-        let q = sample.weight.max_element().min(1.0);
+        let q = weight.max_element().min(1.0);
         if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
             return None;
         }
-        photon.power *= sample.weight / q;
+        photon.power *= weight / q;
         if sample.dispersive && photon.flags & DISPERSED == 0 {
             let mut terminated = false;
             self.wl.terminate_secondary(&mut photon.power, &mut terminated);
