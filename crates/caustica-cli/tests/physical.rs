@@ -44,7 +44,7 @@ fn exr(path: &Path) -> Vec<f32> {
 /// added in another order, so equality is to rounding).
 #[test]
 fn merged_halves_equal_one_full_run() {
-    for integrator in ["ppm", "gi", "path", "lt"] {
+    for integrator in ["ppm", "gi", "path", "lt", "vcm"] {
         let dir = temp_dir(&format!("merge-{integrator}"));
         render(
             &dir,

@@ -190,7 +190,8 @@ impl<'a> Vcm<'a> {
             sensor: Sensor::new(camera, width, height),
             emitters: Emitters::new(scene.lights()),
             spectral: settings_spectral(&settings.spectral, scene),
-            max_length: settings.max_depth.saturating_add(2),
+            // Segments: one more than the surfaces light may scatter at.
+            max_length: super::config::scattering_surfaces(settings.max_depth).saturating_add(1),
             radius,
             light_paths: settings
                 .light_paths_per_pass
