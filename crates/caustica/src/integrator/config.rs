@@ -473,6 +473,7 @@ mod tests {
             Integrator::Ppm(s) => s.max_depth,
             Integrator::Gi(s) => s.max_depth,
             Integrator::Lt(s) => s.max_depth,
+            Integrator::Vcm(s) => s.max_depth,
         }
     }
 
@@ -489,7 +490,12 @@ mod tests {
         assert_eq!(depths(&with(IntegratorKind::Path, Some(8))), 9);
         assert_eq!(depths(&with(IntegratorKind::Path, Some(0))), 1);
         assert_eq!(depths(&with(IntegratorKind::Path, None)), 65);
-        for kind in [IntegratorKind::Ppm, IntegratorKind::Gi, IntegratorKind::Lt] {
+        for kind in [
+            IntegratorKind::Ppm,
+            IntegratorKind::Gi,
+            IntegratorKind::Lt,
+            IntegratorKind::Vcm,
+        ] {
             assert_eq!(depths(&with(kind, Some(8))), 8);
             assert_eq!(depths(&with(kind, None)), 64);
         }
