@@ -647,6 +647,33 @@ impl LightSet {
     }
 }
 
+/// The radiance the emissive object `light` sends from its point `sample` (in direction `wi`,
+/// `distance` from `hit`) to `hit`, or `None` if something is in between. A uniform emitter
+/// needs only an occlusion test short of the point; a textured one the closest hit, which must
+/// be that point, to read the radiance there.
+pub(crate) fn visible_emission(
+    scene: &Scene,
+    light: &AreaLight,
+    hit: &SurfaceHit,
+    sample: &area::AreaSample,
+    wi: Vec3,
+    distance: f32,
+    wl: &Wavelengths,
+) -> Option<Spectrum> {
+    if light.uniform {
+        return scene
+            .unoccluded(hit, wi, distance)
+            .then(|| emission::area_radiance(light, scene, sample, wl));
+    }
+    let origin = hit.ray_origin(wi);
+    let ray = Ray::new(origin, wi);
+    let isect = scene.intersect(&ray, f32::INFINITY)?;
+    if isect.prim != sample.prim || (isect.t - (sample.point - origin).length()).abs() > 1e-3 * (1.0 + distance) {
+        return None;
+    }
+    Some(scene.emission_spectrum(&scene.surface(&ray, &isect), wl))
+}
+
 /// A point on an emissive object for lighting `p`, visibility included.
 fn sample_area_direct(
     scene: &Scene,
@@ -665,15 +692,7 @@ fn sample_area_direct(
         return None;
     }
     let wi = to / d;
-    // The closest hit towards the sampled point must be that point: this tests visibility
-    // and reads the emitted radiance there (textures included).
-    let origin = hit.ray_origin(wi);
-    let ray = Ray::new(origin, wi);
-    let isect = scene.intersect(&ray, f32::INFINITY)?;
-    if isect.prim != sample.prim || (isect.t - (sample.point - origin).length()).abs() > 1e-3 * (1.0 + d) {
-        return None;
-    }
-    let le = scene.emission_spectrum(&scene.surface(&ray, &isect), wl);
+    let le = visible_emission(scene, light, hit, &sample, wi, d, wl)?;
     let pdf = p_pick * drawn.pdf_solid;
     Some(DirectSample {
         wi,

@@ -6,21 +6,10 @@ mod common;
 
 use caustica::film::Film;
 use caustica::integrator::lt::{LightTracer, LtSettings};
-use caustica::integrator::{partial::Accumulator, Progressive};
+use caustica::integrator::Progressive;
 use caustica::math::Vec3;
-use common::{control, rel, scene};
+use common::{control, load_reference, rel, render_passes, scene};
 use std::f32::consts::PI;
-use std::path::PathBuf;
-
-/// Renders passes `first..end` and returns their sums.
-fn render(renderer: &dyn Progressive, width: usize, height: usize, first: u64, end: u64) -> Accumulator {
-    let mut acc = Accumulator::new(width, height, "test");
-    for pass in first..end {
-        let pixels = renderer.render_pass(pass, control()).expect("not cancelled");
-        acc.add(pass, &pixels);
-    }
-    acc
-}
 
 /// A point light of intensity I at height 1 over a Lambertian floor of albedo ρ, seen from
 /// straight above: each floor point sends L = ρ/π · I cos θ / d² towards the eye.
@@ -81,7 +70,7 @@ fn light_tracing_matches_a_point_light_over_a_diffuse_plane() {
             ..LtSettings::default()
         };
         let lt = LightTracer::new(&s, settings, 32, 32, 5);
-        let film = render(&lt, 32, 32, 0, 96).film();
+        let film = render_passes(&lt, 32, 32, 0, 96).film();
         let err = plane_error(&film, &expected);
         eprintln!("spectral {spectral}: worst block error {:.2}%", 100.0 * err);
         assert!(err < 0.02, "spectral {spectral}: {:.2}%", 100.0 * err);
@@ -110,17 +99,13 @@ fn light_tracing_is_deterministic_and_merges() {
     let (one, two) = (run(1), run(2));
     assert!(one.iter().any(|p| p.x > 0.0));
     assert_eq!(one, two);
-    let whole = render(&lt, 32, 32, 0, 4);
-    let mut first = render(&lt, 32, 32, 0, 2);
-    first.merge(&render(&lt, 32, 32, 2, 4)).unwrap();
+    let whole = render_passes(&lt, 32, 32, 0, 4);
+    let mut first = render_passes(&lt, 32, 32, 0, 2);
+    first.merge(&render_passes(&lt, 32, 32, 2, 4)).unwrap();
     assert_eq!(first.passes, whole.passes);
     for (a, b) in first.film().pixels.iter().zip(&whole.film().pixels) {
         assert!((*a - *b).abs().max_element() <= 1e-6 * a.abs().max_element().max(1.0));
     }
-}
-
-fn reference_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference")
 }
 
 type Region = (&'static str, (usize, usize), (usize, usize));
@@ -148,14 +133,8 @@ const REFERENCE_PHOTON_DEPTH: u32 = 8;
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn lt_converges_to_the_cornell_point_light_reference() {
-    let dir = reference_dir();
-    let text = std::fs::read_to_string(dir.join("cornell_caustics_point.ray")).unwrap();
-    let (w, h, pixels) = caustica::image_io::read_exr(&dir.join("cornell_caustics_point_ref.exr")).unwrap();
-    let reference = Film {
-        width: w,
-        height: h,
-        pixels,
-    };
+    let (text, reference) = load_reference("cornell_caustics_point");
+    let (w, h) = (reference.width, reference.height);
     let s = scene(&text);
     let settings = LtSettings {
         photons_per_pass: 1_000_000,
@@ -163,7 +142,7 @@ fn lt_converges_to_the_cornell_point_light_reference() {
         ..LtSettings::default()
     };
     let lt = LightTracer::new(&s, settings, w, h, 21);
-    let film = render(&lt, w, h, 0, PASSES).film();
+    let film = render_passes(&lt, w, h, 0, PASSES).film();
     let mut worst = 0.0f32;
     let mut text = String::new();
     for (name, rows, cols) in REGIONS {

@@ -12,18 +12,7 @@ use caustica::integrator::path::{PathSettings, PathTracer};
 use caustica::integrator::ppm::{Ppm, PpmSettings};
 use caustica::integrator::{partial::Accumulator, Progressive, RenderConfig, RenderSession};
 use caustica::math::Vec3;
-use common::{control, rel, scene};
-use std::path::PathBuf;
-
-/// Renders passes `first..end` and returns their mean.
-fn render(renderer: &dyn Progressive, width: usize, height: usize, first: u64, end: u64) -> Accumulator {
-    let mut acc = Accumulator::new(width, height, "test");
-    for pass in first..end {
-        let pixels = renderer.render_pass(pass, control()).expect("not cancelled");
-        acc.add(pass, &pixels);
-    }
-    acc
-}
+use common::{control, load_reference, rel, render_passes, scene};
 
 fn mean(film: &Film) -> Vec3 {
     film.region_mean((0, film.height - 1), (0, film.width - 1))
@@ -153,7 +142,7 @@ fn photons_see_shading_normals_as_camera_paths_do() {
     let s = scene(LEANING_NORMALS);
     let size = 32;
     let path = PathTracer::new(&s, PathSettings::default(), size, size, 3);
-    let reference = mean(&render(&path, size, size, 0, 1024).film());
+    let reference = mean(&render_passes(&path, size, size, 0, 1024).film());
     let lt = LightTracer::new(
         &s,
         LtSettings {
@@ -174,18 +163,12 @@ fn photons_see_shading_normals_as_camera_paths_do() {
         size,
         5,
     );
-    let lt = mean(&render(&lt, size, size, 0, 16).film());
-    let ppm = mean(&render(&ppm, size, size, 0, 16).film());
+    let lt = mean(&render_passes(&lt, size, size, 0, 16).film());
+    let ppm = mean(&render_passes(&ppm, size, size, 0, 16).film());
     eprintln!("floor: path {reference:?}, lt {lt:?}, ppm {ppm:?}");
     assert!(reference.x > 0.0);
     assert_close("lt", lt, reference, 0.02);
     assert_close("ppm", ppm, reference, 0.02);
-}
-
-/// The independent renderer's references; tests that read them are ignored without them
-/// (build.rs).
-fn reference_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference")
 }
 
 /// A named box of rows and columns (inclusive, from the top-left).
@@ -202,19 +185,6 @@ const WALLS: [Region; 4] = [
 const CAUSTIC: Region = ("glass caustic", (135, 139), (41, 45));
 const SHADOW: Region = ("shadow", (150, 156), (112, 132));
 const FLOOR: Region = ("lit floor", (150, 158), (60, 90));
-
-fn load_reference(dir: &std::path::Path, name: &str) -> (String, Film) {
-    let text = std::fs::read_to_string(dir.join(format!("{name}.ray"))).unwrap();
-    let (w, h, pixels) = caustica::image_io::read_exr(&dir.join(format!("{name}_ref.exr"))).unwrap();
-    (
-        text,
-        Film {
-            width: w,
-            height: h,
-            pixels,
-        },
-    )
-}
 
 /// Relative error of a region's mean (over its pixels and channels) against the reference.
 fn region_error(film: &Film, reference: &Film, region: Region) -> f32 {
@@ -268,8 +238,7 @@ fn ppm_settings(photons: u64) -> PpmSettings {
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn cornell_area_light_ppm_converges_to_the_reference() {
-    let dir = reference_dir();
-    let (text, reference) = load_reference(&dir, "cornell_caustics_area");
+    let (text, reference) = load_reference("cornell_caustics_area");
     let s = scene(&text);
     let ppm = Ppm::new(&s, ppm_settings(200_000), SIZE, SIZE, 11);
     let mut acc = Accumulator::new(SIZE, SIZE, "test");
@@ -302,8 +271,7 @@ fn cornell_area_light_ppm_converges_to_the_reference() {
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn cornell_area_light_path_matches_the_reference() {
-    let dir = reference_dir();
-    let (text, reference) = load_reference(&dir, "cornell_caustics_area");
+    let (text, reference) = load_reference("cornell_caustics_area");
     let s = scene(&text);
     let settings = PathSettings {
         specular_camera_paths: false,
@@ -311,7 +279,7 @@ fn cornell_area_light_path_matches_the_reference() {
         ..PathSettings::default()
     };
     let path = PathTracer::new(&s, settings, SIZE, SIZE, 12);
-    let film = render(&path, SIZE, SIZE, 0, 128).film();
+    let film = render_passes(&path, SIZE, SIZE, 0, 128).film();
     // The back wall is lit by direct and diffuse light; the floor, the side walls and the
     // ceiling also get the mirror's and the glass's caustics, which a path tracer finds only by
     // hitting the small light after a specular bounce: rare, bright samples that need far more
@@ -331,8 +299,7 @@ fn cornell_area_light_path_matches_the_reference() {
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn cornell_area_light_gi_matches_the_reference() {
-    let dir = reference_dir();
-    let (text, reference) = load_reference(&dir, "cornell_caustics_area");
+    let (text, reference) = load_reference("cornell_caustics_area");
     let s = scene(&text);
     let settings = GiSettings {
         photons_per_pass: 200_000,
@@ -341,7 +308,7 @@ fn cornell_area_light_gi_matches_the_reference() {
         ..GiSettings::default()
     };
     let gi = Gi::new(&s, settings, SIZE, SIZE, 1);
-    let film = render(&gi, SIZE, SIZE, 0, 64).film();
+    let film = render_passes(&gi, SIZE, SIZE, 0, 64).film();
     let mut regions = WALLS.to_vec();
     regions.push(FLOOR);
     let (worst, text) = report(&film, &reference, &regions);
@@ -358,11 +325,10 @@ fn cornell_area_light_gi_matches_the_reference() {
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn point_light_caustic_is_the_limit_of_shrinking_area_lights() {
-    let dir = reference_dir();
-    let (text, reference) = load_reference(&dir, "cornell_caustics_point");
+    let (text, reference) = load_reference("cornell_caustics_point");
     let s = scene(&text);
     let ppm = Ppm::new(&s, ppm_settings(100_000), SIZE, SIZE, 14);
-    let film = render(&ppm, SIZE, SIZE, 0, 48).film();
+    let film = render_passes(&ppm, SIZE, SIZE, 0, 48).film();
     let (err, text_report) = report(&film, &reference, &[CAUSTIC, FLOOR, SHADOW]);
     eprintln!("ppm, point light:\n{text_report}");
     assert!(err < 0.03, "{text_report}");
@@ -381,7 +347,7 @@ fn point_light_caustic_is_the_limit_of_shrinking_area_lights() {
     let path = PathTracer::new(&s, settings, SIZE, SIZE, 15);
     // Enough passes that path noise (about ±20% at 8) cannot reach the bound: the region's
     // light without the caustic is about 0.45 of the point light's.
-    let without = caustic(&render(&path, SIZE, SIZE, 0, 64).film());
+    let without = caustic(&render_passes(&path, SIZE, SIZE, 0, 64).film());
     assert!(
         without < 0.5 * point,
         "path cannot render a point light's caustic: {without} vs {point}"
@@ -399,7 +365,7 @@ fn point_light_caustic_is_the_limit_of_shrinking_area_lights() {
         let area_text = format!("{}{}{}", &text[..start], light, &text[end..]);
         let s = scene(&area_text);
         let ppm = Ppm::new(&s, ppm_settings(100_000), SIZE, SIZE, 16);
-        let c = caustic(&render(&ppm, SIZE, SIZE, 0, 48).film());
+        let c = caustic(&render_passes(&ppm, SIZE, SIZE, 0, 48).film());
         eprintln!("radius {radius}: caustic {c:.4} vs point {point:.4}");
         errors.push(rel(c, point));
     }

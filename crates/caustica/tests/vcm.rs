@@ -10,21 +10,10 @@ use caustica::film::Film;
 use caustica::integrator::lt::{LightTracer, LtSettings};
 use caustica::integrator::path::{PathSettings, PathTracer};
 use caustica::integrator::vcm::{Vcm, VcmSettings};
-use caustica::integrator::{partial::Accumulator, Progressive};
+use caustica::integrator::Progressive;
 use caustica::math::Vec3;
-use common::{control, rel, scene};
+use common::{control, load_reference, rel, render_passes, scene};
 use std::f32::consts::PI;
-use std::path::PathBuf;
-
-/// Renders passes `first..end` and returns their sums.
-fn render(renderer: &dyn Progressive, width: usize, height: usize, first: u64, end: u64) -> Accumulator {
-    let mut acc = Accumulator::new(width, height, "test");
-    for pass in first..end {
-        let pixels = renderer.render_pass(pass, control()).expect("not cancelled");
-        acc.add(pass, &pixels);
-    }
-    acc
-}
 
 /// A point light over a Lambertian floor seen from above (as in tests/light_tracing.rs): each
 /// floor point sends L = ρ/π · I cos θ / d² towards the eye.
@@ -73,7 +62,7 @@ fn vcm_matches_a_point_light_over_a_diffuse_plane() {
             ..VcmSettings::default()
         };
         let vcm = Vcm::new(&s, settings, 32, 32, 5);
-        let film = render(&vcm, 32, 32, 0, 16).film();
+        let film = render_passes(&vcm, 32, 32, 0, 16).film();
         let err = plane_error(&s, &film);
         eprintln!(
             "spectral {spectral}, connections {connections}: worst block {:.2}%",
@@ -131,7 +120,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
         32,
         1,
     );
-    let reference = quadrants(&render(&path, 32, 32, 0, 2048).film());
+    let reference = quadrants(&render_passes(&path, 32, 32, 0, 2048).film());
     for connections in [false, true] {
         let settings = VcmSettings {
             light_paths_per_pass: Some(8192),
@@ -140,7 +129,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
             ..VcmSettings::default()
         };
         let vcm = Vcm::new(&s, settings, 32, 32, 2);
-        let got = quadrants(&render(&vcm, 32, 32, 0, 256).film());
+        let got = quadrants(&render_passes(&vcm, 32, 32, 0, 256).film());
         for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
             eprintln!("connections {connections}, quadrant {i}: vcm {g:.4} path {r:.4}");
             assert!(
@@ -160,7 +149,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
         32,
         3,
     );
-    let got = quadrants(&render(&lt, 32, 32, 0, 32).film());
+    let got = quadrants(&render_passes(&lt, 32, 32, 0, 32).film());
     // The upper quadrants see the lamp, which light tracing cannot.
     for i in 2..4 {
         eprintln!("quadrant {i}: lt {:.4} path {:.4}", got[i], reference[i]);
@@ -192,18 +181,14 @@ fn vcm_is_deterministic_and_merges() {
         let (one, two) = (run(1), run(2));
         assert!(one.iter().any(|p| p.x > 0.0));
         assert_eq!(one, two);
-        let whole = render(&vcm, 32, 32, 0, 4);
-        let mut first = render(&vcm, 32, 32, 0, 2);
-        first.merge(&render(&vcm, 32, 32, 2, 4)).unwrap();
+        let whole = render_passes(&vcm, 32, 32, 0, 4);
+        let mut first = render_passes(&vcm, 32, 32, 0, 2);
+        first.merge(&render_passes(&vcm, 32, 32, 2, 4)).unwrap();
         assert_eq!(first.passes, whole.passes);
         for (a, b) in first.film().pixels.iter().zip(&whole.film().pixels) {
             assert!((*a - *b).abs().max_element() <= 1e-6 * a.abs().max_element().max(1.0));
         }
     }
-}
-
-fn reference_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference")
 }
 
 type Region = (&'static str, (usize, usize), (usize, usize));
@@ -231,23 +216,16 @@ const REFERENCE_DEPTH: u32 = 8;
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn vcm_converges_to_the_cornell_references() {
-    let dir = reference_dir();
     for light in ["point", "area"] {
-        let text = std::fs::read_to_string(dir.join(format!("cornell_caustics_{light}.ray"))).unwrap();
-        let (w, h, pixels) =
-            caustica::image_io::read_exr(&dir.join(format!("cornell_caustics_{light}_ref.exr"))).unwrap();
-        let reference = Film {
-            width: w,
-            height: h,
-            pixels,
-        };
+        let (text, reference) = load_reference(&format!("cornell_caustics_{light}"));
+        let (w, h) = (reference.width, reference.height);
         let s = scene(&text);
         let settings = VcmSettings {
             max_depth: REFERENCE_DEPTH,
             ..VcmSettings::default()
         };
         let vcm = Vcm::new(&s, settings, w, h, 21);
-        let film = render(&vcm, w, h, 0, PASSES).film();
+        let film = render_passes(&vcm, w, h, 0, PASSES).film();
         let mut text = String::new();
         let mut failed = false;
         for (name, rows, cols) in REGIONS {

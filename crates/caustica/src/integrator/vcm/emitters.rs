@@ -260,17 +260,7 @@ impl Emitters {
                     return None;
                 }
                 let wi = to / distance;
-                // The closest hit towards the sampled point must be that point: visibility,
-                // and the radiance it sends (textures included).
-                let origin = hit.ray_origin(wi);
-                let ray = Ray::new(origin, wi);
-                let isect = scene.intersect(&ray, f32::INFINITY)?;
-                if isect.prim != point.prim
-                    || (isect.t - (point.point - origin).length()).abs() > 1e-3 * (1.0 + distance)
-                {
-                    return None;
-                }
-                let le = scene.emission_spectrum(&scene.surface(&ray, &isect), wl);
+                let le = crate::light::visible_emission(scene, light, hit, &point, wi, distance, wl)?;
                 let direct_pdf = choice * drawn.pdf_solid;
                 let cos_light = point.normal.dot(wi).abs();
                 Some(DirectSample {
