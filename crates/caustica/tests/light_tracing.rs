@@ -6,9 +6,8 @@ mod common;
 
 use caustica::film::Film;
 use caustica::integrator::lt::{LightTracer, LtSettings};
-use caustica::integrator::Progressive;
 use caustica::math::Vec3;
-use common::{control, load_reference, rel, render_passes, scene};
+use common::{assert_deterministic_and_merges, load_reference, rel, render_passes, report, scene, Region};
 use std::f32::consts::PI;
 
 /// A point light of intensity I at height 1 over a Lambertian floor of albedo ρ, seen from
@@ -91,24 +90,8 @@ fn light_tracing_is_deterministic_and_merges() {
         photons_per_pass: 30_000,
         ..LtSettings::default()
     };
-    let lt = LightTracer::new(&s, settings, 32, 32, 7);
-    let run = |threads| {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| lt.render_pass(3, control()).unwrap())
-    };
-    let (one, two) = (run(1), run(2));
-    assert!(one.iter().any(|p| p.x > 0.0));
-    assert_eq!(one, two);
-    let whole = render_passes(&lt, 32, 32, 0, 4);
-    let mut first = render_passes(&lt, 32, 32, 0, 2);
-    first.merge(&render_passes(&lt, 32, 32, 2, 4)).unwrap();
-    assert_eq!(first.passes, whole.passes);
-    for (a, b) in first.film().pixels.iter().zip(&whole.film().pixels) {
-        assert!((*a - *b).abs().max_element() <= 1e-6 * a.abs().max_element().max(1.0));
-    }
+    assert_deterministic_and_merges(&LightTracer::new(&s, settings, 32, 32, 7), 32, 32);
 }
-
-type Region = (&'static str, (usize, usize), (usize, usize));
 
 /// The reference README's regions (rows, columns inclusive), plus the floor's shadow beside the
 /// mirror sphere, as in tests/physical.rs.
@@ -143,14 +126,7 @@ fn lt_converges_to_the_cornell_point_light_reference() {
     };
     let lt = LightTracer::new(&s, settings, w, h, 21);
     let film = render_passes(&lt, w, h, 0, PASSES).film();
-    let mut worst = 0.0f32;
-    let mut text = String::new();
-    for (name, rows, cols) in REGIONS {
-        let (got, want) = (film.region_mean(rows, cols), reference.region_mean(rows, cols));
-        let err = rel(got.x + got.y + got.z, want.x + want.y + want.z);
-        worst = worst.max(err);
-        text += &format!("  {name}: {got:.4} vs {want:.4} ({:.2}%)\n", 100.0 * err);
-    }
+    let (worst, text) = report(&film, &reference, &REGIONS);
     eprintln!("lt, point light, {PASSES} passes:\n{text}");
     assert!(worst < 0.02, "{text}");
 }

@@ -12,7 +12,7 @@ use caustica::integrator::path::{PathSettings, PathTracer};
 use caustica::integrator::ppm::{Ppm, PpmSettings};
 use caustica::integrator::{partial::Accumulator, Progressive, RenderConfig, RenderSession};
 use caustica::math::Vec3;
-use common::{control, load_reference, rel, render_passes, scene};
+use common::{control, load_reference, rel, render_passes, report, scene, Region};
 
 fn mean(film: &Film) -> Vec3 {
     film.region_mean((0, film.height - 1), (0, film.width - 1))
@@ -40,7 +40,7 @@ fn assert_close(what: &str, got: Vec3, expected: Vec3, tolerance: f32) {
 
 /// Renders the furnace with `passes` passes of a 24×24 image and checks the mean radiance.
 fn furnace(name: &str, renderer: &dyn Progressive, passes: u64, tolerance: f32) {
-    let got = mean(&render(renderer, 24, 24, 0, passes).film());
+    let got = mean(&render_passes(renderer, 24, 24, 0, passes).film());
     assert_close(name, got, furnace_expected(), tolerance);
 }
 
@@ -171,9 +171,6 @@ fn photons_see_shading_normals_as_camera_paths_do() {
     assert_close("ppm", ppm, reference, 0.02);
 }
 
-/// A named box of rows and columns (inclusive, from the top-left).
-type Region = (&'static str, (usize, usize), (usize, usize));
-
 /// Regions of the reference README (rows, columns inclusive), plus a shadow on the floor
 /// beside the mirror sphere.
 const WALLS: [Region; 4] = [
@@ -185,30 +182,6 @@ const WALLS: [Region; 4] = [
 const CAUSTIC: Region = ("glass caustic", (135, 139), (41, 45));
 const SHADOW: Region = ("shadow", (150, 156), (112, 132));
 const FLOOR: Region = ("lit floor", (150, 158), (60, 90));
-
-/// Relative error of a region's mean (over its pixels and channels) against the reference.
-fn region_error(film: &Film, reference: &Film, region: Region) -> f32 {
-    let got = film.region_mean(region.1, region.2);
-    let want = reference.region_mean(region.1, region.2);
-    rel(got.x + got.y + got.z, want.x + want.y + want.z)
-}
-
-fn report(film: &Film, reference: &Film, regions: &[Region]) -> (f32, String) {
-    let mut worst = 0.0f32;
-    let mut text = String::new();
-    for r in regions {
-        let err = region_error(film, reference, *r);
-        worst = worst.max(err);
-        text += &format!(
-            "  {}: {:.4} vs {:.4} ({:.2}%)\n",
-            r.0,
-            film.region_mean(r.1, r.2),
-            reference.region_mean(r.1, r.2),
-            100.0 * err
-        );
-    }
-    (worst, text)
-}
 
 const SIZE: usize = 160;
 

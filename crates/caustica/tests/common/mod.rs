@@ -59,3 +59,50 @@ pub fn load_reference(name: &str) -> (String, Film) {
         },
     )
 }
+
+/// One pass of `renderer` is the same, bit for bit, on one thread and on two (and not black);
+/// passes split over two runs merge into the sums of one run.
+pub fn assert_deterministic_and_merges(renderer: &dyn Progressive, width: usize, height: usize) {
+    let run = |threads| {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| renderer.render_pass(3, control()).unwrap())
+    };
+    let (one, two) = (run(1), run(2));
+    assert!(one.iter().any(|p| p.x > 0.0));
+    assert_eq!(one, two);
+    let whole = render_passes(renderer, width, height, 0, 4);
+    let mut first = render_passes(renderer, width, height, 0, 2);
+    first.merge(&render_passes(renderer, width, height, 2, 4)).unwrap();
+    assert_eq!(first.passes, whole.passes);
+    for (a, b) in first.film().pixels.iter().zip(&whole.film().pixels) {
+        assert!((*a - *b).abs().max_element() <= 1e-6 * a.abs().max_element().max(1.0));
+    }
+}
+
+/// A named box of rows and columns (inclusive, from the top-left).
+pub type Region = (&'static str, (usize, usize), (usize, usize));
+
+/// Relative error of a region's mean (over its pixels and channels) against the reference.
+pub fn region_error(film: &Film, reference: &Film, region: Region) -> f32 {
+    let got = film.region_mean(region.1, region.2);
+    let want = reference.region_mean(region.1, region.2);
+    rel(got.x + got.y + got.z, want.x + want.y + want.z)
+}
+
+/// The worst region error, and a line per region for the log.
+pub fn report(film: &Film, reference: &Film, regions: &[Region]) -> (f32, String) {
+    let mut worst = 0.0f32;
+    let mut text = String::new();
+    for r in regions {
+        let err = region_error(film, reference, *r);
+        worst = worst.max(err);
+        text += &format!(
+            "  {}: {:.4} vs {:.4} ({:.2}%)\n",
+            r.0,
+            film.region_mean(r.1, r.2),
+            reference.region_mean(r.1, r.2),
+            100.0 * err
+        );
+    }
+    (worst, text)
+}
