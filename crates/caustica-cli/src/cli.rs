@@ -154,7 +154,8 @@ pub struct PhotonOptions {
     /// Photons to store per light, comma separated, instead of sharing by power.
     #[arg(long, value_delimiter = ',')]
     pub photons_per_light: Option<Vec<usize>>,
-    /// Emit photons in all directions instead of aiming at mirrors and glass.
+    /// Emit photons in all directions instead of aiming at mirrors and glass (course model;
+    /// vcm: none of its light subpaths aimed).
     #[arg(long)]
     pub no_aim: bool,
     /// Largest photon map in MB (photons are 24 bytes, the kd-tree under 1 byte each); larger

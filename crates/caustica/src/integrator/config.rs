@@ -333,6 +333,7 @@ impl RenderConfig {
                 },
                 max_depth: depth,
                 connections: self.vertex_connections,
+                aim: !self.no_aim,
                 spectral: self.spectral,
             }),
         };
@@ -389,7 +390,7 @@ impl RenderConfig {
         if self.photons_per_light.is_some() {
             ignored.push("--photons-per-light");
         }
-        if self.no_aim {
+        if self.no_aim && self.integrator != Some(IntegratorKind::Vcm) {
             ignored.push("--no-aim");
         }
         if self.max_emitted.is_some() {

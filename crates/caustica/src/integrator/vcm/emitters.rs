@@ -6,13 +6,22 @@
 //! directional lights) and the course forks' lights with a size are reached from the camera
 //! only, by next-event estimation and, for the sky and suns, by BSDF samples that escape,
 //! weighted against each other as in the path tracer.
+//!
+//! Aiming: a share of the light subpaths leaves towards the bounding spheres of the mirrors and
+//! glass (the caustics' sources), the rest everywhere the light shines ([`Aim`]). Every density
+//! below is the mixture's, for the subpath's throughput and for every strategy's weight alike,
+//! so aiming changes where the samples go (many more caustic paths), never the expected image.
 
-use crate::light::emission::area_radiance;
+use crate::light::emission::{area_radiance, Target};
 use crate::light::{spot_profile, AreaLight, Light, LightSet};
 use crate::math::{offset_origin, Frame, Ray, Vec3};
-use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, uniform_cone_pdf, Distribution1D, Rng};
+use crate::sampling::{
+    sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf, uniform_sphere_pdf,
+    Distribution1D, Rng,
+};
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
+use glam::Vec2;
 use std::f32::consts::PI;
 
 /// The lights that start light subpaths, chosen in proportion to their power.
@@ -22,6 +31,88 @@ pub struct Emitters {
     /// Light numbers of the emitters, and their choice distribution.
     numbers: Vec<usize>,
     choice: Option<Distribution1D>,
+    aim: Option<Aim>,
+}
+
+/// Where a share of the light subpaths is aimed: cones from the light point towards the
+/// targets, each chosen in proportion to its solid angle.
+#[derive(Clone, Debug)]
+pub struct Aim {
+    targets: Vec<Target>,
+    /// The share of subpaths aimed (the rest leave as without aiming).
+    share: f32,
+}
+
+/// More targets than this are aimed at as one sphere around them all: every density
+/// evaluation visits each target.
+const MAX_TARGETS: usize = 8;
+
+impl Aim {
+    /// Aiming `share` of the subpaths at `targets` (`None` when there is nothing to aim at).
+    pub fn new(targets: &[Target], share: f32) -> Option<Aim> {
+        if targets.is_empty() || !(share > 0.0 && share <= 1.0) {
+            return None;
+        }
+        let targets = if targets.len() <= MAX_TARGETS {
+            targets.to_vec()
+        } else {
+            let center = targets.iter().map(|t| t.center).sum::<Vec3>() / targets.len() as f32;
+            let radius = targets
+                .iter()
+                .map(|t| (t.center - center).length() + t.radius)
+                .fold(0.0, f32::max);
+            vec![Target { center, radius }]
+        };
+        Some(Aim { targets, share })
+    }
+
+    /// The cone of directions from `from` that meet `target`: its axis and the cosine of its
+    /// half-angle (−1, every direction, from inside).
+    fn cone(from: Vec3, target: &Target) -> (Vec3, f32) {
+        let to = target.center - from;
+        let d2 = to.length_squared();
+        let r2 = target.radius * target.radius;
+        if d2 <= r2 || d2 == 0.0 {
+            return (Vec3::Z, -1.0);
+        }
+        (to / d2.sqrt(), (1.0 - r2 / d2).max(0.0).sqrt())
+    }
+
+    /// A direction from `from` into one of the cones (`None`: they have no solid angle).
+    fn sample(&self, from: Vec3, u_pick: f32, u: Vec2) -> Option<Vec3> {
+        let total: f32 = self.targets.iter().map(|t| 1.0 - Self::cone(from, t).1).sum();
+        if total.is_nan() || total <= 0.0 {
+            return None;
+        }
+        let mut x = u_pick * total;
+        for (i, t) in self.targets.iter().enumerate() {
+            let (axis, cos_max) = Self::cone(from, t);
+            let w = 1.0 - cos_max;
+            if x < w || i + 1 == self.targets.len() {
+                return Some(sample_uniform_cone(u, axis, cos_max));
+            }
+            x -= w;
+        }
+        None
+    }
+
+    /// The solid-angle density of [`Aim::sample`] at `dir`: each cone holding `dir` adds
+    /// its share 1/(2π Σ(1 − cos)) (its weight over its own solid angle).
+    fn pdf(&self, from: Vec3, dir: Vec3) -> f32 {
+        let (mut total, mut inside) = (0.0, 0u32);
+        for t in &self.targets {
+            let (axis, cos_max) = Self::cone(from, t);
+            total += 1.0 - cos_max;
+            if dir.dot(axis) >= cos_max {
+                inside += 1;
+            }
+        }
+        if total > 0.0 {
+            inside as f32 / (2.0 * PI * total)
+        } else {
+            0.0
+        }
+    }
 }
 
 /// The start of a light subpath.
@@ -63,8 +154,8 @@ pub struct DirectSample {
 }
 
 impl Emitters {
-    /// The emitters of `scene`'s lights.
-    pub fn new(lights: &LightSet) -> Emitters {
+    /// The emitters of `scene`'s lights, aimed as `aim` says.
+    pub fn new(lights: &LightSet, aim: Option<Aim>) -> Emitters {
         let radius = lights.scene_sphere().1;
         let powers: Vec<f32> = lights
             .iter()
@@ -91,6 +182,34 @@ impl Emitters {
             probability,
             numbers,
             choice,
+            aim,
+        }
+    }
+
+    /// Solid-angle density of a direction `dir` leaving `from`, whose density without aiming
+    /// is `plain`: the mixture of that and the aimed cones.
+    fn direction_pdf(&self, from: Vec3, dir: Vec3, plain: f32) -> f32 {
+        match &self.aim {
+            None => plain,
+            Some(aim) => (1.0 - aim.share) * plain + aim.share * aim.pdf(from, dir),
+        }
+    }
+
+    /// Draws whether this subpath is aimed; if so, its direction from `from`.
+    fn aimed(&self, from: Vec3, rng: &mut Rng) -> Option<Option<Vec3>> {
+        let aim = self.aim.as_ref()?;
+        let (u_lobe, u_pick, u) = (rng.uniform(), rng.uniform(), rng.uniform2());
+        (u_lobe < aim.share).then(|| aim.sample(from, u_pick, u))
+    }
+
+    /// Solid-angle density, without aiming, of a point or spot light's direction `dir`.
+    fn point_plain_pdf(light: &Light, dir: Vec3) -> f32 {
+        match light {
+            Light::Spot {
+                direction, cos_outer, ..
+            } if dir.dot(*direction) < *cos_outer => 0.0,
+            Light::Spot { cos_outer, .. } => uniform_cone_pdf(*cos_outer),
+            _ => uniform_sphere_pdf(),
         }
     }
 
@@ -111,10 +230,13 @@ impl Emitters {
         let pick = self.probability[number];
         let (u, u_dir) = (rng.uniform2(), rng.uniform2());
         match scene.lights().get(number)? {
-            Light::Point { position, color, .. } => {
-                let dir = crate::sampling::sample_uniform_sphere(u);
-                let pdf = pick / (4.0 * PI);
-                Some(Emission {
+            light @ Light::Point { position, color, .. } => {
+                let dir = match self.aimed(*position, rng) {
+                    Some(aimed) => aimed?,
+                    None => sample_uniform_sphere(u),
+                };
+                let pdf = pick * self.direction_pdf(*position, dir, Self::point_plain_pdf(light, dir));
+                (pdf > 0.0).then(|| Emission {
                     ray: Ray::new(*position, dir),
                     throughput: wl.unbounded(*color) / pdf,
                     emission_pdf: pdf,
@@ -124,7 +246,7 @@ impl Emitters {
                     normal: dir,
                 })
             }
-            Light::Spot {
+            light @ Light::Spot {
                 position,
                 direction,
                 color,
@@ -133,9 +255,12 @@ impl Emitters {
                 exponent,
                 ..
             } => {
-                let dir = sample_uniform_cone(u, *direction, *cos_outer);
+                let dir = match self.aimed(*position, rng) {
+                    Some(aimed) => aimed?,
+                    None => sample_uniform_cone(u, *direction, *cos_outer),
+                };
                 let profile = spot_profile(dir.dot(*direction), *cos_inner, *cos_outer, *exponent);
-                let pdf = pick * uniform_cone_pdf(*cos_outer);
+                let pdf = pick * self.direction_pdf(*position, dir, Self::point_plain_pdf(light, dir));
                 (profile > 0.0 && pdf > 0.0).then(|| Emission {
                     ray: Ray::new(*position, dir),
                     throughput: wl.unbounded(*color) * (profile / pdf),
@@ -149,19 +274,35 @@ impl Emitters {
             Light::Area(light) => {
                 let sample = light.sample(scene, rng.uniform(), u)?;
                 let le = area_radiance(light, scene, &sample, wl);
-                // A face at random (only the outer one of a closed lamp), then a cosine-weighted
-                // direction.
-                let (side, u2) = if light.outward_only {
-                    (1.0, u_dir)
-                } else if u_dir.x < 0.5 {
-                    (1.0, glam::Vec2::new(u_dir.x * 2.0, u_dir.y))
-                } else {
-                    (-1.0, glam::Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y))
+                let (dir, normal) = match self.aimed(sample.point, rng) {
+                    Some(aimed) => {
+                        // Leaves by the face it points out of (a closed lamp only by its outer one).
+                        let dir = aimed?;
+                        let side = if dir.dot(sample.normal) >= 0.0 { 1.0 } else { -1.0 };
+                        if light.outward_only && side < 0.0 {
+                            return None;
+                        }
+                        (dir, sample.normal * side)
+                    }
+                    None => {
+                        // A face at random (only the outer one of a closed lamp), then a
+                        // cosine-weighted direction.
+                        let (side, u2) = if light.outward_only {
+                            (1.0, u_dir)
+                        } else if u_dir.x < 0.5 {
+                            (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y))
+                        } else {
+                            (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y))
+                        };
+                        let normal = sample.normal * side;
+                        (
+                            Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2)),
+                            normal,
+                        )
+                    }
                 };
-                let normal = sample.normal * side;
-                let dir = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2));
                 let cos = dir.dot(normal);
-                let pdf = pick * sample.pdf_area * cos / (PI * faces(light));
+                let pdf = pick * sample.pdf_area * self.direction_pdf(sample.point, dir, cos / (PI * faces(light)));
                 (cos > 0.0 && pdf > 0.0).then(|| Emission {
                     ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
                     throughput: le * (cos / pdf),
@@ -192,13 +333,14 @@ impl Emitters {
     }
 
     /// Emission's density (point × direction, choice included) of leaving emissive object
-    /// `light` (number `number`) at a point of unit normal `normal` in direction `dir`.
-    pub fn emission_pdf(&self, number: usize, light: &AreaLight, normal: Vec3, dir: Vec3) -> f32 {
+    /// `light` (number `number`) at `point`, of unit normal `normal`, in direction `dir`.
+    pub fn emission_pdf(&self, number: usize, light: &AreaLight, point: Vec3, normal: Vec3, dir: Vec3) -> f32 {
         let cos = normal.dot(dir);
         if light.outward_only && cos <= 0.0 {
             return 0.0;
         }
-        self.probability[number] * light.pdf_area(normal) * cos.abs() / (PI * faces(light))
+        let plain = cos.abs() / (PI * faces(light));
+        self.probability[number] * light.pdf_area(normal) * self.direction_pdf(point, dir, plain)
     }
 
     /// A next-event sample of emitter `number` for the point `hit`, visibility included.
@@ -215,7 +357,7 @@ impl Emitters {
         let emit = self.probability[number];
         let (u_pick, u) = (rng.uniform(), rng.uniform2());
         let p = hit.point;
-        let point_light = |position: Vec3, intensity: Vec3, dir_pdf: f32| {
+        let point_light = |light: &Light, position: Vec3, intensity: Vec3| {
             let to = position - p;
             let d2 = to.length_squared();
             if !(d2 > 0.0 && d2.is_finite()) || intensity == Vec3::ZERO {
@@ -223,6 +365,7 @@ impl Emitters {
             }
             let distance = d2.sqrt();
             let wi = to / distance;
+            let dir_pdf = self.direction_pdf(position, -wi, Self::point_plain_pdf(light, -wi));
             scene.unoccluded(hit, wi, distance).then(|| DirectSample {
                 wi,
                 distance,
@@ -234,8 +377,8 @@ impl Emitters {
             })
         };
         match lights.get(number)? {
-            Light::Point { position, color, .. } => point_light(*position, *color, 1.0 / (4.0 * PI)),
-            Light::Spot {
+            light @ Light::Point { position, color, .. } => point_light(light, *position, *color),
+            light @ Light::Spot {
                 position,
                 direction,
                 color,
@@ -249,7 +392,7 @@ impl Emitters {
                 if profile <= 0.0 {
                     return None;
                 }
-                point_light(*position, *color * profile, uniform_cone_pdf(*cos_outer))
+                point_light(light, *position, *color * profile)
             }
             Light::Area(light) => {
                 let drawn = light.sample_towards(scene, p, u_pick, u)?;
@@ -268,7 +411,7 @@ impl Emitters {
                     distance,
                     contribution: le / direct_pdf,
                     direct_pdf,
-                    emission_pdf: self.emission_pdf(number, light, point.normal, -wi),
+                    emission_pdf: self.emission_pdf(number, light, point.point, point.normal, -wi),
                     cos_light,
                     delta: false,
                 })
@@ -284,5 +427,82 @@ fn faces(light: &AreaLight) -> f32 {
         1.0
     } else {
         2.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn target(x: f32, y: f32, z: f32, radius: f32) -> Target {
+        Target {
+            center: Vec3::new(x, y, z),
+            radius,
+        }
+    }
+
+    #[test]
+    fn aimed_density_integrates_to_one_over_the_sphere() {
+        // Two overlapping cones and one apart, seen from the origin.
+        let aim = Aim::new(
+            &[
+                target(0.0, 0.0, -2.0, 0.5),
+                target(0.3, 0.0, -2.0, 0.4),
+                target(2.0, 1.0, 0.0, 0.3),
+            ],
+            1.0,
+        )
+        .unwrap();
+        let mut rng = Rng::new(7, 0);
+        let n = 400_000;
+        let mean: f64 = (0..n)
+            .map(|_| aim.pdf(Vec3::ZERO, sample_uniform_sphere(rng.uniform2())) as f64)
+            .sum::<f64>()
+            / n as f64;
+        let integral = mean * 4.0 * std::f64::consts::PI;
+        assert!((integral - 1.0).abs() < 0.01, "∫ pdf dω = {integral}");
+    }
+
+    #[test]
+    fn aimed_samples_follow_their_density() {
+        // Apart cones: E[1 / pdf] over the samples is the solid angle they cover, Σ 2π(1 − cos).
+        let targets = [
+            target(0.0, 0.0, -2.0, 0.5),
+            target(2.0, 1.0, 0.0, 0.3),
+            target(0.0, 3.0, 0.0, 0.2),
+        ];
+        let aim = Aim::new(&targets, 1.0).unwrap();
+        let from = Vec3::new(0.1, -0.2, 0.3);
+        let exact: f32 = targets.iter().map(|t| 2.0 * PI * (1.0 - Aim::cone(from, t).1)).sum();
+        let mut rng = Rng::new(11, 0);
+        let n = 200_000;
+        let mut sum = 0.0f64;
+        for _ in 0..n {
+            let dir = aim.sample(from, rng.uniform(), rng.uniform2()).unwrap();
+            let pdf = aim.pdf(from, dir);
+            assert!(pdf > 0.0, "a sample outside every cone: {dir:?}");
+            sum += 1.0 / pdf as f64;
+        }
+        let estimate = sum / n as f64;
+        assert!((estimate / exact as f64 - 1.0).abs() < 0.01, "{estimate} vs {exact}");
+    }
+
+    #[test]
+    fn from_inside_a_target_every_direction_is_aimed() {
+        let aim = Aim::new(&[target(0.0, 0.0, 0.0, 1.0)], 1.0).unwrap();
+        let pdf = aim.pdf(Vec3::new(0.1, 0.0, 0.0), Vec3::X);
+        assert!((pdf - uniform_sphere_pdf()).abs() < 1e-6, "{pdf}");
+    }
+
+    #[test]
+    fn many_targets_become_one_around_them_all() {
+        let targets: Vec<Target> = (0..20).map(|i| target(i as f32, 0.0, -5.0, 0.25)).collect();
+        let aim = Aim::new(&targets, 0.5).unwrap();
+        assert_eq!(aim.targets.len(), 1);
+        let all = aim.targets[0];
+        for t in &targets {
+            assert!((t.center - all.center).length() + t.radius <= all.radius * 1.0001);
+        }
+        assert!(Aim::new(&[], 0.5).is_none() && Aim::new(&targets, 0.0).is_none());
     }
 }
