@@ -647,19 +647,28 @@ impl LightSet {
     }
 }
 
-/// The radiance the emissive object `light` sends from its point `sample` (in direction `wi`,
-/// `distance` from `hit`) to `hit`, or `None` if something is in between: the closest hit
-/// towards the point must be that point, and the radiance is read there (textures included).
-/// An occlusion test short of the point instead lost a tenth of a small sphere light's light:
-/// the sphere itself lies within rounding of the test's end.
+/// The radiance the emissive object `light` sends from its point `drawn` (in direction `wi`,
+/// `distance` from `hit`) to `hit`, or `None` if something is in between. A uniform light's
+/// nearest point (a sphere drawn by its cone) needs only an occlusion test that skips the
+/// light's own primitive; otherwise the closest hit towards the point must be that point, and
+/// the radiance is read there (textures included). (An occlusion test short of the point
+/// that did not skip the light lost a tenth of a small sphere light's light: the sphere itself
+/// lies within rounding of the test's end.)
 pub(crate) fn visible_emission(
     scene: &Scene,
+    light: &AreaLight,
     hit: &SurfaceHit,
-    sample: &area::AreaSample,
+    drawn: &area::DirectionSample,
     wi: Vec3,
     distance: f32,
     wl: &Wavelengths,
 ) -> Option<Spectrum> {
+    let sample = &drawn.point;
+    if drawn.nearest && light.uniform {
+        return scene
+            .unoccluded_except(hit, wi, distance, sample.prim)
+            .then(|| emission::area_radiance(light, scene, sample, wl));
+    }
     let origin = hit.ray_origin(wi);
     let ray = Ray::new(origin, wi);
     let isect = scene.intersect(&ray, f32::INFINITY)?;
@@ -687,7 +696,7 @@ fn sample_area_direct(
         return None;
     }
     let wi = to / d;
-    let le = visible_emission(scene, hit, &sample, wi, d, wl)?;
+    let le = visible_emission(scene, light, hit, &drawn, wi, d, wl)?;
     let pdf = p_pick * drawn.pdf_solid;
     Some(DirectSample {
         wi,

@@ -135,7 +135,8 @@ pub struct Intersection {
     pub t: f32,
     /// Primitive index: shapes first, then triangles.
     pub prim: u32,
-    /// Unit normal for shapes; barycentric (u, v, 0) for triangles.
+    /// Shapes: the normal in object space ([`Shape::world_normal`] turns it, only for the hit
+    /// that is shaded); triangles: barycentric (u, v, 0).
     normal_or_bary: Vec3,
     uv: Vec2,
     /// The leaf of a CSG solid hit (0 otherwise).
@@ -367,6 +368,14 @@ impl Scene {
         !self.any_hit(&Ray::new(origin, wi), t_max, |_| true)
     }
 
+    /// As [`Scene::unoccluded`], but primitive `own` never blocks (the light whose point the
+    /// segment ends on, when nothing of it can lie in between).
+    pub fn unoccluded_except(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> bool {
+        let (point, origin) = (hit.point, hit.ray_origin(wi));
+        let t_max = (distance - (origin - point).length()) * (1.0 - 1e-5);
+        !self.any_hit(&Ray::new(origin, wi), t_max, |h| h.prim != own)
+    }
+
     /// World bounds of everything.
     pub fn bounds(&self) -> Aabb {
         self.shape_bvh.bounds().union(self.triangle_bvh.bounds())
@@ -419,7 +428,7 @@ impl Scene {
     /// The nearest hit of shape `prim` in `(0, t_max)`.
     #[inline]
     fn intersect_shape(&self, prim: u32, ray: &Ray, t_max: f32) -> Option<Intersection> {
-        let hit = self.shapes[prim as usize].intersect(ray, t_max)?;
+        let hit = self.shapes[prim as usize].intersect_object_normal(ray, t_max)?;
         Some(Intersection {
             t: hit.t,
             prim,
@@ -503,7 +512,7 @@ impl Scene {
         if t0 >= t_max {
             return None;
         }
-        let next = shape.intersect(&Ray::new(ray.at(t0), ray.dir), t_max - t0)?;
+        let next = shape.intersect_object_normal(&Ray::new(ray.at(t0), ray.dir), t_max - t0)?;
         Some(Intersection {
             t: t0 + next.t,
             prim: hit.prim,
@@ -520,13 +529,15 @@ impl Scene {
         if hit.prim < n_shapes {
             // From the point put on the surface in object space: `ray.at(t)` would carry the
             // error of `t`, which a non-uniform scale can turn into shadow acne.
-            let (point, point_error) = self.shapes[hit.prim as usize].world_point(hit.local_point);
+            let shape = &self.shapes[hit.prim as usize];
+            let (point, point_error) = shape.world_point(hit.local_point);
+            let normal = shape.world_normal(hit.normal_or_bary);
             return SurfaceHit {
                 t: hit.t,
                 point,
                 point_error,
-                geometric_normal: hit.normal_or_bary,
-                shading_normal: hit.normal_or_bary,
+                geometric_normal: normal,
+                shading_normal: normal,
                 uv: hit.uv,
                 material: MaterialRef::One(self.part_material(hit.prim as usize, hit.part)),
                 object: ObjectRef::Shape(hit.prim),

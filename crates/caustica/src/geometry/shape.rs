@@ -144,6 +144,16 @@ impl Shape {
     /// Nearest hit in `(0, t_max)` along the world ray.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
+        let mut hit = self.intersect_object_normal(ray, t_max)?;
+        hit.normal = self.world_normal(hit.normal);
+        (hit.normal != Vec3::ZERO).then_some(hit)
+    }
+
+    /// As [`Shape::intersect`], but the normal stays in object space until
+    /// [`Shape::world_normal`] turns it: a closest-hit search meets many shapes and needs the
+    /// normal of one.
+    #[inline]
+    pub fn intersect_object_normal(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
         if let ShapeKind::Csg(csg) = &self.kind {
             let c = csg.intersect(ray, t_max)?;
             return Some(ShapeHit {
@@ -169,17 +179,27 @@ impl Shape {
             ShapeKind::Csg(_) => return None,
             ShapeKind::Disk { inner } => disk::intersect(&local, t_max, *inner),
         }?;
-        let normal = (self.normal_to_world * hit.normal).normalize_or_zero();
-        if normal == Vec3::ZERO {
+        if hit.normal == Vec3::ZERO {
             return None;
         }
         Some(ShapeHit {
             t: hit.t,
             local_point: hit.point,
-            normal,
+            normal: hit.normal,
             uv: if self.needs_uv { hit.uv } else { Vec2::ZERO },
             part: 0,
         })
+    }
+
+    /// The unit world normal of a normal [`Shape::intersect_object_normal`] found (zero for a
+    /// degenerate transform).
+    #[inline]
+    pub fn world_normal(&self, normal: Vec3) -> Vec3 {
+        match self.kind {
+            // A solid's hits carry the world normal of the leaf they lie on.
+            ShapeKind::Csg(_) => normal,
+            _ => (self.normal_to_world * normal).normalize_or_zero(),
+        }
     }
 }
 

@@ -73,6 +73,9 @@ pub struct DirectionSample {
     pub point: AreaSample,
     /// Solid-angle density as seen from the shading point.
     pub pdf_solid: f32,
+    /// The point is the light's nearest along its direction from the shading point (a sphere
+    /// drawn by its cone): no part of the light itself lies in between.
+    pub nearest: bool,
 }
 
 impl AreaLight {
@@ -253,23 +256,26 @@ impl AreaLight {
     /// by area otherwise (its density converted to solid angle).
     pub fn sample_towards(&self, scene: &Scene, from: Vec3, u_pick: f32, u: Vec2) -> Option<DirectionSample> {
         if let Some((center, radius)) = self.sphere {
-            if let Some(cos_max) = cone_cosine(from, center, radius) {
-                let axis = (center - from).normalize();
+            let to = center - from;
+            let d2 = to.length_squared();
+            if let Some(cos_max) = cone_cosine_at(d2, radius) {
+                let axis = to * d2.sqrt().recip();
                 let dir = sample_uniform_cone(u, axis, cos_max);
                 let t = ray_sphere(from, dir, center, radius)?;
                 let point = from + dir * t;
                 let Sampler::Shape { prim, .. } = &self.sampler else {
                     return None;
                 };
-                let normal = (point - center).normalize_or_zero();
                 return Some(DirectionSample {
                     point: AreaSample {
                         point,
-                        normal,
-                        pdf_area: self.pdf_area(normal),
+                        normal: (point - center).normalize_or_zero(),
+                        // As `sample` draws it: uniform by area.
+                        pdf_area: 1.0 / (4.0 * PI * radius * radius),
                         prim: *prim,
                     },
                     pdf_solid: uniform_cone_pdf(cos_max),
+                    nearest: true,
                 });
             }
         }
@@ -278,6 +284,7 @@ impl AreaLight {
         Some(DirectionSample {
             point: sample,
             pdf_solid,
+            nearest: false,
         })
     }
 
@@ -311,7 +318,11 @@ impl AreaLight {
 
 /// The cosine of the half-angle a sphere subtends from `from`; `None` inside or on it.
 fn cone_cosine(from: Vec3, center: Vec3, radius: f32) -> Option<f32> {
-    let d2 = (center - from).length_squared();
+    cone_cosine_at((center - from).length_squared(), radius)
+}
+
+/// [`cone_cosine`] from `d2`, the squared distance to the centre.
+fn cone_cosine_at(d2: f32, radius: f32) -> Option<f32> {
     let sin2 = radius * radius / d2;
     // Too close to the surface for a cone to be accurate: sample by area instead.
     if sin2.is_nan() || sin2 >= 0.99 {

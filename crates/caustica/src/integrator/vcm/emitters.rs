@@ -403,7 +403,7 @@ impl Emitters {
                     return None;
                 }
                 let wi = to / distance;
-                let le = crate::light::visible_emission(scene, hit, &point, wi, distance, wl)?;
+                let le = crate::light::visible_emission(scene, light, hit, &drawn, wi, distance, wl)?;
                 let direct_pdf = choice * drawn.pdf_solid;
                 let cos_light = point.normal.dot(wi).abs();
                 Some(DirectSample {
