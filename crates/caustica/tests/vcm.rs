@@ -139,17 +139,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
             );
         }
     }
-    let lt = LightTracer::new(
-        &s,
-        LtSettings {
-            photons_per_pass: 200_000,
-            max_depth: depth,
-            ..LtSettings::default()
-        },
-        32,
-        32,
-        3,
-    );
+    let lt = light_tracer(&s, depth, 32, 3);
     let got = quadrants(&render_passes(&lt, 32, 32, 0, 32).film());
     // The upper quadrants see the lamp, which light tracing cannot.
     for i in 2..4 {
@@ -161,6 +151,16 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
             reference[i]
         );
     }
+}
+
+/// Light tracing of 200,000 photons a pass, the independent side of these comparisons.
+fn light_tracer(s: &caustica::scene::Scene, depth: u32, size: usize, seed: u64) -> LightTracer<'_> {
+    let settings = LtSettings {
+        photons_per_pass: 200_000,
+        max_depth: depth,
+        ..LtSettings::default()
+    };
+    LightTracer::new(s, settings, size, size, seed)
 }
 
 /// One pass is the same, bit for bit, on one thread and on two (inner connections on and off);
@@ -278,17 +278,7 @@ fn aimed_vcm_agrees_with_light_tracing_on_a_spot_lit_glass_ball() {
             .collect()
     };
     let depth = 4;
-    let lt = LightTracer::new(
-        &s,
-        LtSettings {
-            photons_per_pass: 200_000,
-            max_depth: depth,
-            ..LtSettings::default()
-        },
-        n,
-        n,
-        5,
-    );
+    let lt = light_tracer(&s, depth, n, 5);
     let reference = means(&render_passes(&lt, n, n, 0, 48).film());
     let lit: Vec<usize> = (0..blocks.len()).filter(|&i| reference[i] >= 0.01).collect();
     let brightest = reference.iter().cloned().fold(0.0, f32::max);
