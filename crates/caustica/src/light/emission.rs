@@ -31,6 +31,18 @@ pub struct Target {
 }
 
 impl Target {
+    /// The cone of directions from `from` that meet the sphere: its axis and the cosine of its
+    /// half-angle (−1, every direction, from inside).
+    pub fn cone_from(&self, from: Vec3) -> (Vec3, f32) {
+        let to = self.center - from;
+        let d2 = to.length_squared();
+        let r2 = self.radius * self.radius;
+        if d2 <= r2 * 1.0001 {
+            return (Vec3::Z, -1.0);
+        }
+        (to / d2.sqrt(), (1.0 - r2 / d2).max(0.0).sqrt())
+    }
+
     /// The sphere around a box (slightly enlarged so grazing paths are not lost).
     pub fn around(bounds: &Aabb) -> Target {
         Target {
@@ -378,20 +390,8 @@ impl Emitter {
 }
 
 fn cone_towards(position: Vec3, target: &Target) -> ConeLobe {
-    let to = target.center - position;
-    let d2 = to.length_squared();
-    let r2 = target.radius * target.radius;
-    if d2 <= r2 * 1.0001 {
-        // The light is inside the target: every direction may reach it.
-        return ConeLobe {
-            axis: Vec3::Z,
-            cos_max: -1.0,
-        };
-    }
-    ConeLobe {
-        axis: to / d2.sqrt(),
-        cos_max: (1.0 - r2 / d2).max(0.0).sqrt(),
-    }
+    let (axis, cos_max) = target.cone_from(position);
+    ConeLobe { axis, cos_max }
 }
 
 /// The bounding spheres photons are aimed at: one per reflective or transmissive object.

@@ -66,27 +66,15 @@ impl Aim {
         Some(Aim { targets, share })
     }
 
-    /// The cone of directions from `from` that meet `target`: its axis and the cosine of its
-    /// half-angle (−1, every direction, from inside).
-    fn cone(from: Vec3, target: &Target) -> (Vec3, f32) {
-        let to = target.center - from;
-        let d2 = to.length_squared();
-        let r2 = target.radius * target.radius;
-        if d2 <= r2 || d2 == 0.0 {
-            return (Vec3::Z, -1.0);
-        }
-        (to / d2.sqrt(), (1.0 - r2 / d2).max(0.0).sqrt())
-    }
-
     /// A direction from `from` into one of the cones (`None`: they have no solid angle).
     fn sample(&self, from: Vec3, u_pick: f32, u: Vec2) -> Option<Vec3> {
-        let total: f32 = self.targets.iter().map(|t| 1.0 - Self::cone(from, t).1).sum();
+        let total: f32 = self.targets.iter().map(|t| 1.0 - t.cone_from(from).1).sum();
         if total.is_nan() || total <= 0.0 {
             return None;
         }
         let mut x = u_pick * total;
         for (i, t) in self.targets.iter().enumerate() {
-            let (axis, cos_max) = Self::cone(from, t);
+            let (axis, cos_max) = t.cone_from(from);
             let w = 1.0 - cos_max;
             if x < w || i + 1 == self.targets.len() {
                 return Some(sample_uniform_cone(u, axis, cos_max));
@@ -101,7 +89,7 @@ impl Aim {
     fn pdf(&self, from: Vec3, dir: Vec3) -> f32 {
         let (mut total, mut inside) = (0.0, 0u32);
         for t in &self.targets {
-            let (axis, cos_max) = Self::cone(from, t);
+            let (axis, cos_max) = t.cone_from(from);
             total += 1.0 - cos_max;
             if dir.dot(axis) >= cos_max {
                 inside += 1;
@@ -473,7 +461,7 @@ mod tests {
         ];
         let aim = Aim::new(&targets, 1.0).unwrap();
         let from = Vec3::new(0.1, -0.2, 0.3);
-        let exact: f32 = targets.iter().map(|t| 2.0 * PI * (1.0 - Aim::cone(from, t).1)).sum();
+        let exact: f32 = targets.iter().map(|t| 2.0 * PI * (1.0 - t.cone_from(from).1)).sum();
         let mut rng = Rng::new(11, 0);
         let n = 200_000;
         let mut sum = 0.0f64;
