@@ -38,6 +38,8 @@ struct Worker<'a> {
     next: u64,
     /// When the first pass began (the plan's time limit counts from there).
     start: Option<Instant>,
+    /// The cost of the passes this run rendered, in full passes.
+    cost_done: f64,
     partial: Option<PathBuf>,
     save_every: f64,
     last_save: Instant,
@@ -57,8 +59,11 @@ impl Worker<'_> {
         }
         let start = *self.start.get_or_insert_with(Instant::now);
         loop {
-            let done = self.session.pass_count();
-            if !self.plan.admits(self.next, done, start.elapsed().as_secs_f64()) {
+            let next_cost = self.session.pass_cost(self.next);
+            if !self
+                .plan
+                .admits(self.next, self.cost_done, start.elapsed().as_secs_f64(), next_cost)
+            {
                 self.finish()?;
                 return Ok(None);
             }
@@ -81,6 +86,7 @@ impl Worker<'_> {
             }
             return Ok(None);
         }
+        self.cost_done += self.session.pass_cost(pass);
         self.next += 1;
         if self.partial.is_some() && self.last_save.elapsed().as_secs_f64() >= self.save_every {
             self.save_partial()?;
@@ -324,6 +330,7 @@ pub fn progressive(
                 cancel: worker_cancel,
                 stopped: worker_stopped,
                 start: None,
+                cost_done: 0.0,
                 partial: config.partial,
                 save_every: options.save_every,
                 last_save: Instant::now(),

@@ -215,4 +215,9 @@ fn check_radius(radius: InitialRadius) -> Result<()> {
 pub trait Progressive: Send + Sync {
     /// Renders pass `pass` (global index); `None` when cancelled.
     fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>>;
+
+    /// The time pass `pass` takes relative to a full pass, for a time limit's plan.
+    fn pass_cost(&self, _pass: u64) -> f64 {
+        1.0
+    }
 }

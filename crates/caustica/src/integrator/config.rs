@@ -112,7 +112,7 @@ pub struct RenderConfig {
     /// `--photons`: caustic photons to store (course), photons emitted per pass (physical).
     pub photons: usize,
     /// `--photons` as given (not the scene's or the default): vcm's light subpaths per pass
-    /// (eight per pixel when unset).
+    /// (16 per pixel when unset, half in the first two passes).
     pub light_paths: Option<u64>,
     /// `--max-emitted`.
     pub max_emitted: Option<u64>,

@@ -106,14 +106,16 @@ impl PassPlan {
 }
 
 impl PassPlan {
-    /// Whether pass `pass` is to start, `done` passes having been rendered in `elapsed` seconds:
-    /// not past the end, and (once a pass is done) expected to finish less than half a pass past
-    /// the time limit, so a run ends within half a pass of it either way.
-    pub fn admits(&self, pass: u64, done: u64, elapsed: f64) -> bool {
+    /// Whether pass `pass`, of relative cost `next` (1 for a full pass, see
+    /// [`Progressive::pass_cost`]), is to start, passes of total cost `done` having been
+    /// rendered in `elapsed` seconds: not past the end, and (once a pass is done) expected to
+    /// finish less than half the pass past the time limit, so a run ends within half a pass of
+    /// it either way.
+    pub fn admits(&self, pass: u64, done: f64, elapsed: f64, next: f64) -> bool {
         let past_end = self.end.is_some_and(|end| pass >= end);
         let out_of_time = self
             .time_limit
-            .is_some_and(|limit| done > 0 && elapsed + 0.5 * elapsed / done as f64 >= limit);
+            .is_some_and(|limit| done > 0.0 && elapsed + 0.5 * next * elapsed / done >= limit);
         !past_end && !out_of_time
     }
 }
@@ -297,14 +299,17 @@ impl<'a> RenderSession<'a> {
         control.progress.start("passes", bar_total);
         let mut reported = 0u64;
         let mut pass = plan.first;
+        // The cost of this run's passes, in full passes.
+        let mut cost_done = 0.0;
         loop {
-            let done = self.accumulator.pass_count();
-            if control.cancelled() || !plan.admits(pass, done, start.elapsed().as_secs_f64()) {
+            let next = self.pass_cost(pass);
+            if control.cancelled() || !plan.admits(pass, cost_done, start.elapsed().as_secs_f64(), next) {
                 break;
             }
             if !self.render_pass(pass, control) {
                 break;
             }
+            cost_done += next;
             pass += 1;
             let done = if by_time {
                 ((start.elapsed().as_secs_f64() * 10.0) as u64).min(bar_total)
@@ -330,6 +335,11 @@ impl<'a> RenderSession<'a> {
             None if self.passes.is_none() => Film::new(self.accumulator.width, self.accumulator.height),
             None => self.accumulator.film(),
         }
+    }
+
+    /// The time pass `pass` takes relative to a full pass ([`Progressive::pass_cost`]).
+    pub fn pass_cost(&self, pass: u64) -> f64 {
+        self.passes.as_ref().map_or(1.0, |p| p.pass_cost(pass))
     }
 
     /// Passes rendered so far.
@@ -359,16 +369,19 @@ mod tests {
     #[test]
     fn a_plan_admits_passes_up_to_its_end_and_within_half_a_pass_of_its_time() {
         let counted = PassPlan::new(Some("2..4"), None).unwrap();
-        assert!(counted.admits(2, 0, 1e9) && counted.admits(3, 1, 0.0));
-        assert!(!counted.admits(4, 2, 0.0));
+        assert!(counted.admits(2, 0.0, 1e9, 1.0) && counted.admits(3, 1.0, 0.0, 1.0));
+        assert!(!counted.admits(4, 2.0, 0.0, 1.0));
         let timed = PassPlan::new(None, Some(1.0)).unwrap();
         // The first pass always runs; later ones only within the time.
-        assert!(timed.admits(0, 0, 5.0) && timed.admits(7, 7, 0.5));
-        assert!(!timed.admits(1, 1, 1.0));
+        assert!(timed.admits(0, 0.0, 5.0, 1.0) && timed.admits(7, 7.0, 0.5, 1.0));
+        assert!(!timed.admits(1, 1.0, 1.0, 1.0));
         // 0.3 s a pass: a third at 0.6 s would end at 0.9 s; after 0.7 s in one pass, a second
         // would end 0.4 s past the limit, more than half a pass.
-        assert!(timed.admits(2, 2, 0.6) && !timed.admits(1, 1, 0.7));
+        assert!(timed.admits(2, 2.0, 0.6, 1.0) && !timed.admits(1, 1.0, 0.7, 1.0));
+        // A half pass in 0.4 s: a full one would take 0.8 s and end 0.2 s past the limit, less
+        // than half of it, so it runs; after a half pass in 0.55 s it would end 0.65 s past.
+        assert!(timed.admits(1, 0.5, 0.4, 1.0) && !timed.admits(1, 0.5, 0.55, 1.0));
         let both = PassPlan::new(Some("3"), Some(10.0)).unwrap();
-        assert!(!both.admits(3, 3, 0.0) && !both.admits(1, 1, 10.0));
+        assert!(!both.admits(3, 3.0, 0.0, 1.0) && !both.admits(1, 1.0, 10.0, 1.0));
     }
 }

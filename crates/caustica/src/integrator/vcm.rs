@@ -13,10 +13,12 @@
 //!   progressive photon mapping): deeper, a merge stands on one sampled bounce of the camera
 //!   path and is as noisy as path tracing, yet the balance heuristic would weigh it like the
 //!   first;
-//! - where the eye sees a caustic's focus directly (the surface before the one the camera ray
-//!   meets is a mirror or glass, and a pilot run found caustic light concentrated there:
-//!   [`focus`]), merging is left out there too, so light tracing keeps the focus sharp instead
-//!   of sharing it with a blurring kernel, while the dim spread-out part is merged smooth;
+//! - where the eye sees a caustic's focus directly (light came from the light through mirrors
+//!   and glass only, and a pilot run found such light concentrated there: [`focus`]), merging
+//!   is left out there too, so light tracing keeps the focus sharp instead of sharing it with a
+//!   blurring kernel, while the dim spread-out part is merged smooth; light that met a diffuse
+//!   surface before the glass (a wall's light focused by a lens) is smooth and merged even
+//!   there, since light tracing it would be the focus's main noise;
 //! - direct light (light tracing and merging at the surface light reaches first) is left to
 //!   next-event estimation (noiseless for a point light) and to emitters that camera paths hit;
 //!   measured, light tracing it doubled the area light's image error.
@@ -54,7 +56,7 @@ use rayon::prelude::*;
 #[derive(Clone, Debug, PartialEq)]
 pub struct VcmSettings {
     /// Light subpaths per pass (`None`: [`LIGHT_PATHS_PER_PIXEL`] per pixel, at most
-    /// [`MAX_DEFAULT_LIGHT_PATHS`]).
+    /// [`MAX_DEFAULT_LIGHT_PATHS`], and half as many in the first two passes).
     pub light_paths_per_pass: Option<u64>,
     /// Knaus & Zwicker's α in (0, 1): how fast the merging radius shrinks.
     pub alpha: f32,
@@ -97,8 +99,10 @@ impl Default for VcmSettings {
 pub const AIM_SHARE: f32 = 0.15;
 
 /// Light subpaths per pixel and pass by default: light tracing carries the caustics, so it gets
-/// most of the time (measured on the Cornell box race, BENCHMARKS.md).
-pub const LIGHT_PATHS_PER_PIXEL: u64 = 8;
+/// most of the time. Measured on the Cornell box race (BENCHMARKS.md), at equal time: 16 cut
+/// the focus's error by a fifth and the caustic region's by a sixth against 8, the image's
+/// unchanged; 24 was no better. The first passes trace half (see [`Vcm::pass_light_paths`]).
+pub const LIGHT_PATHS_PER_PIXEL: u64 = 16;
 /// The default's cap, so that a large image's pass stays within memory (about 100 bytes per
 /// stored light vertex, one or two per path).
 pub const MAX_DEFAULT_LIGHT_PATHS: u64 = 4_000_000;
@@ -127,8 +131,9 @@ struct LightVertex {
     length: u32,
     /// The subpath kept only its hero wavelength.
     dispersed: bool,
-    /// The surface before it has only delta lobes (a mirror or glass): a caustic vertex.
-    after_specular: bool,
+    /// Every surface before it has only delta lobes (mirrors, glass): light seen here is a
+    /// direct caustic, which light tracing keeps sharp where it is focused.
+    direct_caustic: bool,
 }
 
 /// What merging reads of a light vertex: a fraction of a [`LightVertex`], so that a pass's
@@ -141,7 +146,7 @@ struct MergeVertex {
     partial: Partial,
     length: u32,
     dispersed: bool,
-    after_specular: bool,
+    direct_caustic: bool,
 }
 
 /// The light subpaths of one pass (or of one batch of it).
@@ -194,9 +199,18 @@ pub struct Vcm<'a> {
     /// The first pass's merging radius in scene units.
     radius: f32,
     light_paths: u64,
+    /// The first [`RAMP_PASSES`] passes trace half the light subpaths (the default count only).
+    ramp: bool,
     /// Where caustics are focused, from a pilot run on first use.
     focus: std::sync::OnceLock<CausticFocus>,
 }
+
+/// Passes at half the default light subpaths: with full passes from the start, a one-second
+/// time limit stopped after the first (its successor would have ended half a pass late).
+const RAMP_PASSES: u64 = 2;
+
+/// The pilot run's least light subpaths: a small image still finds its caustics' focus.
+const MIN_PILOT_PATHS: u64 = 16_384;
 
 /// The pilot run's pass index: a random stream no real pass reaches.
 const PILOT_PASS: u64 = (1 << 24) - 1;
@@ -231,6 +245,7 @@ impl<'a> Vcm<'a> {
                 .light_paths_per_pass
                 .unwrap_or_else(|| default_light_paths(width, height))
                 .max(1),
+            ramp: settings.light_paths_per_pass.is_none(),
             settings,
             width,
             height,
@@ -239,11 +254,23 @@ impl<'a> Vcm<'a> {
         }
     }
 
+    /// Light subpaths of pass `pass`. With the default count the first [`RAMP_PASSES`] trace
+    /// half: the first pictures (and a run with a time limit of a second or two) come as soon as
+    /// with half the count, and the passes after them spend most of their time on light tracing.
+    fn pass_light_paths(&self, pass: u64) -> u64 {
+        if pass < RAMP_PASSES && self.ramp {
+            self.light_paths.div_ceil(2)
+        } else {
+            self.light_paths
+        }
+    }
+
     /// Where caustics seen directly are focused: a pilot run of one light subpath per pixel
-    /// (at most the default pass's count), in cells one merging diameter wide.
+    /// (at least [`MIN_PILOT_PATHS`], at most the default pass's cap), in cells one merging
+    /// diameter wide.
     fn focus(&self) -> &CausticFocus {
         self.focus.get_or_init(|| {
-            let count = (self.pixels() as u64).clamp(1, MAX_DEFAULT_LIGHT_PATHS);
+            let count = (self.pixels() as u64).clamp(MIN_PILOT_PATHS, MAX_DEFAULT_LIGHT_PATHS);
             let f = Factors::new(self.radius, count as f32);
             let wl = pass_wavelengths(self.spectral, self.seed, PILOT_PASS);
             let batches: Vec<LightPaths> = (0..count.div_ceil(BATCH))
@@ -260,7 +287,7 @@ impl<'a> Vcm<'a> {
                 b.merge_points
                     .iter()
                     .zip(&b.merge_vertices)
-                    .filter(|(_, v)| v.after_specular)
+                    .filter(|(_, v)| v.direct_caustic)
                     .map(|(p, v)| (*p, wl.to_rgb(v.throughput).max_element()))
             });
             CausticFocus::new(caustic, 2.0 * self.radius)
@@ -282,7 +309,8 @@ impl<'a> Vcm<'a> {
         let mut ray = emission.ray;
         let mut previous = emission.ray.origin;
         let mut dispersed = false;
-        let mut after_specular = false;
+        // Only mirrors and glass so far.
+        let mut all_specular = true;
         for length in 1..self.max_length {
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
                 return;
@@ -301,6 +329,7 @@ impl<'a> Vcm<'a> {
                 // The sum's first term stands for a connection that makes this vertex.
                 partial.vcm = 0.0;
             }
+            let direct_caustic = length > 1 && all_specular;
             if bsdf.is_smooth() {
                 let vertex = LightVertex {
                     hit,
@@ -309,7 +338,7 @@ impl<'a> Vcm<'a> {
                     partial,
                     length,
                     dispersed,
-                    after_specular,
+                    direct_caustic,
                 };
                 if to_eye {
                     self.trace_to_eye(&vertex, &bsdf, f, wl, &mut out.splats);
@@ -324,14 +353,14 @@ impl<'a> Vcm<'a> {
                         partial,
                         length,
                         dispersed,
-                        after_specular,
+                        direct_caustic,
                     });
                 }
                 if connected {
                     out.vertices.push(vertex);
                 }
             }
-            after_specular = !bsdf.is_smooth();
+            all_specular &= !bsdf.is_smooth();
             // A further vertex must still reach the eye within the longest path.
             if length + 2 > self.max_length {
                 return;
@@ -388,9 +417,9 @@ impl<'a> Vcm<'a> {
             &v.partial,
             camera_pdf,
             bsdf.pdf_reverse(v.wo, s.to_eye),
-            v.length > 1 && !(v.after_specular && self.focus().contains(v.hit.point)),
+            v.length > 1 && !(v.direct_caustic && self.focus().contains(v.hit.point)),
         );
-        let splat = v.throughput * value * (cos * inv_d2 * s.importance * weight / self.light_paths as f32);
+        let splat = v.throughput * value * (cos * inv_d2 * s.importance * weight / f.light_paths);
         let rgb = wl.to_rgb(splat);
         if rgb.is_finite() {
             splats.push((s.pixel as u32, rgb));
@@ -399,7 +428,7 @@ impl<'a> Vcm<'a> {
 
     /// The light subpaths of pass `pass`, traced in batches in parallel and kept in index order.
     fn light_paths(&self, pass: u64, f: &Factors, wl: &Wavelengths, control: Control) -> Option<LightPaths> {
-        let count = self.light_paths;
+        let count = self.pass_light_paths(pass);
         let batches: Vec<Option<LightPaths>> = (0..count.div_ceil(BATCH))
             .into_par_iter()
             .map(|b| {
@@ -458,8 +487,11 @@ impl<'a> Vcm<'a> {
         // The last bounce's density, for the sky and suns (None: seen directly or by a mirror).
         let mut last_pdf: Option<f32> = None;
         // The sums as they would be without merging at the first vertex, taken if the second
-        // turns out to be a mirror or glass (the eye then sees a caustic there).
+        // turns out to be a mirror or glass (the eye then sees a caustic there), and the sums
+        // with it, kept along the mirrors and glass that follow: light that reached them from
+        // a diffuse surface (not a direct caustic) is merged at the first vertex again.
         let mut without_first_merge = Partial::default();
+        let mut with_first_merge: Option<Partial> = None;
         // The sums without merging at the last vertex, for an emitter hit next (light reaches
         // that vertex first).
         let mut without_last_merge = Partial::default();
@@ -485,7 +517,15 @@ impl<'a> Vcm<'a> {
             }
             if length == 2 && !bsdf.is_smooth() && first_focused {
                 without_first_merge.arrive(d2, cos_in);
+                with_first_merge = Some(partial);
                 partial = without_first_merge;
+            } else if let Some(mut with) = with_first_merge {
+                with.arrive(d2, cos_in);
+                with_first_merge = Some(with);
+                if bsdf.is_smooth() {
+                    partial = with;
+                    with_first_merge = None;
+                }
             }
             if !self.settings.connections && length > 1 {
                 // The sum's first term stands for a connection that makes this vertex (for an
@@ -528,6 +568,9 @@ impl<'a> Vcm<'a> {
             let cos_out = bsdf.normal().dot(sample.wi).abs();
             if sample.specular {
                 partial.scatter_specular(cos_out);
+                if let Some(with) = with_first_merge.as_mut() {
+                    with.scatter_specular(cos_out);
+                }
                 without_last_merge = partial;
                 if length == 1 {
                     without_first_merge = partial;
@@ -721,7 +764,7 @@ impl<'a> Vcm<'a> {
         let f = &pass.factors;
         pass.grid.query(v.hit.point, pass.radius, |slot| {
             let z = &pass.merge_vertices[slot];
-            if v.length + z.length > self.max_length || (focused && z.after_specular) {
+            if v.length + z.length > self.max_length || (focused && z.direct_caustic) {
                 return;
             }
             // Light on another face (a wall's far side, a corner) is not light here.
@@ -741,7 +784,7 @@ impl<'a> Vcm<'a> {
             );
             sum += value * z.throughput * (weight * both_dispersed(v.dispersed, z.dispersed));
         });
-        v.throughput * sum / (std::f32::consts::PI * pass.radius * pass.radius * self.light_paths as f32)
+        v.throughput * sum / (std::f32::consts::PI * pass.radius * pass.radius * f.light_paths)
     }
 }
 
@@ -761,6 +804,13 @@ fn both_dispersed(a: bool, b: bool) -> f32 {
 }
 
 impl Progressive for Vcm<'_> {
+    /// Its share of a full pass's light subpaths (their tracing takes most of a pass; the
+    /// camera paths' fixed part makes a half pass a little dearer than this says, so a time
+    /// limit's plan errs on the short side).
+    fn pass_cost(&self, pass: u64) -> f64 {
+        self.pass_light_paths(pass) as f64 / self.light_paths as f64
+    }
+
     fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
         let wl = pass_wavelengths(self.spectral, self.seed, pass);
         if self.scene.lights().is_empty() {
@@ -769,7 +819,7 @@ impl Progressive for Vcm<'_> {
         // The pilot run, once, before the passes' parallel work asks for it.
         self.focus();
         let radius = self.radius * radius_factor(pass, self.settings.alpha);
-        let f = Factors::new(radius, self.light_paths as f32);
+        let f = Factors::new(radius, self.pass_light_paths(pass) as f32);
         let paths = if self.emitters.is_empty() {
             LightPaths::default()
         } else {
@@ -791,7 +841,7 @@ impl Progressive for Vcm<'_> {
             let mut rng = Rng::new(self.seed, (pass << 32) ^ pixel as u64);
             let (jx, jy) = (rng.uniform(), rng.uniform());
             let ray = camera.generate_ray((x as f32 + jx) / w as f32, 1.0 - (y as f32 + jy) / h as f32);
-            let own = pixel % self.light_paths as usize;
+            let own = pixel % self.pass_light_paths(pass) as usize;
             let v = wl.to_rgb(self.camera_path(ray, &pass_data, own, &wl, &mut rng));
             if v.is_finite() {
                 v

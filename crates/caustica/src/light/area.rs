@@ -203,6 +203,12 @@ impl AreaLight {
         faces * PI * self.area * crate::math::luminance(self.radiance).max(0.0)
     }
 
+    /// Centre and radius of a sphere lamp under a similarity transform (sampled uniformly by
+    /// area, so its area density is 1/(4πr²) everywhere).
+    pub fn sphere(&self) -> Option<(Vec3, f32)> {
+        self.sphere
+    }
+
     /// A point on the light; `u_pick` chooses the triangle of a mesh.
     pub fn sample(&self, scene: &Scene, u_pick: f32, u: Vec2) -> Option<AreaSample> {
         match &self.sampler {
