@@ -58,8 +58,9 @@ impl Worker<'_> {
             return Ok(None);
         }
         let start = *self.start.get_or_insert_with(Instant::now);
+        let mut next_cost;
         loop {
-            let next_cost = self.session.pass_cost(self.next);
+            next_cost = self.session.pass_cost(self.next);
             if !self
                 .plan
                 .admits(self.next, self.cost_done, start.elapsed().as_secs_f64(), next_cost)
@@ -86,7 +87,7 @@ impl Worker<'_> {
             }
             return Ok(None);
         }
-        self.cost_done += self.session.pass_cost(pass);
+        self.cost_done += next_cost;
         self.next += 1;
         if self.partial.is_some() && self.last_save.elapsed().as_secs_f64() >= self.save_every {
             self.save_partial()?;

@@ -261,7 +261,7 @@ impl Emitters {
             (Some(aim), Some((center, radius))) => {
                 (1.0 - aim.share) * area * plain + aim.share * aim.sphere_pdf(center, radius, point, dir)
             }
-            (Some(aim), None) => area * ((1.0 - aim.share) * plain + aim.share * aim.pdf(point, dir)),
+            (Some(_), None) => area * self.direction_pdf(point, dir, plain),
         }
     }
 

@@ -1,6 +1,6 @@
 //! Where the caustics seen directly are focused: cells of space where a pilot run's caustic
-//! light (light vertices right after a mirror or glass) is many times denser than on
-//! average, grown by one cell on every side. There, merging at the camera path's first vertex
+//! light (light vertices reached from the light through mirrors and glass only) is many times
+//! denser than on average, grown by one cell on every side. There, merging at the camera path's first vertex
 //! is left out for caustic light, so light tracing keeps the focus sharp; elsewhere the dim,
 //! spread-out caustic light is merged like any other and comes out smooth.
 //!
