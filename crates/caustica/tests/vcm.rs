@@ -237,8 +237,8 @@ spot_light { position = (1.2, 2, 0); direction = (-1.2, -1.5, 0); color = (3, 3,
 translate(0, 0.5, 0, scale(0.5, sphere { material = { transmissive = (1, 1, 1); index = 1.5; } }))
 rotate(1, 0, 0, -1.5707963, scale(40, square { material = { diffuse = (0.6, 0.6, 0.6); } }))";
 
-/// The same ball lit by a dim spot (its direct caustic still makes focused cells) and by a
-/// wall that a bright spot lights: the wall's light, focused by the ball onto the same floor,
+/// The same ball and spot (its direct caustic makes the focused cells), and a wall that a
+/// brighter spot lights: the wall's light, focused by the ball onto the same floor,
 /// is merged where the direct caustic is light traced.
 const WALL_LIT_BALL: &str = "SBT-raytracer 1.0
 camera { position = (-2.5, 2.5, 0); viewdir = (1, -1.1, 0); updir = (0, 1, 0); fov = 40; }
@@ -279,7 +279,7 @@ fn aimed_vcm_agrees_with_light_tracing_on_a_spot_lit_glass_ball() {
 /// Light focused by the ball after a diffuse wall (merged at the first vertex the eye sees,
 /// even in the focused cells, while the direct caustic there is light traced) against light
 /// tracing: the caustic's blocks (mean at least 0.04; the dim ones, lit by the wall alone,
-/// scatter by ±5% in both renderers at these counts) within 5% (measured −2.4% to +2.1%).
+/// scatter by ±5% in both renderers at these counts) within 5% (measured −1.2% to +2.5%).
 #[test]
 fn vcm_merges_a_wall_lit_caustic_where_the_direct_one_is_traced() {
     vcm_against_light_tracing(WALL_LIT_BALL, &[true], 0.04);
