@@ -23,7 +23,7 @@
 //! - a thin-walled dielectric: Fresnel reflection of the sheet's two faces, 2R/(1 + R), and the
 //!   rest straight through.
 
-use crate::material::{MaterialRef, MaterialSpectra, PhysicalMaterial, SurfaceParams};
+use crate::material::{Lobes, MaterialRef, MaterialSpectra, PhysicalMaterial, SurfaceParams};
 use crate::math::{reflect, Frame, Vec3, Vec4};
 use crate::sampling::sample_cosine_hemisphere;
 use crate::scene::{Scene, SurfaceHit};
@@ -74,6 +74,31 @@ pub struct Bsdf {
     wl: Wavelengths,
 }
 
+/// [`Bsdf::lambertian`]'s answer: the same values as [`Bsdf::eval`], [`Bsdf::pdf`] and
+/// [`Bsdf::pdf_reverse`] for directions on the lit side.
+#[derive(Clone, Copy, Debug)]
+pub struct Lambertian {
+    n: Vec3,
+    ng: Vec3,
+    /// f, the same for every pair of directions on the lit side.
+    pub f: Spectrum,
+    pick: f32,
+    /// The density of drawing `wo` back from any direction on the lit side.
+    pub reverse: f32,
+}
+
+impl Lambertian {
+    /// The density of drawing `wi`, or `None` where `wi` is not on the lit side (f is zero).
+    #[inline]
+    pub fn pdf(&self, wi: Vec3) -> Option<f32> {
+        let cos_i = self.n.dot(wi);
+        if cos_i <= 0.0 || self.ng.dot(wi) <= 0.0 {
+            return None;
+        }
+        Some(self.pick * cos_i / PI)
+    }
+}
+
 /// Whose Fresnel reflectance a microfacet lobe has.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Fresnel {
@@ -117,22 +142,25 @@ impl Bsdf {
         if let Some(physical) = scene.physical(hit) {
             return Bsdf::physical(&physical, hit.shading_normal, hit.geometric_normal, wo, wl);
         }
-        let params = scene.phong(hit);
         let abbe = scene.abbe(hit);
         let spectra = match (wl.is_spectral(), hit.material) {
             (true, MaterialRef::One(id)) => Some(scene.material_spectra(id)),
             _ => None,
         };
-        Bsdf::new(&params, hit.shading_normal, hit.geometric_normal, wo, wl, spectra, abbe)
+        let (ns, ng) = (hit.shading_normal, hit.geometric_normal);
+        match scene.constant_lobes(hit) {
+            Some(lobes) => Bsdf::new(lobes, ns, ng, wo, wl, spectra, abbe),
+            None => Bsdf::new(&Lobes::new(&scene.phong(hit)), ns, ng, wo, wl, spectra, abbe),
+        }
     }
 
-    /// The lobes of `params` at a point with outward shading normal `ns` and geometric normal
-    /// `ng`, seen from direction `wo` (unit, away from the surface), for light at wavelengths
-    /// `wl`. A material's fitted spectra (`spectra`) are used for its constant colours; `abbe`
-    /// makes its dielectric dispersive.
-    #[allow(clippy::too_many_arguments)]
+    /// The lobes of a course material (`lobes`, from its values) at a point with outward
+    /// shading normal `ns` and geometric normal `ng`, seen from direction `wo` (unit, away from
+    /// the surface), for light at wavelengths `wl`. A material's fitted spectra (`spectra`) are
+    /// used for its constant colours; `abbe` makes its dielectric dispersive.
+    #[inline]
     pub fn new(
-        params: &SurfaceParams,
+        lobes: &Lobes,
         ns: Vec3,
         ng: Vec3,
         wo: Vec3,
@@ -143,21 +171,9 @@ impl Bsdf {
         let outside = wo.dot(ng) >= 0.0;
         let facing = if wo.dot(ns) >= 0.0 { ns } else { -ns };
         let ng_facing = if outside { ng } else { -ng };
-        let clamp = |c: Vec3| c.max(Vec3::ZERO);
-        let (mut kd, mut ks, mut kr, mut kt) = (
-            clamp(params.diffuse),
-            clamp(params.specular),
-            clamp(params.reflective),
-            clamp(params.transmissive),
-        );
-        let total = (kd + ks + kr + kt).max_element();
-        let scale = if total > 1.0 { 1.0 / total } else { 1.0 };
-        if total > 1.0 {
-            kd *= scale;
-            ks *= scale;
-            kr *= scale;
-            kt *= scale;
-        }
+        let Lobes {
+            kd, ks, kr, kt, scale, ..
+        } = *lobes;
         // A colour at the wavelengths: the material's fitted spectrum (scaled like the colour)
         // where it has one, else the table's.
         let spectrum = |rgb: Vec3, fit: Option<SigmoidPolynomial>| match (wl, fit) {
@@ -165,32 +181,22 @@ impl Bsdf {
             _ => wl.reflectance(rgb),
         };
         let fits = spectra.copied().unwrap_or_default();
-        let index = if params.index > 0.0 { params.index } else { 1.0 };
         let (index, dispersive) = match (abbe, wl.hero()) {
-            (Some(v), Some(lambda)) if kt != Vec3::ZERO => (cauchy_index(index, v, lambda), true),
-            _ => (index, false),
+            (Some(v), Some(lambda)) if kt != Vec3::ZERO => (cauchy_index(lobes.index, v, lambda), true),
+            _ => (lobes.index, false),
         };
-        let mut pick = [kd.max_element(), ks.max_element(), kr.max_element(), 0.0, 0.0, 0.0];
-        if kt != Vec3::ZERO {
-            // The dielectric reflects even where kt is small; sample it by its larger part.
-            pick[3] = kt.max_element().max(0.04);
-        }
-        let sum: f32 = pick.iter().sum();
-        if sum > 0.0 {
-            pick.iter_mut().for_each(|p| *p /= sum);
-        }
         Bsdf {
             frame: Frame::from_normal(facing),
             ng: ng_facing,
             outside,
             diffuse: spectrum(kd, fits.diffuse),
             glossy: spectrum(ks, fits.specular),
-            exponent: params.shininess.max(0.0),
+            exponent: lobes.exponent,
             mirror: spectrum(kr, fits.reflective),
             transmission: spectrum(kt, fits.transmissive),
             index,
             dispersive,
-            pick,
+            pick: lobes.pick,
             coat: 0.0,
             microfacet: None,
             diffuse_transmission: Spectrum::ZERO,
@@ -202,7 +208,7 @@ impl Bsdf {
     /// The lobes of a material with its own physical description, at a point with outward
     /// shading normal `ns` and geometric normal `ng`, seen from `wo`.
     pub fn physical(material: &PhysicalMaterial<Vec3>, ns: Vec3, ng: Vec3, wo: Vec3, wl: &Wavelengths) -> Bsdf {
-        let mut b = Bsdf::new(&SurfaceParams::default(), ns, ng, wo, wl, None, None);
+        let mut b = Bsdf::new(&Lobes::new(&SurfaceParams::default()), ns, ng, wo, wl, None, None);
         let cos_o = b.frame.z.dot(wo).clamp(0.0, 1.0);
         let clamp01 = |c: Vec3| c.clamp(Vec3::ZERO, Vec3::ONE);
         b.pick = [0.0; 6];
@@ -329,6 +335,28 @@ impl Bsdf {
             }
         }
         f
+    }
+
+    /// A purely Lambertian reflection seen from `wo`, for asking about many light directions
+    /// (merging's candidates) at the cost of one; `None` for any other lobes.
+    pub fn lambertian(&self, wo: Vec3) -> Option<Lambertian> {
+        let only_diffuse = self.pick[0] > 0.0 && self.pick[1..].iter().all(|&p| p == 0.0);
+        if !only_diffuse || self.coat > 0.0 || self.microfacet.is_some() {
+            return None;
+        }
+        let cos_o = self.frame.z.dot(wo);
+        let reverse = if cos_o > 0.0 && self.ng.dot(wo) > 0.0 {
+            self.pick[0] * cos_o / PI
+        } else {
+            0.0
+        };
+        Some(Lambertian {
+            n: self.frame.z,
+            ng: self.ng,
+            f: self.diffuse * (1.0 / PI),
+            pick: self.pick[0],
+            reverse,
+        })
     }
 
     /// Solid-angle pdf with which [`Bsdf::sample`] draws `wi` through its smooth lobes.
@@ -712,7 +740,7 @@ mod tests {
         let n = Vec3::Z;
         let wo = Vec3::Z;
         for (kd, ks, exp) in [(0.8, 0.0, 1.0), (0.0, 0.9, 10.0), (0.0, 0.9, 200.0), (0.5, 0.4, 30.0)] {
-            let bsdf = Bsdf::new(&params(kd, ks, exp), n, n, wo, &RGB, None, None);
+            let bsdf = Bsdf::new(&Lobes::new(&params(kd, ks, exp)), n, n, wo, &RGB, None, None);
             let mut rng = Rng::new(1, 0);
             let count = 200_000;
             let mut sum = 0.0f64;
@@ -740,7 +768,7 @@ mod tests {
     fn pdf_integrates_to_one_over_the_hemisphere() {
         let n = Vec3::Z;
         let wo = Vec3::new(0.6, 0.0, 0.8);
-        let bsdf = Bsdf::new(&params(0.3, 0.5, 5.0), n, n, wo, &RGB, None, None);
+        let bsdf = Bsdf::new(&Lobes::new(&params(0.3, 0.5, 5.0)), n, n, wo, &RGB, None, None);
         let mut rng = Rng::new(2, 0);
         let count = 400_000;
         let mut sum = 0.0f64;
@@ -764,7 +792,7 @@ mod tests {
         };
         let n = Vec3::Z;
         let wo = Vec3::new(0.0, 0.5f32.sin(), 0.5f32.cos());
-        let bsdf = Bsdf::new(&glass, n, n, wo, &RGB, None, None);
+        let bsdf = Bsdf::new(&Lobes::new(&glass), n, n, wo, &RGB, None, None);
         assert!(!bsdf.is_smooth());
         let mut rng = Rng::new(3, 0);
         let count = 100_000;
@@ -789,7 +817,7 @@ mod tests {
         assert!((total / count as f64 - 1.0).abs() < 1e-4, "photons keep their flux");
         // From inside, a steep ray is totally reflected.
         let inside = Bsdf::new(
-            &glass,
+            &Lobes::new(&glass),
             n,
             n,
             -Vec3::new(0.0, 0.9f32.sin(), 0.9f32.cos()),
@@ -1027,7 +1055,7 @@ mod tests {
             reflective: Vec3::splat(0.6),
             ..SurfaceParams::default()
         };
-        let bsdf = Bsdf::new(&p, Vec3::Z, Vec3::Z, Vec3::Z, &RGB, None, None);
+        let bsdf = Bsdf::new(&Lobes::new(&p), Vec3::Z, Vec3::Z, Vec3::Z, &RGB, None, None);
         assert!((bsdf.diffuse.x + bsdf.mirror.x - 1.0).abs() < 1e-6);
         assert!((bsdf.diffuse.x / bsdf.mirror.x - 0.8 / 0.6).abs() < 1e-5);
     }

@@ -144,6 +144,71 @@ pub struct SurfaceParams {
     pub index: f32,
 }
 
+/// A course material's lobes before a point's shading frame: its colours clamped and scaled
+/// so that they reflect at most all light, the chance of picking each lobe, its exponent and
+/// index. The same at every point of an untextured material: scenes keep them per material,
+/// which spares every hit the work.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lobes {
+    /// Diffuse colour.
+    pub kd: Vec3,
+    /// Glossy colour.
+    pub ks: Vec3,
+    /// Mirror colour.
+    pub kr: Vec3,
+    /// Transmitted colour.
+    pub kt: Vec3,
+    /// What the colours were scaled by (fitted spectra are scaled alike).
+    pub scale: f32,
+    /// Phong exponent of the glossy lobe.
+    pub exponent: f32,
+    /// Index of refraction.
+    pub index: f32,
+    /// The chance of picking each lobe: diffuse, glossy, mirror, dielectric (and the physical
+    /// model's microfacet and diffuse transmission, none here).
+    pub pick: [f32; 6],
+}
+
+impl Lobes {
+    /// The lobes of the course's material values `params`.
+    pub fn new(params: &SurfaceParams) -> Lobes {
+        let clamp = |c: Vec3| c.max(Vec3::ZERO);
+        let (mut kd, mut ks, mut kr, mut kt) = (
+            clamp(params.diffuse),
+            clamp(params.specular),
+            clamp(params.reflective),
+            clamp(params.transmissive),
+        );
+        let total = (kd + ks + kr + kt).max_element();
+        let scale = if total > 1.0 { 1.0 / total } else { 1.0 };
+        if total > 1.0 {
+            kd *= scale;
+            ks *= scale;
+            kr *= scale;
+            kt *= scale;
+        }
+        let mut pick = [kd.max_element(), ks.max_element(), kr.max_element(), 0.0, 0.0, 0.0];
+        if kt != Vec3::ZERO {
+            // The dielectric reflects even where kt is small; sample it by its larger part.
+            pick[3] = kt.max_element().max(0.04);
+        }
+        let sum: f32 = pick.iter().sum();
+        if sum > 0.0 {
+            pick.iter_mut().for_each(|p| *p /= sum);
+        }
+        Lobes {
+            kd,
+            ks,
+            kr,
+            kt,
+            scale,
+            exponent: params.shininess.max(0.0),
+            index: if params.index > 0.0 { params.index } else { 1.0 },
+            pick,
+        }
+    }
+}
+
 impl Material {
     /// The values at texture coordinates `uv`.
     #[inline]

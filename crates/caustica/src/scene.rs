@@ -11,7 +11,7 @@ use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::Shape;
 use crate::light::{Light, LightSet};
-use crate::material::{Material, MaterialRef, MaterialSpectra, SurfaceParams};
+use crate::material::{Lobes, Material, MaterialRef, MaterialSpectra, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
 use crate::progress::Progress;
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -94,6 +94,8 @@ pub struct Scene {
     materials: Vec<Material>,
     /// Each material's fitted spectra, made the first time spectral transport asks.
     material_spectra: Vec<OnceLock<MaterialSpectra>>,
+    /// Each untextured material's lobes, worked out once (`None`: textured).
+    material_lobes: Vec<Option<Lobes>>,
     textures: Vec<Texture>,
     shapes: Vec<Shape>,
     /// Material id of each shape.
@@ -206,6 +208,10 @@ impl Scene {
             lights: LightSet::default(),
             ambient,
             material_spectra: materials.iter().map(|_| OnceLock::new()).collect(),
+            material_lobes: materials
+                .iter()
+                .map(|m| (!m.is_textured()).then(|| Lobes::new(&m.eval(&[], Vec2::ZERO))))
+                .collect(),
             materials,
             textures,
             shapes,
@@ -302,6 +308,16 @@ impl Scene {
                 let p = ids.map(|id| self.materials[id as usize].eval(&self.textures, hit.uv));
                 SurfaceParams::blend([&p[0], &p[1], &p[2]], weights)
             }
+        }
+    }
+
+    /// The lobes of the material at a surface point, if they are the same everywhere on it
+    /// (one untextured material).
+    #[inline]
+    pub fn constant_lobes(&self, hit: &SurfaceHit) -> Option<&Lobes> {
+        match hit.material {
+            MaterialRef::One(id) => self.material_lobes[id as usize].as_ref(),
+            MaterialRef::Blend { .. } => None,
         }
     }
 

@@ -170,6 +170,13 @@ pub enum Wavelengths {
     },
 }
 
+/// A reflectance colour at sampled wavelengths `lambda` (the sigmoid-polynomial fit of `rgb`).
+#[inline(never)]
+fn sampled_reflectance(lambda: &[f32; SAMPLES], rgb: Vec3) -> Spectrum {
+    let c = Uplift::get().coefficients(rgb.clamp(Vec3::ZERO, Vec3::ONE));
+    Vec4::from_array(lambda.map(|l| c.eval(l)))
+}
+
 impl Wavelengths {
     /// Four wavelengths from one uniform number: the hero from `u`, the others from u + i/4,
     /// each distributed by [`visible_pdf`] and together stratified.
@@ -206,14 +213,13 @@ impl Wavelengths {
     }
 
     /// A reflectance colour (components in [0, 1]) at these wavelengths.
-    #[inline]
+    #[inline(always)]
     pub fn reflectance(&self, rgb: Vec3) -> Spectrum {
         match self {
+            // Kept inline: every surface hit asks for four colours, and in RGB mode a call
+            // costs more than the answer.
             Wavelengths::Rgb => rgb.extend(0.0),
-            Wavelengths::Sampled { lambda, .. } => {
-                let c = Uplift::get().coefficients(rgb.clamp(Vec3::ZERO, Vec3::ONE));
-                Vec4::from_array(lambda.map(|l| c.eval(l)))
-            }
+            Wavelengths::Sampled { lambda, .. } => sampled_reflectance(lambda, rgb),
         }
     }
 

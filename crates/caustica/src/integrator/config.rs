@@ -335,6 +335,7 @@ impl RenderConfig {
                 connections: self.vertex_connections,
                 aim: !self.no_aim,
                 spectral: self.spectral,
+                ..VcmSettings::default()
             }),
         };
         if progressive {

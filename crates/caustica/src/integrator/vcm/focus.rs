@@ -57,6 +57,11 @@ impl CausticFocus {
         CausticFocus { inv_cell, cells }
     }
 
+    /// Whether no cell is focused.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
     /// Whether `p` lies in a focused cell.
     pub fn contains(&self, p: Vec3) -> bool {
         !self.cells.is_empty() && self.cells.contains(&cell_of(p, self.inv_cell))

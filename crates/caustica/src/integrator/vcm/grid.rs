@@ -7,42 +7,53 @@ use crate::math::Vec3;
 
 /// The grid: bucket `b` holds `indices[starts[b]..starts[b + 1]]`, at `positions` of the same
 /// range.
+#[derive(Default)]
 pub struct HashGrid {
     inv_cell: f32,
     mask: u32,
     starts: Vec<u32>,
     indices: Vec<u32>,
     positions: Vec<Vec3>,
+    /// Each point's bucket while building (kept for the next build's memory).
+    keys: Vec<u32>,
 }
 
 impl HashGrid {
     /// The grid over `points` for queries of radius `radius`.
     pub fn new(points: &[Vec3], radius: f32) -> HashGrid {
-        let buckets = points.len().next_power_of_two().max(1);
-        let inv_cell = if radius > 0.0 { 0.5 / radius } else { 0.0 };
-        let mask = (buckets - 1) as u32;
-        let mut grid = HashGrid {
-            inv_cell,
-            mask,
-            starts: vec![0; buckets + 1],
-            indices: vec![0; points.len()],
-            positions: vec![Vec3::ZERO; points.len()],
-        };
-        let keys: Vec<u32> = points.iter().map(|&p| grid.bucket(grid.cell(p))).collect();
-        for &k in &keys {
-            grid.starts[k as usize + 1] += 1;
-        }
-        for b in 0..buckets {
-            grid.starts[b + 1] += grid.starts[b];
-        }
-        let mut fill = grid.starts.clone();
-        for (i, &k) in keys.iter().enumerate() {
-            let slot = fill[k as usize] as usize;
-            grid.indices[slot] = i as u32;
-            grid.positions[slot] = points[i];
-            fill[k as usize] += 1;
-        }
+        let mut grid = HashGrid::default();
+        grid.rebuild(points, radius);
         grid
+    }
+
+    /// Makes it the grid over `points` for queries of radius `radius`, in the memory it has.
+    pub fn rebuild(&mut self, points: &[Vec3], radius: f32) {
+        let buckets = points.len().next_power_of_two().max(1);
+        self.inv_cell = if radius > 0.0 { 0.5 / radius } else { 0.0 };
+        self.mask = (buckets - 1) as u32;
+        let mut keys = std::mem::take(&mut self.keys);
+        keys.clear();
+        keys.extend(points.iter().map(|&p| self.bucket(self.cell(p))));
+        // A counting sort: each bucket's end, then filled from its end backwards, so that a
+        // bucket keeps its points in their order and `starts` ends at each bucket's start.
+        self.starts.clear();
+        self.starts.resize(buckets + 1, 0);
+        for &k in &keys {
+            self.starts[k as usize] += 1;
+        }
+        for b in 1..buckets {
+            self.starts[b] += self.starts[b - 1];
+        }
+        self.starts[buckets] = points.len() as u32;
+        self.indices.resize(points.len(), 0);
+        self.positions.resize(points.len(), Vec3::ZERO);
+        for (i, &k) in keys.iter().enumerate().rev() {
+            self.starts[k as usize] -= 1;
+            let slot = self.starts[k as usize] as usize;
+            self.indices[slot] = i as u32;
+            self.positions[slot] = points[i];
+        }
+        self.keys = keys;
     }
 
     fn cell(&self, p: Vec3) -> [i32; 3] {
@@ -117,6 +128,28 @@ mod tests {
                 .filter(|&i| (points[i] - p).length_squared() <= radius * radius)
                 .collect();
             assert_eq!(found, expected);
+        }
+    }
+
+    #[test]
+    fn a_rebuilt_grid_is_the_new_grid_over_its_points() {
+        let mut rng = Rng::new(5, 0);
+        let mut cloud = |n: usize| -> Vec<Vec3> {
+            (0..n)
+                .map(|_| Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()))
+                .collect()
+        };
+        let (first, second) = (cloud(3000), cloud(700));
+        let mut reused = HashGrid::new(&first, 0.05);
+        reused.rebuild(&second, 0.03);
+        let fresh = HashGrid::new(&second, 0.03);
+        assert_eq!(reused.order(), fresh.order());
+        assert_eq!(reused.starts, fresh.starts);
+        for p in second.iter().take(100) {
+            let (mut a, mut b) = (Vec::new(), Vec::new());
+            reused.query(*p, 0.03, |slot| a.push(slot));
+            fresh.query(*p, 0.03, |slot| b.push(slot));
+            assert_eq!(a, b);
         }
     }
 }
