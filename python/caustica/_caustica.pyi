@@ -38,7 +38,7 @@ class RenderOptions(TypedDict, total=False):
     passes: int | str | None
     time: float | None
     partial: PathLike | None
-    footprint: float
+    footprint: float | None
     alpha: float
     no_camera_specular: bool
     vertex_connections: bool

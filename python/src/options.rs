@@ -155,7 +155,7 @@ pub fn parse(
             "passes" => c.passes = v.optional(Value::passes)?,
             "time" => c.time = v.optional(Value::number)?,
             "partial" => c.partial = v.optional(Value::path)?,
-            "footprint" => c.footprint = v.number()? as f32,
+            "footprint" => c.footprint = v.optional(Value::number)?.map(|px| px as f32),
             "alpha" => c.alpha = v.number()? as f32,
             "no_camera_specular" => c.no_camera_specular = v.flag()?,
             "vertex_connections" => c.vertex_connections = v.flag()?,

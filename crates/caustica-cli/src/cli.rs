@@ -277,9 +277,10 @@ pub struct ProgressiveOptions {
     /// for the physical one].
     #[arg(long, value_parser = ["clamp", "reinhard", "linear"])]
     pub tone_map: Option<String>,
-    /// ppm: first gather radius in pixels at the gather point (the footprint the blur starts from).
-    #[arg(long, default_value_t = 2.0)]
-    pub footprint: f32,
+    /// ppm, gi: first gather radius in pixels at the gather point (the footprint the blur starts
+    /// from); vcm: first merging radius in pixels [default: 2 for ppm and gi, 3 for vcm].
+    #[arg(long)]
+    pub footprint: Option<f32>,
     /// Black wherever the camera looks into a mirror or through glass, as in a particle tracer's
     /// image (for comparing with one).
     #[arg(long)]

@@ -134,8 +134,9 @@ pub struct RenderConfig {
     pub passes: Option<String>,
     /// `--time`.
     pub time: Option<f64>,
-    /// `--footprint`.
-    pub footprint: f32,
+    /// `--footprint` (`None`: each integrator's own first radius, 2 pixels for `ppm` and `gi`,
+    /// [`MERGING_FOOTPRINT`](super::vcm::MERGING_FOOTPRINT) for `vcm`).
+    pub footprint: Option<f32>,
     /// `--alpha`.
     pub alpha: f32,
     /// `--no-camera-specular`.
@@ -173,7 +174,7 @@ impl Default for RenderConfig {
             no_estimate_reuse: false,
             passes: None,
             time: None,
-            footprint: 2.0,
+            footprint: None,
             alpha: 2.0 / 3.0,
             no_camera_specular: false,
             vertex_connections: false,
@@ -271,9 +272,11 @@ impl RenderConfig {
             ));
         }
         let depth = self.depth.unwrap_or(if progressive { 64 } else { 5 });
-        let initial_radius = match self.radius {
-            Some(r) => InitialRadius::World(r),
-            None => InitialRadius::Pixels(self.footprint),
+        // `--radius`, else `--footprint`, else the integrator's own default.
+        let initial_radius = |default: InitialRadius| match (self.radius, self.footprint) {
+            (Some(r), _) => InitialRadius::World(r),
+            (None, Some(px)) => InitialRadius::Pixels(px),
+            (None, None) => default,
         };
         let specular_camera_paths = !self.no_camera_specular;
         let photons_per_pass = self.photon_total() as u64;
@@ -305,7 +308,7 @@ impl RenderConfig {
             IntegratorKind::Ppm => Integrator::Ppm(PpmSettings {
                 photons_per_pass,
                 alpha: self.alpha,
-                initial_radius,
+                initial_radius: initial_radius(PpmSettings::default().initial_radius),
                 max_depth: depth,
                 specular_camera_paths,
                 spectral: self.spectral,
@@ -313,7 +316,7 @@ impl RenderConfig {
             IntegratorKind::Gi => Integrator::Gi(GiSettings {
                 photons_per_pass,
                 k_global: self.k,
-                caustic_radius: initial_radius,
+                caustic_radius: initial_radius(GiSettings::default().caustic_radius),
                 alpha: self.alpha,
                 max_depth: depth,
                 specular_camera_paths,
@@ -327,10 +330,7 @@ impl RenderConfig {
             IntegratorKind::Vcm => Integrator::Vcm(VcmSettings {
                 light_paths_per_pass: self.light_paths,
                 alpha: self.alpha,
-                initial_radius: match self.radius {
-                    Some(r) => InitialRadius::World(r),
-                    None => InitialRadius::Pixels(self.footprint),
-                },
+                initial_radius: initial_radius(VcmSettings::default().initial_radius),
                 max_depth: depth,
                 connections: self.vertex_connections,
                 aim: !self.no_aim,
@@ -346,7 +346,7 @@ impl RenderConfig {
             if self.k == 0 || self.k > 10_000 {
                 return Err(Error::InvalidSettings("--k must be between 1 and 10000".into()));
             }
-            if !(self.footprint > 0.0 && self.footprint <= 10_000.0) {
+            if self.footprint.is_some_and(|px| !(px > 0.0 && px <= 10_000.0)) {
                 return Err(Error::InvalidSettings(
                     "--footprint must be a positive number of pixels (at most 10000)".into(),
                 ));
@@ -416,7 +416,7 @@ impl RenderConfig {
         if self.radius.is_some() {
             ignored.push("--radius");
         }
-        if self.footprint != default.footprint {
+        if self.footprint.is_some() {
             ignored.push("--footprint");
         }
         if self.alpha != default.alpha {
@@ -520,5 +520,42 @@ mod tests {
             assert_eq!(RenderConfig::for_scene(&hints(1)).depth, Some(0), "direct light only");
             assert_eq!(RenderConfig::for_scene(&hints(0)).depth, Some(0));
         }
+    }
+
+    fn first_radius(config: &RenderConfig) -> InitialRadius {
+        match config.integrator().unwrap() {
+            Integrator::Ppm(s) => s.initial_radius,
+            Integrator::Gi(s) => s.caustic_radius,
+            Integrator::Vcm(s) => s.initial_radius,
+            other => panic!("{other:?} has no radius"),
+        }
+    }
+
+    /// Without `--footprint` each integrator starts from its own radius (`vcm` merges from 3
+    /// pixels, `ppm` and `gi` gather from 2); `--footprint` sets it for all, `--radius` wins.
+    #[test]
+    fn the_first_radius_is_each_integrators_own_unless_given() {
+        let with = |kind, footprint, radius| RenderConfig {
+            integrator: Some(kind),
+            footprint,
+            radius,
+            ..RenderConfig::default()
+        };
+        use InitialRadius::{Pixels, World};
+        for (kind, own) in [
+            (IntegratorKind::Ppm, 2.0),
+            (IntegratorKind::Gi, 2.0),
+            (IntegratorKind::Vcm, 3.0),
+        ] {
+            assert_eq!(first_radius(&with(kind, None, None)), Pixels(own));
+            assert_eq!(first_radius(&with(kind, Some(1.5), None)), Pixels(1.5));
+            assert_eq!(first_radius(&with(kind, Some(1.5), Some(0.1))), World(0.1));
+            assert!(with(kind, Some(0.0), None).integrator().is_err());
+        }
+        assert_eq!(
+            with(IntegratorKind::Lt, Some(3.0), None).ignored_by_lt(),
+            ["--footprint"]
+        );
+        assert!(with(IntegratorKind::Lt, None, None).ignored_by_lt().is_empty());
     }
 }
