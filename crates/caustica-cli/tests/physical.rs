@@ -186,3 +186,26 @@ fn ctrl_c_keeps_the_passes_done() {
     assert!(part.pass_count() >= 1);
     assert_eq!(exr(&dir.join("run.exr")).len(), 32 * 24 * 3);
 }
+
+/// vcm starts no light paths from suns: on the pool (sunlight through water) it says the
+/// sun's caustics will be missing; ppm, which renders them, says nothing of the kind.
+#[test]
+fn vcm_warns_that_a_suns_caustics_are_missing() {
+    let dir = temp_dir("vcm-sun");
+    let pool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/pool.ray");
+    let run = |integrator: &str| {
+        let out = caustica()
+            .current_dir(&dir)
+            .arg("render")
+            .arg(&pool)
+            .args(["--model", "physical", "--integrator", integrator])
+            .args(["--width", "8", "--passes", "1", "--photons", "1000", "-o", "pool.exr"])
+            .assert()
+            .success();
+        String::from_utf8_lossy(&out.get_output().stderr).into_owned()
+    };
+    let vcm = run("vcm");
+    assert!(vcm.contains("sun or directional light(s): the caustics"), "{vcm}");
+    let ppm = run("ppm");
+    assert!(!ppm.contains("sun or directional"), "{ppm}");
+}

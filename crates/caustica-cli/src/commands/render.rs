@@ -162,6 +162,11 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                     ignored.join(", ")
                 );
             }
+            if config.integrator_kind().ok() == Some(IntegratorKind::Vcm) {
+                if let Some(why) = vcm_misses_far_caustics(scene) {
+                    eprintln!("warning: {why}");
+                }
+            }
             let ignored = config.ignored_by_lt();
             if !ignored.is_empty() {
                 eprintln!(
@@ -388,6 +393,21 @@ fn preview_json(report: &Option<PreviewReport>) -> serde_json::Value {
 }
 
 /// What the physical model reads differently from the course's shading.
+/// vcm starts no light subpaths from suns and directional lights (they reach the image by
+/// camera paths only), so the caustics they cast through glass or off mirrors are missing.
+fn vcm_misses_far_caustics(scene: &Scene) -> Option<String> {
+    let far = scene
+        .lights()
+        .iter()
+        .filter(|l| matches!(l, Light::Directional { .. } | Light::Sun { .. }))
+        .count();
+    (far > 0 && !caustica::light::emission::caustic_targets(scene).is_empty()).then(|| {
+        format!(
+            "vcm traces no light paths from the scene's {far} sun or directional light(s): the caustics they cast through glass or off mirrors will be missing (--integrator ppm renders them)"
+        )
+    })
+}
+
 fn physical_notes(scene: &Scene) -> Vec<String> {
     let mut notes = Vec::new();
     let attenuated = scene
