@@ -392,7 +392,6 @@ fn preview_json(report: &Option<PreviewReport>) -> serde_json::Value {
     }
 }
 
-/// What the physical model reads differently from the course's shading.
 /// vcm starts no light subpaths from suns and directional lights (they reach the image by
 /// camera paths only), so the caustics they cast through glass or off mirrors are missing.
 fn vcm_misses_far_caustics(scene: &Scene) -> Option<String> {
@@ -408,6 +407,7 @@ fn vcm_misses_far_caustics(scene: &Scene) -> Option<String> {
     })
 }
 
+/// What the physical model reads differently from the course's shading.
 fn physical_notes(scene: &Scene) -> Vec<String> {
     let mut notes = Vec::new();
     let attenuated = scene
