@@ -78,7 +78,7 @@ def run_one(renderer, scene, budget, seed, out, ref, caustica, extra=(), referen
         rec['render_cpu'] = summary['seconds']['render_cpu']
     else:
         if summary.get('photons_per_pass'):
-            rec['photons'] = summary['passes'] * summary['photons_per_pass']
+            rec['photons'] = summary['photons']   # resized passes count by their share
         if renderer == 'cs-path':   # one camera path per pixel and pass (--aa 1)
             rec['spp'] = summary['passes']
     if reference is not None:

@@ -220,4 +220,22 @@ pub trait Progressive: Send + Sync {
     fn pass_cost(&self, _pass: u64) -> f64 {
         1.0
     }
+
+    /// Pass `pass`'s weight in the image's mean: its share of a full pass's light paths.
+    fn pass_weight(&self, _pass: u64) -> f64 {
+        1.0
+    }
+
+    /// For the end of a time limit: the share of a full pass that pass `pass` can take and
+    /// still end within `seconds`, from the passes timed so far. `None`: this integrator's
+    /// passes keep their size.
+    fn share_within(&self, _pass: u64, _seconds: f64) -> Option<f64> {
+        None
+    }
+
+    /// Renders pass `pass` at `share` of a full pass (its weight is `share`); an integrator
+    /// whose [`Progressive::share_within`] is `None` renders it at its own size.
+    fn render_share(&self, pass: u64, _share: f64, control: Control) -> Option<Vec<Vec3>> {
+        self.render_pass(pass, control)
+    }
 }

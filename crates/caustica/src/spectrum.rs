@@ -170,6 +170,12 @@ pub enum Wavelengths {
     },
 }
 
+/// Fits the table that turns colours into spectra now, if it is not yet (it takes a few tenths
+/// of a second, once per process), so that a timed part of a render does not pay for it.
+pub fn prepare() {
+    Uplift::get();
+}
+
 /// A reflectance colour at sampled wavelengths `lambda` (the sigmoid-polynomial fit of `rgb`).
 #[inline(never)]
 fn sampled_reflectance(lambda: &[f32; SAMPLES], rgb: Vec3) -> Spectrum {

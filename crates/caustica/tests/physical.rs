@@ -219,7 +219,7 @@ fn cornell_area_light_ppm_converges_to_the_reference() {
     let mut pass = 0;
     for end in [4, 16, 64] {
         while pass < end {
-            acc.add(pass, &ppm.render_pass(pass, control()).unwrap());
+            acc.add(pass, &ppm.render_pass(pass, control()).unwrap(), 1.0);
             pass += 1;
         }
         let (worst, text) = report(&acc.film(), &reference, &[CAUSTIC, FLOOR]);

@@ -1,19 +1,21 @@
 //! Vertex connection and merging (`vcm`) against a closed form, against the path tracer and
 //! light tracing on a purely diffuse scene, against the independent reference (skipped when
 //! `../shared/reference/` is absent), and its contracts: the same image on any thread count,
-//! and split runs that merge into one. That the weights of all its strategies sum to one is a
+//! split runs that merge into one, and passes resized for a time limit that weigh their share. That the weights of all its strategies sum to one is a
 //! unit test beside them (integrator/vcm/mis.rs).
 
 mod common;
 
 use caustica::film::Film;
 use caustica::integrator::lt::{LightTracer, LtSettings};
+use caustica::integrator::partial::Accumulator;
 use caustica::integrator::path::{PathSettings, PathTracer};
 use caustica::integrator::radius::InitialRadius;
 use caustica::integrator::vcm::{Vcm, VcmSettings};
+use caustica::integrator::Progressive;
 use caustica::math::Vec3;
 use common::{
-    assert_deterministic_and_merges, load_reference, region_error, rel, render_passes, report, scene, Region,
+    assert_deterministic_and_merges, control, load_reference, region_error, rel, render_passes, report, scene, Region,
 };
 use std::f32::consts::PI;
 
@@ -140,6 +142,27 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
             );
         }
     }
+    // Passes resized as a time limit's last pass is (a quarter and seven quarters of a full
+    // one), each weighted by its share: the same light in the mean.
+    let settings = VcmSettings {
+        light_paths_per_pass: Some(8192),
+        max_depth: depth,
+        ..VcmSettings::default()
+    };
+    let vcm = Vcm::new(&s, settings, 32, 32, 4);
+    let mut acc = Accumulator::new(32, 32, "resized");
+    for pass in 0..256 {
+        let share = if pass % 2 == 0 { 0.25 } else { 1.75 };
+        acc.add(pass, &vcm.render_share(pass, share, control()).unwrap(), share);
+    }
+    let got = quadrants(&acc.film());
+    for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
+        eprintln!("resized passes, quadrant {i}: vcm {g:.4} path {r:.4}");
+        assert!(
+            rel(*g, *r) < 0.02,
+            "resized passes, quadrant {i}: vcm {g} against path {r}"
+        );
+    }
     let lt = light_tracer(&s, depth, 32, 3);
     let got = quadrants(&render_passes(&lt, 32, 32, 0, 32).film());
     // The upper quadrants see the lamp, which light tracing cannot.
@@ -177,6 +200,24 @@ fn vcm_is_deterministic_and_merges() {
         };
         assert_deterministic_and_merges(&Vcm::new(&s, settings, 32, 32, 7), 32, 32);
     }
+}
+
+/// With the default light subpath count the first two passes trace half as many and weigh
+/// half as much; a pass resized to the same share is the same pass, and the merge of split
+/// runs still equals one run.
+#[test]
+fn vcm_passes_weigh_their_light_subpaths() {
+    let s = scene(DIFFUSE_BOX);
+    let vcm = Vcm::new(&s, VcmSettings::default(), 32, 32, 7);
+    assert_eq!(
+        (vcm.pass_weight(0), vcm.pass_weight(1), vcm.pass_weight(2)),
+        (0.5, 0.5, 1.0)
+    );
+    assert_eq!(vcm.pass_cost(1), 0.5);
+    let own = vcm.render_pass(0, control()).unwrap();
+    assert_eq!(vcm.render_share(0, 0.5, control()).unwrap(), own);
+    assert_ne!(vcm.render_share(0, 0.75, control()).unwrap(), own);
+    assert_deterministic_and_merges(&vcm, 32, 32);
 }
 
 /// Regions of the reference (rows, columns inclusive) that show no mirror or glass (the

@@ -280,6 +280,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
             .unwrap_or_else(|| caustica::integrator::vcm::default_light_paths(width, height)),
         _ => 0,
     };
+    let full_passes = session.accumulator().weight;
     if args.json {
         let summary = if progressive {
             json!({
@@ -292,6 +293,9 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "passes": passes_done,
                 "pass_ranges": ranges.join(","),
                 "photons_per_pass": photons_per_pass,
+                // Passes resized to a time limit count by their share of a full pass.
+                "full_passes": full_passes,
+                "photons": (full_passes * photons_per_pass as f64).round() as u64,
                 "complete": complete,
                 "seconds": {
                     "parse": parse_seconds,

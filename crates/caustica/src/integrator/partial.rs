@@ -4,9 +4,13 @@
 //! i) alone, so passes can run in any order, on any machine: the average of the passes of
 //! several partial runs equals the average of one run over all of them.
 //!
+//! Passes may differ in size (a vcm pass under a time limit is cut or stretched to end at it):
+//! each is added with its weight, its share of a full pass's light paths, and the image is the
+//! weighted mean, so a small pass moves it no more than its paths deserve.
+//!
 //! A partial file (`.part`) holds the sums of a run's passes: a short text header (format, image
-//! size, the run's settings fingerprint, the passes it holds) and then the sums as little-endian
-//! f64 triples, rows from the top.
+//! size, the run's settings fingerprint, the passes it holds, their total weight) and then the
+//! weighted sums as little-endian f64 triples, rows from the top.
 
 use crate::error::{Error, Result};
 use crate::film::Film;
@@ -24,6 +28,8 @@ pub struct Accumulator {
     pub fingerprint: String,
     /// The passes held, as half-open ranges, sorted and disjoint.
     pub passes: Vec<(u64, u64)>,
+    /// The passes' total weight (their count when all are full).
+    pub weight: f64,
     sum: Vec<[f64; 3]>,
 }
 
@@ -37,6 +43,7 @@ impl Accumulator {
             height,
             fingerprint: fingerprint.into(),
             passes: Vec::new(),
+            weight: 0.0,
             sum: vec![[0.0; 3]; width * height],
         }
     }
@@ -49,6 +56,7 @@ impl Accumulator {
             height,
             fingerprint: fingerprint.into(),
             passes: Vec::new(),
+            weight: 0.0,
             sum: Vec::new(),
         }
     }
@@ -63,14 +71,15 @@ impl Accumulator {
         self.passes.iter().map(|(a, b)| b - a).sum()
     }
 
-    /// Adds the pixels of pass `pass`.
-    pub fn add(&mut self, pass: u64, pixels: &[Vec3]) {
+    /// Adds the pixels of pass `pass`, of weight `weight` (1 for a full pass).
+    pub fn add(&mut self, pass: u64, pixels: &[Vec3], weight: f64) {
         assert_eq!(pixels.len(), self.sum.len(), "pass image size");
         for (s, p) in self.sum.iter_mut().zip(pixels) {
-            s[0] += p.x as f64;
-            s[1] += p.y as f64;
-            s[2] += p.z as f64;
+            s[0] += weight * p.x as f64;
+            s[1] += weight * p.y as f64;
+            s[2] += weight * p.z as f64;
         }
+        self.weight += weight;
         self.insert_range(pass, pass + 1);
     }
 
@@ -87,10 +96,10 @@ impl Accumulator {
         self.passes = merged;
     }
 
-    /// The mean of the passes.
+    /// The weighted mean of the passes.
     pub fn film(&self) -> Film {
         let mut film = Film::new(self.width, self.height);
-        let n = self.pass_count().max(1) as f64;
+        let n = if self.weight > 0.0 { self.weight } else { 1.0 };
         for (p, s) in film.pixels.iter_mut().zip(&self.sum) {
             *p = Vec3::new((s[0] / n) as f32, (s[1] / n) as f32, (s[2] / n) as f32);
         }
@@ -125,6 +134,7 @@ impl Accumulator {
                 s[c] += o[c];
             }
         }
+        self.weight += other.weight;
         for &(a, b) in &other.passes {
             self.insert_range(a, b);
         }
@@ -135,11 +145,12 @@ impl Accumulator {
     pub fn save(&self, path: &Path) -> Result<()> {
         let ranges: Vec<String> = self.passes.iter().map(|(a, b)| format!("{a}..{b}")).collect();
         let mut bytes = format!(
-            "{MAGIC}\nwidth {}\nheight {}\nfingerprint {}\npasses {}\n\n",
+            "{MAGIC}\nwidth {}\nheight {}\nfingerprint {}\npasses {}\nweight {}\n\n",
             self.width,
             self.height,
             self.fingerprint.replace('\n', " "),
-            ranges.join(",")
+            ranges.join(","),
+            self.weight
         )
         .into_bytes();
         bytes.reserve(self.sum.len() * 24);
@@ -170,7 +181,7 @@ impl Accumulator {
         if lines.next() != Some(MAGIC) {
             return Err(bad("wrong first line"));
         }
-        let (mut width, mut height, mut fingerprint, mut passes) = (None, None, None, None);
+        let (mut width, mut height, mut fingerprint, mut passes, mut weight) = (None, None, None, None, None);
         for line in lines {
             let (key, value) = line.split_once(' ').unwrap_or((line, ""));
             match key {
@@ -178,6 +189,10 @@ impl Accumulator {
                 "height" => height = value.parse::<usize>().ok(),
                 "fingerprint" => fingerprint = Some(value.to_string()),
                 "passes" => passes = Some(parse_ranges(value).ok_or_else(|| bad("bad pass ranges"))?),
+                "weight" => {
+                    let w = value.parse::<f64>().ok().filter(|w| w.is_finite() && *w >= 0.0);
+                    weight = Some(w.ok_or_else(|| bad("bad weight"))?);
+                }
                 _ => return Err(bad(&format!("unknown header line `{line}`"))),
             }
         }
@@ -208,11 +223,14 @@ impl Accumulator {
             height,
             fingerprint: fingerprint.ok_or_else(|| bad("no fingerprint"))?,
             passes: Vec::new(),
+            weight: 0.0,
             sum,
         };
         for (a, b) in passes.ok_or_else(|| bad("no passes"))? {
             acc.insert_range(a, b);
         }
+        // Files written before passes had weights hold full passes only.
+        acc.weight = weight.unwrap_or(acc.pass_count() as f64);
         Ok(acc)
     }
 }
@@ -261,9 +279,11 @@ mod tests {
         let mut whole = Accumulator::new(3, 2, "run");
         let mut first = Accumulator::new(3, 2, "run");
         let mut second = Accumulator::new(3, 2, "run");
+        // Pass 5 is a half pass: it weighs half as much in the mean.
+        let weight = |i: u64| if i == 5 { 0.5 } else { 1.0 };
         for i in 0..6 {
-            whole.add(i, &pass(i));
-            if i < 3 { &mut first } else { &mut second }.add(i, &pass(i));
+            whole.add(i, &pass(i), weight(i));
+            if i < 3 { &mut first } else { &mut second }.add(i, &pass(i), weight(i));
         }
         let path = dir.join("b.part");
         second.save(&path).unwrap();
@@ -272,7 +292,9 @@ mod tests {
         first.merge(&loaded).unwrap();
         assert_eq!(first.passes, vec![(0, 6)]);
         assert_eq!(first.film(), whole.film());
-        assert!((whole.film().pixels[0].x - 2.5).abs() < 1e-6);
+        // (0 + 1 + 2 + 3 + 4 + 5/2) / 5.5
+        assert!((whole.film().pixels[0].x - 12.5 / 5.5).abs() < 1e-6);
+        assert_eq!(first.weight, 5.5);
         // Counting passes twice, or mixing runs, is refused.
         assert!(first.merge(&loaded).is_err());
         assert!(Accumulator::new(3, 2, "other").merge(&second).is_err());
@@ -281,6 +303,15 @@ mod tests {
         std::fs::write(&path, &bytes[..bytes.len() - 5]).unwrap();
         let err = Accumulator::load(&path).unwrap_err().to_string();
         assert!(err.contains("truncated"), "{err}");
+        // A file from before passes had weights: its passes are full ones.
+        let mut old = Accumulator::new(3, 2, "run");
+        old.add(0, &pass(1), 1.0);
+        old.add(1, &pass(2), 1.0);
+        old.save(&path).unwrap();
+        let text = std::fs::read(&path).unwrap();
+        let cut = text.windows(9).position(|w| w == b"weight 2\n").unwrap();
+        std::fs::write(&path, [&text[..cut], &text[cut + 9..]].concat()).unwrap();
+        assert_eq!(Accumulator::load(&path).unwrap(), old);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

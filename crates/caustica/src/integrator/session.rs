@@ -105,18 +105,52 @@ impl PassPlan {
     }
 }
 
+/// The smallest share of a full pass worth a pass of its own at the end of a time limit.
+const MIN_SHARE: f64 = 1.0 / 64.0;
+
 impl PassPlan {
+    /// Whether pass `pass` is past the plan's end.
+    pub fn past_end(&self, pass: u64) -> bool {
+        self.end.is_some_and(|end| pass >= end)
+    }
+
     /// Whether pass `pass`, of relative cost `next` (1 for a full pass, see
     /// [`Progressive::pass_cost`]), is to start, passes of total cost `done` having been
     /// rendered in `elapsed` seconds: not past the end, and (once a pass is done) expected to
     /// finish less than half the pass past the time limit, so a run ends within half a pass of
     /// it either way.
     pub fn admits(&self, pass: u64, done: f64, elapsed: f64, next: f64) -> bool {
-        let past_end = self.end.is_some_and(|end| pass >= end);
+        let past_end = self.past_end(pass);
         let out_of_time = self
             .time_limit
             .is_some_and(|limit| done > 0.0 && elapsed + 0.5 * next * elapsed / done >= limit);
         !past_end && !out_of_time
+    }
+}
+
+/// The size of a run's next pass.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Resize {
+    /// Its own.
+    Own,
+    /// This share of a full pass, the run's last.
+    To(f64),
+    /// None: the time is up.
+    Stop,
+}
+
+impl Resize {
+    /// The size of a pass of relative cost `own`, followed by one of cost `next` (0: none), when
+    /// `share` of a full pass fits in the time left (`None`: passes keep their size).
+    fn choose(share: Option<f64>, own: f64, next: f64, first: bool) -> Resize {
+        match share {
+            None => Resize::Own,
+            Some(share) if share >= own + next => Resize::Own,
+            Some(share) if share >= MIN_SHARE => Resize::To(share),
+            // A run renders at least one pass.
+            Some(_) if first => Resize::To(MIN_SHARE),
+            Some(_) => Resize::Stop,
+        }
     }
 }
 
@@ -238,10 +272,19 @@ impl<'a> RenderSession<'a> {
     /// interrupted pass of a progressive integrator is dropped; the course model's single pass
     /// keeps the tiles it finished.
     pub fn render_pass(&mut self, pass: u64, control: Control) -> bool {
+        self.render_sized_pass(pass, None, control)
+    }
+
+    /// [`RenderSession::render_pass`], at `share` of a full pass when given.
+    fn render_sized_pass(&mut self, pass: u64, share: Option<f64>, control: Control) -> bool {
         if let Some(passes) = &self.passes {
-            return match passes.render_pass(pass, control) {
+            let (pixels, weight) = match share {
+                Some(share) => (passes.render_share(pass, share, control), share),
+                None => (passes.render_pass(pass, control), passes.pass_weight(pass)),
+            };
+            return match pixels {
                 Some(pixels) => {
-                    self.accumulator.add(pass, &pixels);
+                    self.accumulator.add(pass, &pixels, weight);
                     true
                 }
                 None => false,
@@ -303,13 +346,21 @@ impl<'a> RenderSession<'a> {
         let mut cost_done = 0.0;
         loop {
             let next = self.pass_cost(pass);
-            if control.cancelled() || !plan.admits(pass, cost_done, start.elapsed().as_secs_f64(), next) {
+            let elapsed = start.elapsed().as_secs_f64();
+            if control.cancelled() || plan.past_end(pass) {
                 break;
             }
-            if !self.render_pass(pass, control) {
+            let resize = self.resize(plan, pass, elapsed, cost_done == 0.0);
+            let share = match resize {
+                Resize::Stop => break,
+                Resize::To(share) => Some(share),
+                Resize::Own if plan.admits(pass, cost_done, elapsed, next) => None,
+                Resize::Own => break,
+            };
+            if !self.render_sized_pass(pass, share, control) {
                 break;
             }
-            cost_done += next;
+            cost_done += share.unwrap_or(next);
             pass += 1;
             let done = if by_time {
                 ((start.elapsed().as_secs_f64() * 10.0) as u64).min(bar_total)
@@ -319,6 +370,9 @@ impl<'a> RenderSession<'a> {
             control.progress.advance(done.saturating_sub(reported));
             reported = reported.max(done);
             after_pass(self)?;
+            if share.is_some() {
+                break;
+            }
         }
         control.progress.finish();
         Ok(RunSummary {
@@ -326,6 +380,28 @@ impl<'a> RenderSession<'a> {
             photon_seconds: 0.0,
             render_seconds: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// Whether pass `pass` of `plan`, `elapsed` seconds into the run (`first`: its first pass),
+    /// keeps its own size. Under
+    /// a time limit, an integrator that can resize its passes makes the last one fill the time
+    /// left: it is cut when it would not end in time, and stretched when the next pass would
+    /// not (so no time is left idle and none overrun by more than the estimate's error).
+    fn resize(&self, plan: &PassPlan, pass: u64, elapsed: f64, first: bool) -> Resize {
+        let (Some(limit), Some(passes)) = (plan.time_limit, &self.passes) else {
+            return Resize::Own;
+        };
+        let next = if plan.past_end(pass + 1) {
+            0.0
+        } else {
+            passes.pass_cost(pass + 1)
+        };
+        Resize::choose(
+            passes.share_within(pass, limit - elapsed),
+            passes.pass_cost(pass),
+            next,
+            first,
+        )
     }
 
     /// The mean of the passes so far (the course model: its image, black before it is made).
@@ -383,5 +459,24 @@ mod tests {
         assert!(timed.admits(1, 0.5, 0.4, 1.0) && !timed.admits(1, 0.5, 0.55, 1.0));
         let both = PassPlan::new(Some("3"), Some(10.0)).unwrap();
         assert!(!both.admits(3, 3.0, 0.0, 1.0) && !both.admits(1, 1.0, 10.0, 1.0));
+        assert!(both.past_end(3) && !both.past_end(2));
+    }
+
+    #[test]
+    fn the_last_pass_of_a_time_limit_fills_the_time_left() {
+        // Room for this half pass and the next full one: its own size.
+        assert_eq!(Resize::choose(Some(1.6), 0.5, 1.0, true), Resize::Own);
+        // Room for more than this half pass but not the next: it takes all the time left.
+        assert_eq!(Resize::choose(Some(0.73), 0.5, 1.0, true), Resize::To(0.73));
+        // No room for this pass: it is cut.
+        assert_eq!(Resize::choose(Some(0.3), 1.0, 1.0, false), Resize::To(0.3));
+        // The plan's last pass (no next) keeps its size when it fits, and is not stretched.
+        assert_eq!(Resize::choose(Some(5.0), 1.0, 0.0, false), Resize::Own);
+        assert_eq!(Resize::choose(Some(0.6), 1.0, 0.0, false), Resize::To(0.6));
+        // Too little time for a useful pass: the run ends, unless it has rendered none.
+        assert_eq!(Resize::choose(Some(0.001), 1.0, 1.0, false), Resize::Stop);
+        assert_eq!(Resize::choose(Some(0.0), 0.5, 1.0, true), Resize::To(MIN_SHARE));
+        // Integrators that do not resize passes.
+        assert_eq!(Resize::choose(None, 1.0, 1.0, false), Resize::Own);
     }
 }

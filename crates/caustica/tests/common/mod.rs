@@ -34,7 +34,7 @@ pub fn render_passes(renderer: &dyn Progressive, width: usize, height: usize, fi
     let mut acc = Accumulator::new(width, height, "test");
     for pass in first..end {
         let pixels = renderer.render_pass(pass, control()).expect("not cancelled");
-        acc.add(pass, &pixels);
+        acc.add(pass, &pixels, renderer.pass_weight(pass));
     }
     acc
 }
