@@ -281,8 +281,10 @@ const PILOT_PASS: u64 = (1 << 24) - 1;
 
 /// A first pass's time per light subpath, all its work counted, over the pilot run's (which
 /// neither joins subpaths to the eye nor merges them, nor pays for a pass's first memory).
-/// Measured on six scenes' first passes, on one and two threads: 1.6–2.2.
-const PILOT_TO_PASS_COST: f64 = 2.0;
+/// Measured on six scenes' first passes, on one and two threads: 1.6–2.2. On the race's boxes
+/// at 0.5 s (one thread, eight seeds), 2.0 ended the point box's pass at 0.51–0.53 s and the
+/// area box's at 0.49 s; 2.2 at 0.48 s and 0.44 s.
+const PILOT_TO_PASS_COST: f64 = 2.1;
 
 impl<'a> Vcm<'a> {
     /// A renderer for `scene` at `width`×`height`.
