@@ -383,10 +383,10 @@ impl<'a> RenderSession<'a> {
     }
 
     /// Whether pass `pass` of `plan`, `elapsed` seconds into the run (`first`: its first pass),
-    /// keeps its own size. Under
-    /// a time limit, an integrator that can resize its passes makes the last one fill the time
-    /// left: it is cut when it would not end in time, and stretched when the next pass would
-    /// not (so no time is left idle and none overrun by more than the estimate's error).
+    /// keeps its own size. Under a time limit, an integrator that can resize its passes makes
+    /// the last one fill the time left: it is cut when it would not end in time, and stretched
+    /// when the next pass would not (so no time is left idle and none overrun by more than the
+    /// estimate's error).
     fn resize(&self, plan: &PassPlan, pass: u64, elapsed: f64, first: bool) -> Resize {
         let (Some(limit), Some(passes)) = (plan.time_limit, &self.passes) else {
             return Resize::Own;
