@@ -11,7 +11,7 @@ use crate::{wait, InternalError, Outcome};
 use caustica::film::Film;
 use caustica::integrator::config::thread_pool;
 use caustica::integrator::partial::merge_files;
-use caustica::integrator::{PassPlan, RenderSession};
+use caustica::integrator::{PassPlan, RenderSession, Resize};
 use caustica::progress::{Control, NoProgress};
 use caustica::Error;
 use numpy::PyArray3;
@@ -40,6 +40,8 @@ struct Worker<'a> {
     start: Option<Instant>,
     /// The cost of the passes this run rendered, in full passes.
     cost_done: f64,
+    /// The last pass was resized to the time left: the next call ends the run.
+    finished_after: bool,
     partial: Option<PathBuf>,
     save_every: f64,
     last_save: Instant,
@@ -53,34 +55,42 @@ impl Worker<'_> {
         if self.finished {
             return Ok(None);
         }
+        if self.finished_after {
+            self.finish()?;
+            return Ok(None);
+        }
         if self.stopped.load(Ordering::SeqCst) {
             self.finish()?;
             return Ok(None);
         }
         let start = *self.start.get_or_insert_with(Instant::now);
-        let mut next_cost;
-        loop {
-            next_cost = self.session.pass_cost(self.next);
-            if !self
-                .plan
-                .admits(self.next, self.cost_done, start.elapsed().as_secs_f64(), next_cost)
-            {
-                self.finish()?;
-                return Ok(None);
-            }
+        // The session's rule for a run's passes (under a time limit vcm's last fills it).
+        let share = loop {
+            let size = self
+                .session
+                .next_pass(&self.plan, self.next, self.cost_done, start.elapsed().as_secs_f64());
+            let share = match size {
+                Resize::Stop => {
+                    self.finish()?;
+                    return Ok(None);
+                }
+                Resize::To(share) => Some(share),
+                Resize::Own => None,
+            };
             // A merged part may hold passes of the plan already.
             if !self.session.accumulator().holds(self.next) {
-                break;
+                break share;
             }
             self.next += 1;
-        }
+        };
+        let next_cost = share.unwrap_or_else(|| self.session.pass_cost(self.next));
         let control = Control {
             progress: &NoProgress,
             cancel: &self.cancel,
         };
         let pass = self.next;
         let session = &mut self.session;
-        if !self.pool.install(|| session.render_pass(pass, control)) {
+        if !self.pool.install(|| session.render_sized_pass(pass, share, control)) {
             // Cancelled: the pass is dropped (by Ctrl-C the caller raises instead).
             if self.stopped.load(Ordering::SeqCst) {
                 self.finish()?;
@@ -89,6 +99,10 @@ impl Worker<'_> {
         }
         self.cost_done += next_cost;
         self.next += 1;
+        if share.is_some() {
+            // A resized pass was sized to the time left: the run ends with it.
+            self.finished_after = true;
+        }
         if self.partial.is_some() && self.last_save.elapsed().as_secs_f64() >= self.save_every {
             self.save_partial()?;
         }
@@ -332,6 +346,7 @@ pub fn progressive(
                 stopped: worker_stopped,
                 start: None,
                 cost_done: 0.0,
+                finished_after: false,
                 partial: config.partial,
                 save_every: options.save_every,
                 last_save: Instant::now(),

@@ -40,6 +40,17 @@ def test_a_time_limit_ends_the_run(scenes):
     assert time.perf_counter() - start < 10
 
 
+def test_vcm_fills_a_time_limit_as_the_command_line_does(scenes):
+    # The session's rule: vcm's last pass is resized to the time left and ends the run.
+    start = time.perf_counter()
+    run = caustica.progressive(scenes / "glass_sphere.ray", model="physical", integrator="vcm", width=32, time=0.3)
+    images = list(run)
+    assert len(images) >= 1 and run.passes == len(images)
+    assert np.isfinite(images[-1]).all() and np.array_equal(run.image(), images[-1])
+    assert list(run) == []
+    assert time.perf_counter() - start < 10
+
+
 def test_cancel_stops_the_pass_in_flight_and_keeps_the_rest(scenes):
     options = dict(model="physical", width=160, photons=200_000, passes=1000)
     run = caustica.progressive(scenes / "glass_sphere.ray", **options)

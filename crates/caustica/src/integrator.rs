@@ -24,7 +24,7 @@ pub mod vcm;
 pub mod whitted;
 
 pub use config::RenderConfig;
-pub use session::{PassPlan, RenderOptions, RenderSession, RunSummary};
+pub use session::{PassPlan, RenderOptions, RenderSession, Resize, RunSummary};
 pub use tiles::{image_size, ImageSettings};
 
 use crate::error::{Error, Result};

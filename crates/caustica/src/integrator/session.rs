@@ -128,9 +128,9 @@ impl PassPlan {
     }
 }
 
-/// The size of a run's next pass.
+/// The size of a run's next pass ([`RenderSession::next_pass`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Resize {
+pub enum Resize {
     /// Its own.
     Own,
     /// This share of a full pass, the run's last.
@@ -276,7 +276,7 @@ impl<'a> RenderSession<'a> {
     }
 
     /// [`RenderSession::render_pass`], at `share` of a full pass when given.
-    fn render_sized_pass(&mut self, pass: u64, share: Option<f64>, control: Control) -> bool {
+    pub fn render_sized_pass(&mut self, pass: u64, share: Option<f64>, control: Control) -> bool {
         if let Some(passes) = &self.passes {
             let (pixels, weight) = match share {
                 Some(share) => (passes.render_share(pass, share, control), share),
@@ -346,16 +346,13 @@ impl<'a> RenderSession<'a> {
         let mut cost_done = 0.0;
         loop {
             let next = self.pass_cost(pass);
-            let elapsed = start.elapsed().as_secs_f64();
-            if control.cancelled() || plan.past_end(pass) {
+            if control.cancelled() {
                 break;
             }
-            let resize = self.resize(plan, pass, elapsed, cost_done == 0.0);
-            let share = match resize {
+            let share = match self.next_pass(plan, pass, cost_done, start.elapsed().as_secs_f64()) {
                 Resize::Stop => break,
                 Resize::To(share) => Some(share),
-                Resize::Own if plan.admits(pass, cost_done, elapsed, next) => None,
-                Resize::Own => break,
+                Resize::Own => None,
             };
             if !self.render_sized_pass(pass, share, control) {
                 break;
@@ -380,6 +377,19 @@ impl<'a> RenderSession<'a> {
             photon_seconds: 0.0,
             render_seconds: start.elapsed().as_secs_f64(),
         })
+    }
+
+    /// The size of pass `pass` of `plan`, `elapsed` seconds into a run whose passes so far cost
+    /// `cost_done` full passes: [`Resize::Stop`] past the plan's end or its time (a pass of its
+    /// own size starts only if it is expected to end less than half a pass past the limit).
+    pub fn next_pass(&self, plan: &PassPlan, pass: u64, cost_done: f64, elapsed: f64) -> Resize {
+        if plan.past_end(pass) {
+            return Resize::Stop;
+        }
+        match self.resize(plan, pass, elapsed, cost_done == 0.0) {
+            Resize::Own if !plan.admits(pass, cost_done, elapsed, self.pass_cost(pass)) => Resize::Stop,
+            size => size,
+        }
     }
 
     /// Whether pass `pass` of `plan`, `elapsed` seconds into the run (`first`: its first pass),
