@@ -1,8 +1,9 @@
 //! The sums of a run's passes, kept, saved, loaded and merged.
 //!
 //! Every pass is a complete, independent estimate of the image, and pass `i` depends on (seed,
-//! i) alone, so passes can run in any order, on any machine: the average of the passes of
-//! several partial runs equals the average of one run over all of them.
+//! i) alone (and, for a pass resized to a time limit, its size), so passes can run in any order,
+//! on any machine: the weighted mean of the passes of several partial runs equals that of one
+//! run over all of them.
 //!
 //! Passes may differ in size (a vcm pass under a time limit is cut or stretched to end at it):
 //! each is added with its weight, its share of a full pass's light paths, and the image is the
