@@ -37,6 +37,8 @@ def main():
     arg('--renderers', default='mi-ptracer,mi-path,cs-vcm,cs-ppm,cs-lt,cs-path',
         help='comma-separated: mi-ptracer, mi-path, cs-<caustica integrator> (default: %(default)s)')
     arg('--seeds', type=int, default=4, help='runs per scene, budget and renderer, seeds 1..N (default: %(default)s)')
+    arg('--first-seed', type=int, default=1, help='start the seeds here, to add seeds to a run with --append '
+        '(default: %(default)s)')
     arg('--caustica', default=os.path.join(common.REPO, 'target', 'release', 'caustica'),
         help='caustica binary (default: target/release/caustica)')
     arg('--out', default=os.path.join(common.REPO, 'target', 'race'), help='output folder (default: target/race)')
@@ -83,7 +85,7 @@ def ladder(a, results):
     tmp = tempfile.mkdtemp(prefix='race-')
     failed = set()
     # seed, scene, budget, renderer: the renderers at one budget run back to back, under similar load
-    runs = list(itertools.product(range(1, a.seeds + 1), scenes, budgets, renderers))
+    runs = list(itertools.product(range(a.first_seed, a.first_seed + a.seeds), scenes, budgets, renderers))
     try:
         with open(results, 'a') as fo:
             for i, (seed, scene, budget, r) in enumerate(runs, 1):
