@@ -36,7 +36,7 @@ def main():
     arg('--budgets', default='0.5,1,2,4,8,16', help='wall-time budgets in seconds (default: %(default)s)')
     arg('--renderers', default='mi-ptracer,mi-path,cs-vcm,cs-ppm,cs-lt,cs-path',
         help='comma-separated: mi-ptracer, mi-path, cs-<caustica integrator> (default: %(default)s)')
-    arg('--seeds', type=int, default=4, help='runs per scene, budget and renderer, seeds 1..N (default: %(default)s)')
+    arg('--seeds', type=int, default=4, help='runs per scene, budget and renderer: seeds FIRST_SEED onwards (default: %(default)s)')
     arg('--first-seed', type=int, default=1, help='start the seeds here, to add seeds to a run with --append '
         '(default: %(default)s)')
     arg('--caustica', default=os.path.join(common.REPO, 'target', 'release', 'caustica'),
