@@ -180,7 +180,20 @@ impl Bsdf {
             (Wavelengths::Sampled { lambda, .. }, Some(fit)) => Vec4::from_array(lambda.map(|l| fit.eval(l))) * scale,
             _ => wl.reflectance(rgb),
         };
-        let fits = spectra.copied().unwrap_or_default();
+        let [diffuse, glossy, mirror, transmission] = match wl {
+            // The colours as they are, without the closure: called four times per hit, it took
+            // each colour through memory and stalled on reading it back (6% of `path`).
+            Wavelengths::Rgb => [kd, ks, kr, kt].map(|c| c.extend(0.0)),
+            Wavelengths::Sampled { .. } => {
+                let fits = spectra.copied().unwrap_or_default();
+                [
+                    spectrum(kd, fits.diffuse),
+                    spectrum(ks, fits.specular),
+                    spectrum(kr, fits.reflective),
+                    spectrum(kt, fits.transmissive),
+                ]
+            }
+        };
         let (index, dispersive) = match (abbe, wl.hero()) {
             (Some(v), Some(lambda)) if kt != Vec3::ZERO => (cauchy_index(lobes.index, v, lambda), true),
             _ => (lobes.index, false),
@@ -189,11 +202,11 @@ impl Bsdf {
             frame: Frame::from_normal(facing),
             ng: ng_facing,
             outside,
-            diffuse: spectrum(kd, fits.diffuse),
-            glossy: spectrum(ks, fits.specular),
+            diffuse,
+            glossy,
             exponent: lobes.exponent,
-            mirror: spectrum(kr, fits.reflective),
-            transmission: spectrum(kt, fits.transmissive),
+            mirror,
+            transmission,
             index,
             dispersive,
             pick: lobes.pick,

@@ -389,7 +389,17 @@ impl Scene {
     pub fn unoccluded_except(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> bool {
         let (point, origin) = (hit.point, hit.ray_origin(wi));
         let t_max = (distance - (origin - point).length()) * (1.0 - 1e-5);
-        !self.any_hit(&Ray::new(origin, wi), t_max, |h| h.prim != own)
+        let ray = Ray::new(origin, wi);
+        let n_shapes = self.shapes.len() as u32;
+        // `own` is passed over before it is intersected: the segment ends on it, so the test
+        // would find it on nearly every call only to throw the hit away.
+        let blocked = self.shape_bvh.any_hit(&ray, t_max, |prim, t_max| {
+            prim != own
+                && self.shapes[prim as usize]
+                    .intersect_object_normal(&ray, t_max)
+                    .is_some()
+        }) || self.triangle_bvh.each_hit(&ray, t_max, |h| n_shapes + h.prim != own);
+        !blocked
     }
 
     /// World bounds of everything.
