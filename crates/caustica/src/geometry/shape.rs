@@ -466,15 +466,8 @@ mod tests {
                 let origin = Vec3::new(4.0 * u(), 4.0 * u(), 4.0 * u());
                 let target = m.transform_point3(Vec3::new(0.7 * u(), 0.7 * u(), 0.0));
                 let ray = Ray::new(origin, (target - origin).normalize());
-                let local = Ray::new(
-                    s.object_from_world.transform_point3(ray.origin),
-                    s.object_from_world.transform_vector3(ray.dir),
-                );
                 // The exact hit, from the f32 ray in f64.
-                let (o, d) = (
-                    inverse.transform_point3(ray.origin.as_dvec3()),
-                    inverse.transform_vector3(ray.dir.as_dvec3()),
-                );
+                let (local, o, d) = in_object_space(&s, &inverse, &ray);
                 let exact = o + d * (-o.z / d.z);
                 let world = s.intersect_square(&ray, f32::INFINITY);
                 let object = square::intersect(&local, f32::INFINITY);
@@ -497,6 +490,17 @@ mod tests {
         }
         assert!(hits > 4000 && edge < 10, "{hits} hits, {edge} at an edge");
         check_mean_errors(hits, world_error, object_error, 1e-5, &format!("{edge} at an edge"));
+    }
+
+    /// `ray` moved into `s`'s object space as the object-space tests see it (f32), and its
+    /// origin and direction moved there in f64 by `inverse`, the exact inverse transform.
+    fn in_object_space(s: &Shape, inverse: &glam::DMat4, ray: &Ray) -> (Ray, glam::DVec3, glam::DVec3) {
+        let local = Ray::new(
+            s.object_from_world.transform_point3(ray.origin),
+            s.object_from_world.transform_vector3(ray.dir),
+        );
+        let o = inverse.transform_point3(ray.origin.as_dvec3());
+        (local, o, inverse.transform_vector3(ray.dir.as_dvec3()))
     }
 
     /// The mean distance to the exact point over `hits` (from the summed errors) of a
@@ -543,14 +547,7 @@ mod tests {
                     target + Vec3::new(u(), u(), u()).normalize() * scale * (2.0 + 8.0 * u().abs())
                 };
                 let ray = Ray::new(origin, (target - origin).normalize());
-                let local = Ray::new(
-                    s.object_from_world.transform_point3(ray.origin),
-                    s.object_from_world.transform_vector3(ray.dir),
-                );
-                let (o, d) = (
-                    inverse.transform_point3(ray.origin.as_dvec3()),
-                    inverse.transform_vector3(ray.dir.as_dvec3()),
-                );
+                let (local, o, d) = in_object_space(&s, &inverse, &ray);
                 let (a, half_b, c) = (d.dot(d), o.dot(d), o.dot(o) - 1.0);
                 let disc = half_b * half_b - a * c;
                 let world = s.intersect_object_normal(&ray, f32::INFINITY);
