@@ -155,7 +155,7 @@ pub struct PhotonOptions {
     #[arg(long, value_delimiter = ',')]
     pub photons_per_light: Option<Vec<usize>>,
     /// Emit photons in all directions instead of aiming at mirrors and glass (course model;
-    /// vcm: none of its light subpaths aimed).
+    /// vcm: none of its light subpaths, nor their bounces, aimed).
     #[arg(long)]
     pub no_aim: bool,
     /// Largest photon map in MB (photons are 24 bytes, the kd-tree under 1 byte each); larger

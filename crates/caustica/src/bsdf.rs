@@ -350,11 +350,17 @@ impl Bsdf {
         f
     }
 
+    /// Whether the surface is a purely Lambertian reflector.
+    #[inline]
+    pub fn is_lambertian(&self) -> bool {
+        let only_diffuse = self.pick[0] > 0.0 && self.pick[1..].iter().all(|&p| p == 0.0);
+        only_diffuse && self.coat <= 0.0 && self.microfacet.is_none()
+    }
+
     /// A purely Lambertian reflection seen from `wo`, for asking about many light directions
     /// (merging's candidates) at the cost of one; `None` for any other lobes.
     pub fn lambertian(&self, wo: Vec3) -> Option<Lambertian> {
-        let only_diffuse = self.pick[0] > 0.0 && self.pick[1..].iter().all(|&p| p == 0.0);
-        if !only_diffuse || self.coat > 0.0 || self.microfacet.is_some() {
+        if !self.is_lambertian() {
             return None;
         }
         let cos_o = self.frame.z.dot(wo);

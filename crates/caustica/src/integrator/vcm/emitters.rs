@@ -67,6 +67,11 @@ impl Aim {
         Some(Aim { targets, share })
     }
 
+    /// The share of samples aimed.
+    pub fn share(&self) -> f32 {
+        self.share
+    }
+
     /// A target, chosen in proportion to the solid angle it subtends from `from` (`None`: none
     /// subtends any).
     fn pick(&self, from: Vec3, u_pick: f32) -> Option<&Target> {
@@ -86,14 +91,14 @@ impl Aim {
     }
 
     /// A direction from `from` into one of the cones (`None`: they have no solid angle).
-    fn sample(&self, from: Vec3, u_pick: f32, u: Vec2) -> Option<Vec3> {
+    pub(super) fn sample(&self, from: Vec3, u_pick: f32, u: Vec2) -> Option<Vec3> {
         let (axis, cos_max) = self.pick(from, u_pick)?.cone_from(from);
         Some(sample_uniform_cone(u, axis, cos_max))
     }
 
     /// The solid-angle density of [`Aim::sample`] at `dir`: each cone holding `dir` adds
     /// its share 1/(2π Σ(1 − cos)) (its weight over its own solid angle).
-    fn pdf(&self, from: Vec3, dir: Vec3) -> f32 {
+    pub(super) fn pdf(&self, from: Vec3, dir: Vec3) -> f32 {
         let (mut total, mut inside) = (0.0, 0u32);
         for t in &self.targets {
             let (axis, cos_max) = t.cone_from(from);
