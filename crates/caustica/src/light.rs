@@ -223,7 +223,7 @@ impl Light {
     }
 
     /// A sun's radiance within its disc: E / (π sin²θ), zero for other lights.
-    fn sun_radiance(&self) -> Vec3 {
+    pub(crate) fn sun_radiance(&self) -> Vec3 {
         match self {
             Light::Sun {
                 color, one_minus_cos, ..
@@ -585,8 +585,23 @@ impl LightSet {
     /// each light's radiance weighted against next-event estimation's chance of sampling it
     /// there (power heuristic).
     pub fn escaped_weighted(&self, dir: Vec3, bsdf_pdf: Option<f32>, wl: &Wavelengths) -> Spectrum {
+        self.escaped_weighted_except(dir, bsdf_pdf, wl, |_| false)
+    }
+
+    /// [`LightSet::escaped_weighted`] leaving out the lights for which `skip` holds (an
+    /// integrator that weighs them itself).
+    pub(crate) fn escaped_weighted_except(
+        &self,
+        dir: Vec3,
+        bsdf_pdf: Option<f32>,
+        wl: &Wavelengths,
+        skip: impl Fn(usize) -> bool,
+    ) -> Spectrum {
         let mut l = Spectrum::ZERO;
         for (index, light) in self.lights.iter().enumerate() {
+            if skip(index) {
+                continue;
+            }
             let (radiance, light_pdf) = match light {
                 Light::Environment(env) => (env.radiance(dir), env.pdf(dir)),
                 Light::Sun { direction, cos_max, .. } if -dir.dot(*direction) >= *cos_max => {

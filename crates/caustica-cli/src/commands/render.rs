@@ -163,7 +163,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 );
             }
             if config.integrator_kind().ok() == Some(IntegratorKind::Vcm) {
-                if let Some(why) = vcm_misses_far_caustics(scene) {
+                if let Some(why) = vcm_misses_sky_caustics(scene) {
                     eprintln!("warning: {why}");
                 }
             }
@@ -396,18 +396,12 @@ fn preview_json(report: &Option<PreviewReport>) -> serde_json::Value {
     }
 }
 
-/// vcm starts no light subpaths from suns and directional lights (they reach the image by
-/// camera paths only), so the caustics they cast through glass or off mirrors are missing.
-fn vcm_misses_far_caustics(scene: &Scene) -> Option<String> {
-    let far = scene
-        .lights()
-        .iter()
-        .filter(|l| matches!(l, Light::Directional { .. } | Light::Sun { .. }))
-        .count();
-    (far > 0 && !caustica::light::emission::caustic_targets(scene).is_empty()).then(|| {
-        format!(
-            "vcm traces no light paths from the scene's {far} sun or directional light(s): the caustics they cast through glass or off mirrors will be missing (--integrator ppm renders them)"
-        )
+/// vcm starts no light subpaths from the sky (it reaches the image by camera paths only), so
+/// the caustics it casts through glass or off mirrors are missing.
+fn vcm_misses_sky_caustics(scene: &Scene) -> Option<String> {
+    let sky = scene.lights().iter().any(|l| matches!(l, Light::Environment(_)));
+    (sky && !caustica::light::emission::caustic_targets(scene).is_empty()).then(|| {
+        "vcm traces no light paths from the sky (the environment light): the caustics it casts through glass or off mirrors will be missing (--integrator ppm renders them)".to_string()
     })
 }
 

@@ -9,10 +9,10 @@
 //!
 //! Departures from the textbook, each leaving a strategy out for a class of paths where it is
 //! the worst estimator (the weights of those paths still sum to one, see [`mis`]):
-//! - merging happens only at the first smooth surface the camera path meets (as in
-//!   progressive photon mapping): deeper, a merge stands on one sampled bounce of the camera
-//!   path and is as noisy as path tracing, yet the balance heuristic would weigh it like the
-//!   first;
+//! - merging happens only at the first vertex where the camera path scatters off a smooth
+//!   lobe (as in progressive photon mapping; a coated glass's delta lobes pass it on, as
+//!   mirrors and glass do): deeper, a merge stands on one sampled bounce of the camera path
+//!   and is as noisy as path tracing, yet the balance heuristic would weigh it like the first;
 //! - where the eye sees a caustic's focus directly (light came from the light through mirrors
 //!   and glass only, and a pilot run found such light concentrated there: [`focus`]), merging
 //!   is left out there too, so light tracing keeps the focus sharp instead of sharing it with a
@@ -463,7 +463,13 @@ impl<'a> Vcm<'a> {
                 let direct = self.emitters.direct_pdf(scene, &emission, hit.point);
                 partial = Partial::light(f, emission.emission_pdf, direct, emission.cos, emission.delta);
             }
-            partial.arrive((hit.point - previous).length_squared(), bsdf.normal().dot(wo).abs());
+            // A far light's densities are across its beam: no distance to its first vertex.
+            let d2 = if length == 1 && emission.far {
+                1.0
+            } else {
+                (hit.point - previous).length_squared()
+            };
+            partial.arrive(d2, bsdf.normal().dot(wo).abs());
             if !self.settings.connections && length > 1 {
                 // The sum's first term stands for a connection that makes this vertex.
                 partial.vcm = 0.0;
@@ -620,7 +626,6 @@ impl<'a> Vcm<'a> {
     fn camera_path(&self, ray: Ray, pass: &PassData, own: usize, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
         let f = &pass.factors;
         let scene = self.scene;
-        let lights = scene.lights();
         let camera_pdf = self.sensor.importance(ray.dir);
         if camera_pdf <= 0.0 {
             return Spectrum::ZERO;
@@ -642,13 +647,15 @@ impl<'a> Vcm<'a> {
         // The sums without merging at the last vertex, for an emitter hit next (light reaches
         // that vertex first).
         let mut without_last_merge = Partial::default();
-        // Whether a smooth surface came before: merging is a strategy at the first only.
+        // Whether the path scattered off a smooth lobe before: merging is a strategy at the
+        // first vertex where it does (the delta lobes of coated glass, as mirrors and glass,
+        // pass the merge on to the next vertex).
         let mut smooth_before = false;
         // Whether the first vertex lies where caustics are focused.
         let mut first_focused = false;
         for length in 1..=self.max_length {
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                l += throughput * lights.escaped_weighted(ray.dir, last_pdf, wl);
+                l += throughput * self.escaped(ray.dir, previous, last_pdf, &without_last_merge, length, wl);
                 break;
             };
             let hit = scene.surface(&ray, &isect);
@@ -687,7 +694,6 @@ impl<'a> Vcm<'a> {
                 first_focused = self.focus().contains(hit.point);
             }
             if bsdf.is_smooth() {
-                smooth_before = true;
                 let v = CameraVertex {
                     hit: &hit,
                     bsdf: &bsdf,
@@ -713,6 +719,7 @@ impl<'a> Vcm<'a> {
                 break;
             };
             let cos_out = bsdf.normal().dot(sample.wi).abs();
+            smooth_before |= !sample.specular;
             if sample.specular {
                 partial.scatter_specular(cos_out);
                 if let Some(with) = with_first_merge.as_mut() {
@@ -756,6 +763,38 @@ impl<'a> Vcm<'a> {
         } else {
             Spectrum::ZERO
         }
+    }
+
+    /// What a camera path leaving `from` in `dir` after `length` segments sees of the sky and
+    /// suns: a sun that starts light subpaths weighed against every strategy (`camera`: the
+    /// sums without merging at the last vertex, where light arrives first), the rest against
+    /// next-event estimation alone, as in the path tracer (`last_pdf`: the last bounce's).
+    fn escaped(
+        &self,
+        dir: Vec3,
+        from: Vec3,
+        last_pdf: Option<f32>,
+        camera: &Partial,
+        length: u32,
+        wl: &Wavelengths,
+    ) -> Spectrum {
+        let lights = self.scene.lights();
+        let mut l = lights.escaped_weighted_except(dir, last_pdf, wl, |number| self.emitters.emits(number));
+        for number in 0..lights.len() {
+            if let Some((radiance, direct, emission)) = self.emitters.sun_seen(self.scene, number, from, dir) {
+                let weight = if length == 1 {
+                    1.0
+                } else {
+                    mis::emitter_hit(
+                        camera,
+                        direct * self.direct_samples(number, length - 1) as f32,
+                        emission,
+                    )
+                };
+                l += wl.unbounded(radiance) * weight;
+            }
+        }
+        l
     }
 
     /// The weight of an emitter the camera path hit after `length` segments.

@@ -165,6 +165,29 @@ impl SoftLight {
         }
     }
 
+    /// The area density with which [`SoftLight::sample_towards`] from `from` draws the light's
+    /// point `point` of unit normal `normal` (0 where it cannot: the side of a ball or the
+    /// face of a parallelogram turned away from `from`).
+    pub fn pdf_area_towards(&self, from: Vec3, point: Vec3, normal: Vec3) -> f32 {
+        let to = point - from;
+        let d2 = to.length_squared();
+        let cos_light = -normal.dot(to) / d2.sqrt();
+        if !(cos_light > 1e-7 && d2 > 0.0) {
+            return 0.0;
+        }
+        match self.shape {
+            SoftShape::Sphere { center, radius } => {
+                let c2 = (center - from).length_squared();
+                if c2 <= radius * radius * (1.0 + 1e-4) {
+                    return 0.0;
+                }
+                let cos_max = (1.0 - radius * radius / c2).max(0.0).sqrt();
+                uniform_cone_pdf(cos_max) * cos_light / d2
+            }
+            SoftShape::Parallelogram { area, .. } => 1.0 / area,
+        }
+    }
+
     /// A point of the light seen from `from` and the solid-angle pdf of having drawn it: a ball
     /// by the cone it subtends, a parallelogram by area. `None` when nothing of the light's
     /// lit side can be seen from there.

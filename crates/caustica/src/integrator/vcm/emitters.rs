@@ -2,10 +2,12 @@
 //! its weights need: how likely emission made a point and direction, and how likely
 //! next-event estimation would have drawn the same point.
 //!
-//! Points, spots and emissive objects take part in every strategy. Far lights (suns, the sky,
-//! directional lights) and the course forks' lights with a size are reached from the camera
-//! only, by next-event estimation and, for the sky and suns, by BSDF samples that escape,
-//! weighted against each other as in the path tracer.
+//! Points, spots, emissive objects, directional lights and suns take part in every strategy.
+//! A directional light or sun starts its subpaths on a plane across its beam outside the scene
+//! ([`Beam`]), so its densities are per unit area across the beam, with no distance to the
+//! first vertex. The sky and the course forks' lights with a size are reached from the camera
+//! only, by next-event estimation and, for the sky, by BSDF samples that escape, weighted
+//! against each other as in the path tracer.
 //!
 //! Aiming: a share of the light subpaths leaves towards the bounding spheres of the mirrors and
 //! glass (the caustics' sources), the rest everywhere the light shines ([`Aim`]); a sphere lamp
@@ -17,8 +19,8 @@ use crate::light::emission::{area_radiance, Target};
 use crate::light::{spot_profile, AreaLight, Light, LightSet};
 use crate::math::{offset_origin, Frame, Ray, Vec3};
 use crate::sampling::{
-    sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf, uniform_sphere_pdf,
-    Distribution1D, Rng,
+    sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, sample_uniform_sphere, uniform_cone_pdf,
+    uniform_sphere_pdf, Distribution1D, Rng,
 };
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -33,6 +35,132 @@ pub struct Emitters {
     numbers: Vec<usize>,
     choice: Option<Distribution1D>,
     aim: Option<Aim>,
+    /// Each light's beam, for the directional lights and suns.
+    beams: Vec<Option<Beam>>,
+}
+
+/// The share of a directional light's or sun's subpaths aimed at the mirrors and glass: their
+/// beam covers the whole scene, where a glass may take a hundredth of it.
+pub const FAR_AIM_SHARE: f32 = 0.5;
+
+/// Where a directional light's or sun's subpaths start: a plane across the beam outside the
+/// scene, a point on it from a mixture of discs (the scene's, and each target's as the beam
+/// sees it, by area), then a direction along the beam (a sun's: uniform in its cone).
+#[derive(Clone, Debug)]
+pub struct Beam {
+    /// Unit travel direction of the beam's centre.
+    direction: Vec3,
+    frame: Frame,
+    plane_origin: Vec3,
+    /// The scene's disc, centred on the plane's origin.
+    scene_radius: f32,
+    /// The targets' discs on the plane.
+    targets: Vec<(Vec2, f32)>,
+    /// π Σ r² over the targets.
+    target_area: f32,
+    /// The share of starts on the targets' discs (0 without targets).
+    share: f32,
+    /// A sun's cone: cos θ and 1 − cos θ of its angular radius.
+    sun: Option<(f32, f32)>,
+}
+
+impl Beam {
+    /// The beam of a light travelling in `direction` (a sun's centre; `sun`: its cone) across
+    /// the scene's sphere (`center`, `radius`), `share` of it aimed at `targets`.
+    pub fn new(
+        direction: Vec3,
+        sun: Option<(f32, f32)>,
+        (center, radius): (Vec3, f32),
+        targets: &[Target],
+        share: f32,
+    ) -> Beam {
+        let frame = Frame::from_normal(direction);
+        let plane_origin = center - direction * (radius * 2.0 + 1.0);
+        // A sun's subpaths lean by up to its angular radius: each disc widens so that every
+        // leaning ray that can reach its sphere starts inside it.
+        let lean = sun.map_or(0.0, |(cos_max, _)| (1.0 - cos_max * cos_max).max(0.0).sqrt() / cos_max);
+        let disc = |t: &Target| {
+            let local = frame.to_local(t.center - plane_origin);
+            (
+                Vec2::new(local.x, local.y),
+                t.radius + (local.z.max(0.0) + t.radius) * lean,
+            )
+        };
+        let scene_radius = disc(&Target { center, radius }).1;
+        let targets: Vec<(Vec2, f32)> = targets.iter().map(disc).collect();
+        let target_area: f32 = targets.iter().map(|(_, r)| PI * r * r).sum();
+        let share = if target_area > 0.0 { share.clamp(0.0, 1.0) } else { 0.0 };
+        Beam {
+            direction,
+            frame,
+            plane_origin,
+            scene_radius,
+            targets,
+            target_area,
+            share,
+            sun,
+        }
+    }
+
+    /// A start on the plane: the point and its area density there.
+    fn sample(&self, u_lobe: f32, u_pick: f32, u: Vec2) -> Option<(Vec3, f32)> {
+        let (center, radius) = if u_lobe < self.share {
+            let mut x = u_pick * self.target_area;
+            let mut chosen = *self.targets.last()?;
+            for &(c, r) in &self.targets {
+                let a = PI * r * r;
+                if x < a {
+                    chosen = (c, r);
+                    break;
+                }
+                x -= a;
+            }
+            chosen
+        } else {
+            (Vec2::ZERO, self.scene_radius)
+        };
+        let p = center + sample_uniform_disc(u) * radius;
+        let pdf = self.plane_pdf(p);
+        (pdf > 0.0).then(|| (self.plane_origin + self.frame.x * p.x + self.frame.y * p.y, pdf))
+    }
+
+    /// Area density of a start at `p` on the plane (the mixture's).
+    fn plane_pdf(&self, p: Vec2) -> f32 {
+        let inside = |c: Vec2, r: f32| (p - c).length_squared() <= r * r * (1.0 + 1e-5);
+        let mut pdf = 0.0;
+        if inside(Vec2::ZERO, self.scene_radius) {
+            pdf += (1.0 - self.share) / (PI * self.scene_radius * self.scene_radius);
+        }
+        if self.share > 0.0 {
+            let count = self.targets.iter().filter(|&&(c, r)| inside(c, r)).count();
+            pdf += self.share * count as f32 / self.target_area;
+        }
+        pdf
+    }
+
+    /// Density, per unit area across the ray, of a start whose ray travels in `dir` through
+    /// `point`: the plane's density where that ray leaves it, over the cosine of its lean.
+    fn across_pdf(&self, point: Vec3, dir: Vec3) -> f32 {
+        let lean = dir.dot(self.direction);
+        if lean.is_nan() || lean <= 0.0 {
+            return 0.0;
+        }
+        let back = (point - self.plane_origin).dot(self.direction) / lean;
+        let local = self.frame.to_local(point - dir * back - self.plane_origin);
+        self.plane_pdf(Vec2::new(local.x, local.y)) / lean
+    }
+
+    /// Solid-angle density of a direction within a sun's cone (1 for a directional light,
+    /// whose one direction is a delta).
+    fn direction_pdf(&self) -> f32 {
+        self.sun
+            .map_or(1.0, |(_, one_minus_cos)| 1.0 / (2.0 * PI * one_minus_cos))
+    }
+
+    /// Whether `dir` (travelling) lies in the beam: a sun's cone (a directional light's never).
+    fn holds(&self, dir: Vec3) -> bool {
+        self.sun.is_some_and(|(cos_max, _)| dir.dot(self.direction) >= cos_max)
+    }
 }
 
 /// Where a share of the light subpaths is aimed: cones from the light point towards the
@@ -181,6 +309,9 @@ pub struct Emission {
     pub light: usize,
     /// The point's unit normal (for an emissive object; the direction for a point).
     pub normal: Vec3,
+    /// The light is a directional light or a sun: the densities are across the beam, and the
+    /// first segment's length does not change them.
+    pub far: bool,
 }
 
 /// One next-event sample of an emitter.
@@ -203,14 +334,43 @@ pub struct DirectSample {
 }
 
 impl Emitters {
-    /// The emitters of `scene`'s lights, aimed as `aim` says.
+    /// The emitters of `scene`'s lights, aimed as `aim` says (directional lights and suns
+    /// aim [`FAR_AIM_SHARE`] at the same targets).
     pub fn new(lights: &LightSet, aim: Option<Aim>) -> Emitters {
-        let radius = lights.scene_sphere().1;
+        let sphere = lights.scene_sphere();
+        let radius = sphere.1;
         let powers: Vec<f32> = lights
             .iter()
             .map(|light| match light {
-                Light::Point { .. } | Light::Spot { .. } | Light::Area(_) => light.power(radius).max(0.0),
+                Light::Point { .. }
+                | Light::Spot { .. }
+                | Light::Area(_)
+                | Light::Directional { .. }
+                | Light::Sun { .. }
+                | Light::Soft(_) => light.power(radius).max(0.0),
                 _ => 0.0,
+            })
+            .collect();
+        let targets = aim.as_ref().map_or(&[][..], |a| &a.targets[..]);
+        let beams = lights
+            .iter()
+            .map(|light| match *light {
+                Light::Directional { direction, .. } => {
+                    Some(Beam::new(direction, None, sphere, targets, FAR_AIM_SHARE))
+                }
+                Light::Sun {
+                    direction,
+                    cos_max,
+                    one_minus_cos,
+                    ..
+                } => Some(Beam::new(
+                    direction,
+                    Some((cos_max, one_minus_cos)),
+                    sphere,
+                    targets,
+                    FAR_AIM_SHARE,
+                )),
+                _ => None,
             })
             .collect();
         let numbers: Vec<usize> = (0..powers.len()).filter(|&i| powers[i] > 0.0).collect();
@@ -232,6 +392,7 @@ impl Emitters {
             numbers,
             choice,
             aim,
+            beams,
         }
     }
 
@@ -312,6 +473,7 @@ impl Emitters {
                     delta: true,
                     light: number,
                     normal: dir,
+                    far: false,
                 })
             }
             light @ Light::Spot {
@@ -337,6 +499,7 @@ impl Emitters {
                     delta: true,
                     light: number,
                     normal: dir,
+                    far: false,
                 })
             }
             Light::Area(light) => {
@@ -389,6 +552,51 @@ impl Emitters {
                     delta: false,
                     light: number,
                     normal,
+                    far: false,
+                })
+            }
+            light @ (Light::Directional { .. } | Light::Sun { .. }) => {
+                let beam = self.beams[number].as_ref()?;
+                let (origin, plane_pdf) = beam.sample(rng.uniform(), rng.uniform(), u)?;
+                let (dir, radiance) = match beam.sun {
+                    Some((cos_max, _)) => (
+                        sample_uniform_cone(u_dir, beam.direction, cos_max),
+                        light.sun_radiance(),
+                    ),
+                    None => (beam.direction, light.color()),
+                };
+                let lean = dir.dot(beam.direction);
+                let pdf = pick * beam.direction_pdf() * plane_pdf / lean;
+                (lean > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(origin, dir),
+                    throughput: wl.unbounded(radiance) / pdf,
+                    emission_pdf: pdf,
+                    cos: 1.0,
+                    delta: beam.sun.is_none(),
+                    light: number,
+                    normal: dir,
+                    far: true,
+                })
+            }
+            Light::Soft(light) => {
+                // A point uniform by area, then a cosine-weighted direction (or an aimed one).
+                let s = light.sample_point(u);
+                let dir = match self.aimed(s.point, rng) {
+                    Some(aimed) => aimed?,
+                    None => Frame::from_normal(s.normal).to_world(sample_cosine_hemisphere(u_dir)),
+                };
+                let cos = dir.dot(s.normal);
+                let pdf = pick * self.direction_pdf(s.point, dir, cos.max(0.0) / PI) / light.area();
+                (cos > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(s.point, dir),
+                    throughput: wl.unbounded(s.radiance) * (cos / pdf),
+                    emission_pdf: pdf,
+                    cos,
+                    // No ray meets it: camera paths never reach it but by next-event estimation.
+                    delta: true,
+                    light: number,
+                    normal: s.normal,
+                    far: false,
                 })
             }
             _ => None,
@@ -406,8 +614,26 @@ impl Emitters {
                 let cos = e.normal.dot(to).abs() / d2.sqrt();
                 choice * light.pdf_towards(from, e.ray.origin, e.normal) * cos / d2
             }
+            Some(Light::Soft(light)) => choice * light.pdf_area_towards(from, e.ray.origin, e.normal),
+            // A sun's is per solid angle (no distance to a far light).
+            Some(Light::Sun { .. }) => choice * self.beams[e.light].as_ref().map_or(0.0, Beam::direction_pdf),
             _ => choice,
         }
+    }
+
+    /// A sun that a camera path leaving `from` in direction `dir` (unit) sees: its radiance,
+    /// next-event estimation's solid-angle density of that direction, and emission's density
+    /// of the subpath that would have come along it (`None`: light `number` is no sun that
+    /// starts subpaths, or `dir` misses it).
+    pub fn sun_seen(&self, scene: &Scene, number: usize, from: Vec3, dir: Vec3) -> Option<(Vec3, f32, f32)> {
+        let beam = self.beams.get(number)?.as_ref()?;
+        let light = scene.lights().get(number)?;
+        if !beam.holds(-dir) || !self.emits(number) {
+            return None;
+        }
+        let direct = scene.lights().direct_probability(number) * beam.direction_pdf();
+        let emission = self.probability[number] * beam.direction_pdf() * beam.across_pdf(from, -dir);
+        Some((light.sun_radiance(), direct, emission))
     }
 
     /// Emission's density (point × direction, choice included) of leaving emissive object
@@ -492,6 +718,50 @@ impl Emitters {
                     emission_pdf: self.emission_pdf(number, light, point.point, point.normal, -wi),
                     cos_light,
                     delta: false,
+                })
+            }
+            light @ (Light::Directional { .. } | Light::Sun { .. }) => {
+                let beam = self.beams[number].as_ref()?;
+                let (wi, radiance) = match beam.sun {
+                    Some((cos_max, _)) => (sample_uniform_cone(u, -beam.direction, cos_max), light.sun_radiance()),
+                    None => (-beam.direction, light.color()),
+                };
+                if radiance == Vec3::ZERO || !scene.unoccluded(hit, wi, f32::INFINITY) {
+                    return None;
+                }
+                let direct_pdf = choice * beam.direction_pdf();
+                Some(DirectSample {
+                    wi,
+                    distance: f32::INFINITY,
+                    contribution: wl.unbounded(radiance) / direct_pdf,
+                    direct_pdf,
+                    emission_pdf: emit * beam.direction_pdf() * beam.across_pdf(p, -wi),
+                    cos_light: 1.0,
+                    delta: beam.sun.is_none(),
+                })
+            }
+            Light::Soft(light) => {
+                let (s, pdf_solid) = light.sample_towards(p, u)?;
+                let to = s.point - p;
+                let distance = to.length();
+                if distance.is_nan() || distance <= 0.0 || pdf_solid <= 0.0 {
+                    return None;
+                }
+                let wi = to / distance;
+                let cos_light = -s.normal.dot(wi);
+                if cos_light <= 0.0 || !scene.unoccluded(hit, wi, distance) {
+                    return None;
+                }
+                let direct_pdf = choice * pdf_solid;
+                let plain = cos_light / PI;
+                Some(DirectSample {
+                    wi,
+                    distance,
+                    contribution: wl.unbounded(s.radiance) / direct_pdf,
+                    direct_pdf,
+                    emission_pdf: emit * self.direction_pdf(s.point, -wi, plain) / light.area(),
+                    cos_light,
+                    delta: true,
                 })
             }
             _ => None,
@@ -627,6 +897,62 @@ mod tests {
         );
         let inwards = inwards as f64 / n as f64;
         assert!(inwards < 0.25, "{inwards} of the aimed starts leave inwards");
+    }
+
+    /// A sun's beam 3° across, a third aimed at two targets, over a scene of radius 4.
+    fn sun_beam() -> Beam {
+        let cos_max = (1.5f32).to_radians().cos();
+        Beam::new(
+            Vec3::new(-1.2, -1.5, 0.3).normalize(),
+            Some((cos_max, 1.0 - cos_max)),
+            (Vec3::ZERO, 4.0),
+            &[target(0.0, 0.5, 0.0, 0.5), target(1.0, 0.3, 1.0, 0.3)],
+            1.0 / 3.0,
+        )
+    }
+
+    #[test]
+    fn beam_density_integrates_to_one_over_its_plane() {
+        let beam = sun_beam();
+        // The scene's disc holds the targets' discs: uniform points over its bounding square.
+        let half = beam.scene_radius;
+        let mut rng = Rng::new(3, 0);
+        let n = 1_000_000;
+        let mean: f64 = (0..n)
+            .map(|_| {
+                let u = rng.uniform2();
+                beam.plane_pdf(Vec2::new((2.0 * u.x - 1.0) * half, (2.0 * u.y - 1.0) * half)) as f64
+            })
+            .sum::<f64>()
+            / n as f64;
+        let integral = mean * (2.0 * half as f64).powi(2);
+        assert!((integral - 1.0).abs() < 0.01, "∫ pdf dA = {integral}");
+    }
+
+    #[test]
+    fn beam_starts_carry_their_density_along_the_ray() {
+        // The density across the ray, read anywhere along it, is the start's on the plane
+        // over the cosine of its lean; the aimed share lands on the targets' discs.
+        let beam = sun_beam();
+        let mut rng = Rng::new(4, 0);
+        let mut on_targets = 0;
+        let n = 20_000;
+        for _ in 0..n {
+            let (origin, pdf) = beam.sample(rng.uniform(), rng.uniform(), rng.uniform2()).unwrap();
+            let (cos_max, _) = beam.sun.unwrap();
+            let dir = sample_uniform_cone(rng.uniform2(), beam.direction, cos_max);
+            let along = beam.across_pdf(origin + dir * (3.0 + 6.0 * rng.uniform()), dir);
+            let expected = pdf / dir.dot(beam.direction);
+            assert!((along / expected - 1.0).abs() < 1e-3, "{along} vs {expected}");
+            let local = beam.frame.to_local(origin - beam.plane_origin);
+            let p = Vec2::new(local.x, local.y);
+            on_targets += beam.targets.iter().any(|&(c, r)| (p - c).length_squared() <= r * r) as usize;
+        }
+        // A third aimed, plus the uniform starts that fall on the targets' discs anyway.
+        let share = on_targets as f64 / n as f64;
+        let area_share = (beam.target_area / (PI * beam.scene_radius * beam.scene_radius)) as f64;
+        let expected = 1.0 / 3.0 + 2.0 / 3.0 * area_share;
+        assert!((share - expected).abs() < 0.02, "{share} vs {expected}");
     }
 
     #[test]
