@@ -107,6 +107,15 @@ fn quadrants(film: &Film) -> [f32; 4] {
     ]
 }
 
+/// The quadrant means of `passes` path-traced passes of a 32² image of `s` at `--depth` `depth`.
+fn path_quadrants(s: &caustica::scene::Scene, depth: u32, passes: u64) -> [f32; 4] {
+    let settings = PathSettings {
+        max_depth: caustica::integrator::config::scattering_surfaces(depth),
+        ..PathSettings::default()
+    };
+    quadrants(&render_passes(&PathTracer::new(s, settings, 32, 32, 1), 32, 32, 0, passes).film())
+}
+
 /// On a purely diffuse scene (with many bounces of light between coloured walls) `vcm`, with
 /// and without inner connections, agrees with the path tracer, and light tracing with both
 /// wherever it sees the same thing (the quadrants below the lamp): each quadrant within 2%.
@@ -114,17 +123,7 @@ fn quadrants(film: &Film) -> [f32; 4] {
 fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
     let s = scene(DIFFUSE_BOX);
     let depth = 6;
-    let path = PathTracer::new(
-        &s,
-        PathSettings {
-            max_depth: caustica::integrator::config::scattering_surfaces(depth),
-            ..PathSettings::default()
-        },
-        32,
-        32,
-        1,
-    );
-    let reference = quadrants(&render_passes(&path, 32, 32, 0, 2048).film());
+    let reference = path_quadrants(&s, depth, 2048);
     for connections in [false, true] {
         let settings = VcmSettings {
             light_paths_per_pass: Some(8192),
@@ -195,17 +194,7 @@ rotate(1, 0, 0, -1.5707963, scale(40, square { material = { diffuse = (0.6, 0.6,
 fn vcm_merges_behind_coated_glass() {
     let s = scene(COATED_SHEET);
     let depth = 6;
-    let path = PathTracer::new(
-        &s,
-        PathSettings {
-            max_depth: caustica::integrator::config::scattering_surfaces(depth),
-            ..PathSettings::default()
-        },
-        32,
-        32,
-        1,
-    );
-    let reference = quadrants(&render_passes(&path, 32, 32, 0, 8192).film());
+    let reference = path_quadrants(&s, depth, 8192);
     let settings = VcmSettings {
         light_paths_per_pass: Some(8192),
         max_depth: depth,
