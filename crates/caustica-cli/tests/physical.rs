@@ -186,33 +186,3 @@ fn ctrl_c_keeps_the_passes_done() {
     assert!(part.pass_count() >= 1);
     assert_eq!(exr(&dir.join("run.exr")).len(), 32 * 24 * 3);
 }
-
-/// vcm starts no light paths from the sky: on the pool (sunlight and skylight through water)
-/// it says the sky's caustics will be missing; under a directional light alone (the
-/// magnifier), whose light paths it traces, and with ppm, which renders both, it says nothing
-/// of the kind.
-#[test]
-fn vcm_warns_that_the_skys_caustics_are_missing() {
-    let dir = temp_dir("vcm-sky");
-    let run = |scene: &str, integrator: &str| {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes").join(scene);
-        let out = caustica()
-            .current_dir(&dir)
-            .arg("render")
-            .arg(&path)
-            .args(["--model", "physical", "--integrator", integrator])
-            .args(["--width", "8", "--passes", "1", "--photons", "1000", "-o", "out.exr"])
-            .assert()
-            .success();
-        String::from_utf8_lossy(&out.get_output().stderr).into_owned()
-    };
-    let vcm = run("pool.ray", "vcm");
-    assert!(
-        vcm.contains("from the sky (the environment light): the caustics"),
-        "{vcm}"
-    );
-    for (scene, integrator) in [("pool.ray", "ppm"), ("magnifier_sun.ray", "vcm")] {
-        let said = run(scene, integrator);
-        assert!(!said.contains("no light paths"), "{scene}, {integrator}: {said}");
-    }
-}

@@ -162,11 +162,6 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                     ignored.join(", ")
                 );
             }
-            if config.integrator_kind().ok() == Some(IntegratorKind::Vcm) {
-                if let Some(why) = vcm_misses_sky_caustics(scene) {
-                    eprintln!("warning: {why}");
-                }
-            }
             let ignored = config.ignored_by_lt();
             if !ignored.is_empty() {
                 eprintln!(
@@ -394,15 +389,6 @@ fn preview_json(report: &Option<PreviewReport>) -> serde_json::Value {
         }),
         None => serde_json::Value::Null,
     }
-}
-
-/// vcm starts no light subpaths from the sky (it reaches the image by camera paths only), so
-/// the caustics it casts through glass or off mirrors are missing.
-fn vcm_misses_sky_caustics(scene: &Scene) -> Option<String> {
-    let sky = scene.lights().iter().any(|l| matches!(l, Light::Environment(_)));
-    (sky && !caustica::light::emission::caustic_targets(scene).is_empty()).then(|| {
-        "vcm traces no light paths from the sky (the environment light): the caustics it casts through glass or off mirrors will be missing (--integrator ppm renders them)".to_string()
-    })
 }
 
 /// What the physical model reads differently from the course's shading.

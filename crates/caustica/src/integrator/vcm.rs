@@ -766,8 +766,8 @@ impl<'a> Vcm<'a> {
     }
 
     /// What a camera path leaving `from` in `dir` after `length` segments sees of the sky and
-    /// suns: a sun that starts light subpaths weighed against every strategy (`camera`: the
-    /// sums without merging at the last vertex, where light arrives first), the rest against
+    /// suns: those that start light subpaths weighed against every strategy (`camera`: the
+    /// sums without merging at the last vertex, where light arrives first), any other against
     /// next-event estimation alone, as in the path tracer (`last_pdf`: the last bounce's).
     fn escaped(
         &self,
@@ -781,7 +781,7 @@ impl<'a> Vcm<'a> {
         let lights = self.scene.lights();
         let mut l = lights.escaped_weighted_except(dir, last_pdf, wl, |number| self.emitters.emits(number));
         for number in 0..lights.len() {
-            if let Some((radiance, direct, emission)) = self.emitters.sun_seen(self.scene, number, from, dir) {
+            if let Some((radiance, direct, emission)) = self.emitters.far_seen(self.scene, number, from, dir) {
                 let weight = if length == 1 {
                     1.0
                 } else {

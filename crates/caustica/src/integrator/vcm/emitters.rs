@@ -2,12 +2,12 @@
 //! its weights need: how likely emission made a point and direction, and how likely
 //! next-event estimation would have drawn the same point.
 //!
-//! Points, spots, emissive objects, directional lights and suns take part in every strategy.
-//! A directional light or sun starts its subpaths on a plane across its beam outside the scene
-//! ([`Beam`]), so its densities are per unit area across the beam, with no distance to the
-//! first vertex. The sky and the course forks' lights with a size are reached from the camera
-//! only, by next-event estimation and, for the sky, by BSDF samples that escape, weighted
-//! against each other as in the path tracer.
+//! Every light takes part in every strategy it can. A directional light, a sun or the sky
+//! starts its subpaths on a plane across its beam outside the scene ([`Beam`]; the sky's beam
+//! is the direction its own sampling draws), so their densities are per unit area across the
+//! beam, with no distance to the first vertex. The course forks' lights with a size start
+//! theirs from a point on them; no ray meets them, so camera paths reach them by next-event
+//! estimation alone.
 //!
 //! Aiming: a share of the light subpaths leaves towards the bounding spheres of the mirrors and
 //! glass (the caustics' sources), the rest everywhere the light shines ([`Aim`]); a sphere lamp
@@ -37,6 +37,9 @@ pub struct Emitters {
     aim: Option<Aim>,
     /// Each light's beam, for the directional lights and suns.
     beams: Vec<Option<Beam>>,
+    /// The scene's sphere and the targets, for the sky's beams (one per direction).
+    sphere: (Vec3, f32),
+    far_targets: Vec<Target>,
 }
 
 /// The share of a directional light's or sun's subpaths aimed at the mirrors and glass: their
@@ -334,23 +337,11 @@ pub struct DirectSample {
 }
 
 impl Emitters {
-    /// The emitters of `scene`'s lights, aimed as `aim` says (directional lights and suns
-    /// aim [`FAR_AIM_SHARE`] at the same targets).
+    /// The emitters of `scene`'s lights, aimed as `aim` says (directional lights, suns and
+    /// the sky aim [`FAR_AIM_SHARE`] at the same targets).
     pub fn new(lights: &LightSet, aim: Option<Aim>) -> Emitters {
         let sphere = lights.scene_sphere();
-        let radius = sphere.1;
-        let powers: Vec<f32> = lights
-            .iter()
-            .map(|light| match light {
-                Light::Point { .. }
-                | Light::Spot { .. }
-                | Light::Area(_)
-                | Light::Directional { .. }
-                | Light::Sun { .. }
-                | Light::Soft(_) => light.power(radius).max(0.0),
-                _ => 0.0,
-            })
-            .collect();
+        let powers: Vec<f32> = lights.iter().map(|light| light.power(sphere.1).max(0.0)).collect();
         let targets = aim.as_ref().map_or(&[][..], |a| &a.targets[..]);
         let beams = lights
             .iter()
@@ -387,12 +378,15 @@ impl Emitters {
             .collect();
         let weights: Vec<f32> = numbers.iter().map(|&i| powers[i]).collect();
         let choice = (total > 0.0 && total.is_finite()).then(|| Distribution1D::new(&weights));
+        let far_targets = targets.to_vec();
         Emitters {
             probability,
             numbers,
             choice,
             aim,
             beams,
+            sphere,
+            far_targets,
         }
     }
 
@@ -578,6 +572,23 @@ impl Emitters {
                     far: true,
                 })
             }
+            Light::Environment(env) => {
+                // A direction by the sky's own sampling, then a start across that beam.
+                let sky = env.sample(u_dir)?;
+                let dir = -sky.wi;
+                let (origin, plane_pdf) = self.sky_beam(dir).sample(rng.uniform(), rng.uniform(), u)?;
+                let pdf = pick * sky.pdf * plane_pdf;
+                (pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(origin, dir),
+                    throughput: wl.unbounded(sky.radiance) / pdf,
+                    emission_pdf: pdf,
+                    cos: 1.0,
+                    delta: false,
+                    light: number,
+                    normal: dir,
+                    far: true,
+                })
+            }
             Light::Soft(light) => {
                 // A point uniform by area, then a cosine-weighted direction (or an aimed one).
                 let s = light.sample_point(u);
@@ -599,7 +610,6 @@ impl Emitters {
                     far: false,
                 })
             }
-            _ => None,
         }
     }
 
@@ -615,25 +625,45 @@ impl Emitters {
                 choice * light.pdf_towards(from, e.ray.origin, e.normal) * cos / d2
             }
             Some(Light::Soft(light)) => choice * light.pdf_area_towards(from, e.ray.origin, e.normal),
-            // A sun's is per solid angle (no distance to a far light).
+            // A sun's and the sky's are per solid angle (no distance to a far light).
             Some(Light::Sun { .. }) => choice * self.beams[e.light].as_ref().map_or(0.0, Beam::direction_pdf),
+            Some(Light::Environment(env)) => choice * env.pdf(-e.ray.dir),
             _ => choice,
         }
     }
 
-    /// A sun that a camera path leaving `from` in direction `dir` (unit) sees: its radiance,
-    /// next-event estimation's solid-angle density of that direction, and emission's density
-    /// of the subpath that would have come along it (`None`: light `number` is no sun that
-    /// starts subpaths, or `dir` misses it).
-    pub fn sun_seen(&self, scene: &Scene, number: usize, from: Vec3, dir: Vec3) -> Option<(Vec3, f32, f32)> {
-        let beam = self.beams.get(number)?.as_ref()?;
-        let light = scene.lights().get(number)?;
-        if !beam.holds(-dir) || !self.emits(number) {
+    /// What a camera path leaving `from` in direction `dir` (unit) sees of far light `number`
+    /// (a sun or the sky): its radiance, next-event estimation's solid-angle density of that
+    /// direction, and emission's density of the subpath that would have come along it (`None`:
+    /// the light is neither or starts no subpaths, or `dir` misses the sun).
+    pub fn far_seen(&self, scene: &Scene, number: usize, from: Vec3, dir: Vec3) -> Option<(Vec3, f32, f32)> {
+        if !self.emits(number) {
             return None;
         }
-        let direct = scene.lights().direct_probability(number) * beam.direction_pdf();
-        let emission = self.probability[number] * beam.direction_pdf() * beam.across_pdf(from, -dir);
-        Some((light.sun_radiance(), direct, emission))
+        let choice = scene.lights().direct_probability(number);
+        let emit = self.probability[number];
+        match scene.lights().get(number)? {
+            light @ Light::Sun { .. } => {
+                let beam = self.beams.get(number)?.as_ref()?;
+                if !beam.holds(-dir) {
+                    return None;
+                }
+                let direct = choice * beam.direction_pdf();
+                let emission = emit * beam.direction_pdf() * beam.across_pdf(from, -dir);
+                Some((light.sun_radiance(), direct, emission))
+            }
+            Light::Environment(env) => {
+                let pdf = env.pdf(dir);
+                let emission = emit * pdf * self.sky_beam(-dir).across_pdf(from, -dir);
+                Some((env.radiance(dir), choice * pdf, emission))
+            }
+            _ => None,
+        }
+    }
+
+    /// The sky's beam travelling in `dir`.
+    fn sky_beam(&self, dir: Vec3) -> Beam {
+        Beam::new(dir, None, self.sphere, &self.far_targets, FAR_AIM_SHARE)
     }
 
     /// Emission's density (point × direction, choice included) of leaving emissive object
@@ -740,6 +770,22 @@ impl Emitters {
                     delta: beam.sun.is_none(),
                 })
             }
+            Light::Environment(env) => {
+                let sky = env.sample(u)?;
+                if sky.radiance == Vec3::ZERO || !scene.unoccluded(hit, sky.wi, f32::INFINITY) {
+                    return None;
+                }
+                let direct_pdf = choice * sky.pdf;
+                Some(DirectSample {
+                    wi: sky.wi,
+                    distance: f32::INFINITY,
+                    contribution: wl.unbounded(sky.radiance) / direct_pdf,
+                    direct_pdf,
+                    emission_pdf: emit * sky.pdf * self.sky_beam(-sky.wi).across_pdf(p, -sky.wi),
+                    cos_light: 1.0,
+                    delta: false,
+                })
+            }
             Light::Soft(light) => {
                 let (s, pdf_solid) = light.sample_towards(p, u)?;
                 let to = s.point - p;
@@ -764,7 +810,6 @@ impl Emitters {
                     delta: true,
                 })
             }
-            _ => None,
         }
     }
 }
