@@ -144,8 +144,9 @@ pub struct SceneArgs {
 /// Photon-map options.
 #[derive(Args, Debug, Clone)]
 pub struct PhotonOptions {
-    /// Caustic photons to store (0 disables caustics); photons per pass of ppm and gi
-    /// [default: 200000, or what a pbrt-v4 scene's sppm integrator asks]
+    /// Caustic photons to store (0 disables caustics); photons per pass of ppm and gi, light
+    /// paths per pass of lt and vcm [default: 200000, or what a pbrt-v4 scene's sppm integrator
+    /// asks; vcm: a pilot balances them against its camera paths]
     #[arg(long)]
     pub photons: Option<usize>,
     /// Stop emitting after this many photons (default: 200 per photon to store).

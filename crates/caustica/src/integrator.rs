@@ -226,6 +226,11 @@ pub trait Progressive: Send + Sync {
         1.0
     }
 
+    /// Light paths (photons) a full pass traces, when the integrator chose the number itself.
+    fn chosen_paths_per_pass(&self) -> Option<u64> {
+        None
+    }
+
     /// For the end of a time limit: the share of a full pass that pass `pass` can take and
     /// still end within `seconds`, from the passes timed so far. `None`: this integrator's
     /// passes keep their size.

@@ -584,3 +584,24 @@ fn focus_pixels_take_more_camera_samples() {
         "mean {eight} against {one} (± {standard_error})"
     );
 }
+
+/// The balance pilot sizes a pass by what each side adds to the noise: over a floor under a
+/// point light the light subpaths add nothing that next-event estimation does not give
+/// exactly (none of its light is merged or traced to the eye), so a pass traces the fewest
+/// (one for 16 pixels, at least 256); in the diffuse box merging carries the indirect light
+/// and a pass traces many more. The pilot's count is the same on one thread and on two.
+#[test]
+fn vcm_balances_light_subpaths_against_camera_paths() {
+    let count = |text: &str, threads: usize| {
+        let s = scene(text);
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| Vcm::new(&s, VcmSettings::default(), 32, 32, 7).chosen_paths_per_pass())
+    };
+    let plane = count(PLANE, 1).unwrap();
+    let diffuse = count(DIFFUSE_BOX, 1).unwrap();
+    eprintln!("balanced light subpaths a pass: floor {plane}, diffuse box {diffuse}");
+    assert_eq!(plane, 256);
+    assert!(diffuse > 4 * plane, "{diffuse}");
+    assert_eq!(count(DIFFUSE_BOX, 2), Some(diffuse));
+    assert_eq!(count(PLANE, 2), Some(plane));
+}

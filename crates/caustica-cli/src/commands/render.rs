@@ -272,6 +272,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         Integrator::Lt(s) => s.photons_per_pass,
         Integrator::Vcm(s) => s
             .light_paths_per_pass
+            .or_else(|| session.chosen_paths_per_pass())
             .unwrap_or_else(|| caustica::integrator::vcm::default_light_paths(width, height)),
         _ => 0,
     };

@@ -423,6 +423,12 @@ impl<'a> RenderSession<'a> {
         }
     }
 
+    /// Light paths a full pass traces, when the integrator chose the number
+    /// ([`Progressive::chosen_paths_per_pass`]).
+    pub fn chosen_paths_per_pass(&self) -> Option<u64> {
+        self.passes.as_ref().and_then(|p| p.chosen_paths_per_pass())
+    }
+
     /// The time pass `pass` takes relative to a full pass ([`Progressive::pass_cost`]).
     pub fn pass_cost(&self, pass: u64) -> f64 {
         self.passes.as_ref().map_or(1.0, |p| p.pass_cost(pass))

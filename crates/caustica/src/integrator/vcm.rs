@@ -28,8 +28,11 @@
 //! paths, a few percent of uniform emission on the race's scenes, become many times more
 //! frequent, and every weight uses the mixture's density. So is a share of their bounces off
 //! Lambertian surfaces ([`BOUNCE_AIM_SHARE`]), for the light a lit wall sends through a glass.
+//! How many light subpaths a pass traces against its camera paths is measured on the scene by
+//! a pilot ([`balance`]).
 //! Determinism: light subpaths are traced in fixed batches and added in index order.
 
+pub mod balance;
 pub mod emitters;
 pub mod focus;
 pub mod grid;
@@ -47,6 +50,7 @@ use crate::progress::Control;
 use crate::sampling::{power_heuristic, Rng};
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths, SAMPLES};
+use balance::{balanced_light_paths, PassCosts, PixelSpread, CANDIDATE_COST};
 use emitters::{Aim, Emitters};
 use focus::CausticFocus;
 use grid::HashGrid;
@@ -56,8 +60,8 @@ use rayon::prelude::*;
 /// Settings of vertex connection and merging.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VcmSettings {
-    /// Light subpaths per pass (`None`: [`LIGHT_PATHS_PER_PIXEL`] per pixel, at most
-    /// [`MAX_DEFAULT_LIGHT_PATHS`], and half as many in the first two passes).
+    /// Light subpaths per pass (`None`: as many as a pilot finds best against the camera paths
+    /// ([`balance`]), and half as many in the first two passes).
     pub light_paths_per_pass: Option<u64>,
     /// Knaus & Zwicker's α in (0, 1): how fast the merging radius shrinks.
     pub alpha: f32,
@@ -121,10 +125,11 @@ pub const AIM_SHARE: f32 = 0.15;
 /// in more time; aiming only the first bounce left the focus 0.0132 (area).
 pub const BOUNCE_AIM_SHARE: f32 = 0.05;
 
-/// Light subpaths per pixel and pass by default: light tracing carries the caustics, so it gets
-/// most of the time. Measured on the Cornell box race (BENCHMARKS.md), at equal time: 16 cut
-/// the focus's error by a fifth and the caustic region's by a sixth against 8, the image's
-/// unchanged; 24 was no better. The first passes trace half (see [`Vcm::pass_light_paths`]).
+/// Light subpaths per pixel and pass where the eye sees a caustic's focus (elsewhere the
+/// balance pilot chooses, [`balance`]), and the weights of the pilot's estimates. Measured on
+/// the Cornell box race (BENCHMARKS.md), at equal time: 16 cut the focus's error by a fifth and
+/// the caustic region's by a sixth against 8; 24 was no better. The first passes trace half
+/// (see [`Vcm::pass_light_paths`]).
 pub const LIGHT_PATHS_PER_PIXEL: u64 = 16;
 /// The default's cap, so that a large image's pass stays within memory (about 100 bytes per
 /// stored light vertex, one or two per path).
@@ -192,6 +197,8 @@ struct LightPaths {
     merge_vertices: Vec<MergeVertex>,
     /// What light tracing adds to each pixel, in batch order.
     splats: Vec<(u32, Vec3)>,
+    /// Rays the subpaths cast (for the balance pilot's costs).
+    rays: u64,
 }
 
 impl LightPaths {
@@ -202,6 +209,7 @@ impl LightPaths {
         self.merge_points.clear();
         self.merge_vertices.clear();
         self.splats.clear();
+        self.rays = 0;
     }
 
     /// Appends `batch`'s subpaths after its own.
@@ -212,6 +220,7 @@ impl LightPaths {
         self.merge_points.extend_from_slice(&batch.merge_points);
         self.merge_vertices.extend_from_slice(&batch.merge_vertices);
         self.splats.extend_from_slice(&batch.splats);
+        self.rays += batch.rays;
     }
 }
 
@@ -233,6 +242,39 @@ struct PassData {
     merge_vertices: Vec<MergeVertex>,
     factors: Factors,
     radius: f32,
+}
+
+/// The work of camera paths, for the balance pilot's costs.
+#[derive(Clone, Copy, Debug, Default)]
+struct CameraWork {
+    rays: u64,
+    /// Light vertices looked at by merging.
+    candidates: u64,
+    /// What merging added.
+    merged: Spectrum,
+}
+
+impl PassData {
+    /// `paths` arranged for merging within `radius` (`grid` and `merge_vertices` lend their
+    /// memory).
+    fn arrange(
+        paths: LightPaths,
+        mut grid: HashGrid,
+        mut merge_vertices: Vec<MergeVertex>,
+        factors: Factors,
+        radius: f32,
+    ) -> PassData {
+        grid.rebuild(&paths.merge_points, radius);
+        merge_vertices.clear();
+        merge_vertices.extend(grid.order().iter().map(|&i| paths.merge_vertices[i as usize]));
+        PassData {
+            paths,
+            grid,
+            merge_vertices,
+            factors,
+            radius,
+        }
+    }
 }
 
 /// What a camera vertex needs to join light to.
@@ -262,7 +304,10 @@ pub struct Vcm<'a> {
     max_length: u32,
     /// The first pass's merging radius in scene units.
     radius: f32,
-    light_paths: u64,
+    /// Light subpaths in a full pass: the setting's, or the balance pilot's on first use.
+    light_paths: std::sync::OnceLock<u64>,
+    /// The balance pilot's estimate of a full pass's seconds per light subpath.
+    balance_seconds: std::sync::OnceLock<f64>,
     /// The first [`RAMP_PASSES`] passes trace half the light subpaths (the default count only).
     ramp: bool,
     /// Where caustics are focused, from a pilot run on first use.
@@ -293,6 +338,19 @@ const MIN_PILOT_PATHS: u64 = 16_384;
 
 /// The pilot run's pass index: a random stream no real pass reaches.
 const PILOT_PASS: u64 = (1 << 24) - 1;
+/// The balance pilot's two halves' pass indices, streams no real pass reaches either.
+const BALANCE_PASSES: [u64; 2] = [PILOT_PASS - 1, PILOT_PASS - 2];
+/// Seed offset of the balance pilot's camera samples.
+const BALANCE_SEED: u64 = 0x0062_616c_616e_6365;
+/// The balance pilot samples this share of the pixels, and at least [`MIN_BALANCE_PIXELS`].
+const BALANCE_PIXEL_SHARE: usize = 16;
+const MIN_BALANCE_PIXELS: usize = 2048;
+/// The balanced count's bounds: one light subpath for this many pixels, and at least
+/// [`MIN_LIGHT_PATHS`]; [`MOST_LIGHT_PATHS_PER_PIXEL`] a pixel, at most
+/// [`MAX_DEFAULT_LIGHT_PATHS`].
+const LEAST_SHARE_OF_PIXELS: u64 = 16;
+const MIN_LIGHT_PATHS: u64 = 256;
+const MOST_LIGHT_PATHS_PER_PIXEL: u64 = 4 * LIGHT_PATHS_PER_PIXEL;
 
 /// A first pass's time per light subpath, all its work counted, over the pilot run's (which
 /// neither joins subpaths to the eye nor merges them, nor pays for a pass's first memory).
@@ -332,10 +390,11 @@ impl<'a> Vcm<'a> {
             // Segments: one more than the surfaces light may scatter at.
             max_length: super::config::scattering_surfaces(settings.max_depth).saturating_add(1),
             radius,
-            light_paths: settings
-                .light_paths_per_pass
-                .unwrap_or_else(|| default_light_paths(width, height))
-                .max(1),
+            light_paths: match settings.light_paths_per_pass {
+                Some(count) => std::sync::OnceLock::from(count.max(1)),
+                None => std::sync::OnceLock::new(),
+            },
+            balance_seconds: std::sync::OnceLock::new(),
             ramp: settings.light_paths_per_pass.is_none(),
             settings,
             width,
@@ -354,9 +413,9 @@ impl<'a> Vcm<'a> {
     /// with half the count, and the passes after them spend most of their time on light tracing.
     fn pass_light_paths(&self, pass: u64) -> u64 {
         if pass < RAMP_PASSES && self.ramp {
-            self.light_paths.div_ceil(2)
+            self.full_pass_paths().div_ceil(2)
         } else {
-            self.light_paths
+            self.full_pass_paths()
         }
     }
 
@@ -372,26 +431,151 @@ impl<'a> Vcm<'a> {
             let count = (self.pixels() as u64).clamp(MIN_PILOT_PATHS, MAX_DEFAULT_LIGHT_PATHS);
             let f = Factors::new(self.radius, count as f32);
             let wl = pass_wavelengths(self.spectral, self.seed, PILOT_PASS);
-            let batches: Vec<LightPaths> = (0..count.div_ceil(BATCH))
-                .into_par_iter()
-                .map(|b| {
-                    let mut out = LightPaths::default();
-                    for i in b * BATCH..((b + 1) * BATCH).min(count) {
-                        self.trace_light(PILOT_PASS, i, &f, &wl, false, &mut out);
-                    }
-                    out
-                })
-                .collect();
+            let paths = self.pilot_paths(PILOT_PASS, count, &f, &wl, false);
             let _ = self.pilot_seconds.set(start.elapsed().as_secs_f64() / count as f64);
-            let caustic = batches.iter().flat_map(|b| {
-                b.merge_points
-                    .iter()
-                    .zip(&b.merge_vertices)
-                    .filter(|(_, v)| v.direct_caustic)
-                    .map(|(p, v)| (*p, wl.to_rgb(v.throughput).max_element()))
-            });
+            let caustic = paths
+                .merge_points
+                .iter()
+                .zip(&paths.merge_vertices)
+                .filter(|(_, v)| v.direct_caustic)
+                .map(|(p, v)| (*p, wl.to_rgb(v.throughput).max_element()));
             CausticFocus::new(caustic, 2.0 * self.radius)
         })
+    }
+
+    /// The first `count` light subpaths of pass `pass` (a pilot's: it cannot be cancelled).
+    fn pilot_paths(&self, pass: u64, count: u64, f: &Factors, wl: &Wavelengths, to_eye: bool) -> LightPaths {
+        let batches: Vec<LightPaths> = (0..count.div_ceil(BATCH))
+            .into_par_iter()
+            .map(|b| {
+                let mut out = LightPaths::default();
+                for i in b * BATCH..((b + 1) * BATCH).min(count) {
+                    self.trace_light(pass, i, f, wl, to_eye, &mut out);
+                    out.ends.push(out.vertices.len() as u32);
+                }
+                out
+            })
+            .collect();
+        let mut all = LightPaths::default();
+        all.ends.push(0);
+        for batch in &batches {
+            all.append(batch);
+        }
+        all
+    }
+
+    /// Light subpaths in a full pass: the setting's, or else the balance pilot's count.
+    fn full_pass_paths(&self) -> u64 {
+        *self.light_paths.get_or_init(|| self.balance_pilot())
+    }
+
+    /// The balance pilot ([`balance`]): two independent halves of a pilot pass's light subpaths,
+    /// and two camera samples at each of a sample of the pixels, each joined to both halves.
+    /// The halves' difference is the light side's noise, the samples' the camera side's; rays
+    /// counted are the costs. Its own random streams, so every run of a seed finds the same
+    /// count (split runs merge into one).
+    fn balance_pilot(&self) -> u64 {
+        let (w, h) = (self.width, self.height);
+        let pixels = self.pixels();
+        let default = default_light_paths(w, h);
+        if self.scene.lights().is_empty() || self.emitters.is_empty() {
+            return default;
+        }
+        let focus_pixels = self.focus_pixels();
+        // Where the eye sees a caustic's focus, its error falls with every light subpath
+        // traced, and the default count was measured best for it (the race's focus).
+        if focus_pixels.iter().any(|&f| f) {
+            return default;
+        }
+        let start = std::time::Instant::now();
+        let half = (pixels as u64)
+            .clamp(MIN_PILOT_PATHS, MAX_DEFAULT_LIGHT_PATHS)
+            .div_ceil(2);
+        // Every weight as in a pass of the default count; each half's light estimates scaled
+        // up to stand for such a pass.
+        let f = Factors::new(self.radius, default as f32);
+        let scale = default as f64 / half as f64;
+        let wl = pass_wavelengths(self.spectral, self.seed, BALANCE_PASSES[0]);
+        let halves = BALANCE_PASSES.map(|pass| {
+            let paths = self.pilot_paths(pass, half, &f, &wl, true);
+            PassData::arrange(paths, HashGrid::default(), Vec::new(), f, self.radius)
+        });
+        let light_seconds = start.elapsed().as_secs_f64() / (2 * half) as f64;
+        let splats = halves.each_ref().map(|data| {
+            let mut film = vec![0.0f64; pixels];
+            for &(pixel, value) in &data.paths.splats {
+                film[pixel as usize] += channel_mean(value);
+            }
+            film
+        });
+        let sampled = pixels.min(MIN_BALANCE_PIXELS.max(pixels / BALANCE_PIXEL_SHARE)).max(1);
+        let stride = pixels / sampled;
+        let camera = self.scene.camera();
+        let camera_start = std::time::Instant::now();
+        // A pixel from each run of `stride`.
+        let chosen: Vec<usize> = (0..sampled)
+            .map(|j| {
+                let mut rng = Rng::new(self.seed ^ BALANCE_SEED, j as u64);
+                j * stride + ((rng.uniform() * stride as f32) as usize).min(stride - 1)
+            })
+            .collect();
+        let measured: Vec<(PixelSpread, CameraWork)> = chosen
+            .par_iter()
+            .map(|&pixel| {
+                let mut rng = Rng::new(self.seed ^ BALANCE_SEED ^ 1, pixel as u64);
+                let (x, y) = (pixel % w, pixel / w);
+                let own = pixel % half as usize;
+                let mut work = CameraWork::default();
+                let (mut values, mut cameras) = ([0.0f64; 2], [0.0f64; 2]);
+                let mut light = 0.0;
+                for i in 0..2 {
+                    let (jx, jy) = (rng.uniform(), rng.uniform());
+                    let ray = camera.generate_ray((x as f32 + jx) / w as f32, 1.0 - (y as f32 + jy) / h as f32);
+                    // The same camera path (the same random numbers) joined to each half: the
+                    // camera strategies' part is the same, the light's differs.
+                    let mut twin = rng.clone();
+                    let merged_before = work.merged;
+                    let all = channel_mean(wl.to_rgb(self.camera_path(ray, &halves[0], own, &wl, &mut rng, &mut work)));
+                    let merged_a = channel_mean(wl.to_rgb(work.merged - merged_before));
+                    let mut other = CameraWork::default();
+                    self.camera_path(ray, &halves[1], own, &wl, &mut twin, &mut other);
+                    let merged_b = channel_mean(wl.to_rgb(other.merged));
+                    let light_a = scale * (merged_a + splats[0][pixel]);
+                    let light_b = scale * (merged_b + splats[1][pixel]);
+                    // A half's variance is half its squared difference from the other's.
+                    light += 0.5 * (light_a - light_b).powi(2);
+                    cameras[i] = all - merged_a;
+                    values[i] = cameras[i] + 0.5 * (light_a + light_b);
+                }
+                let spread = PixelSpread {
+                    camera: 0.5 * (cameras[0] - cameras[1]).powi(2),
+                    light: half as f64 * light / 2.0,
+                    mean: 0.5 * (values[0] + values[1]),
+                };
+                (spread, work)
+            })
+            .collect();
+        let camera_seconds = camera_start.elapsed().as_secs_f64() / (4 * chosen.len()) as f64;
+        let spreads: Vec<PixelSpread> = measured.iter().map(|(s, _)| *s).collect();
+        let (rays, candidates) = measured
+            .iter()
+            .fold((0u64, 0u64), |(r, c), (_, work)| (r + work.rays, c + work.candidates));
+        let camera_samples = (2 * chosen.len()) as f64;
+        // No pixel sees a focus: one camera sample each.
+        let samples_a_pass = pixels as f64;
+        let costs = PassCosts {
+            camera: rays as f64 / camera_samples * samples_a_pass,
+            per_light_path: (halves[0].paths.rays + halves[1].paths.rays) as f64 / (2 * half) as f64
+                + CANDIDATE_COST * candidates as f64 / camera_samples * samples_a_pass / half as f64,
+        };
+        let bounds = (
+            (pixels as u64 / LEAST_SHARE_OF_PIXELS).max(MIN_LIGHT_PATHS),
+            (pixels as u64 * MOST_LIGHT_PATHS_PER_PIXEL).clamp(MIN_LIGHT_PATHS, MAX_DEFAULT_LIGHT_PATHS),
+        );
+        let count = balanced_light_paths(&spreads, costs, bounds).unwrap_or(default);
+        let pass_seconds = light_seconds * count as f64 + camera_seconds * samples_a_pass;
+        let _ = self.balance_seconds.set(pass_seconds / count as f64);
+        count
     }
 
     /// Whether each pixel sees a focused cell directly: the ray through its centre ends in
@@ -451,6 +635,7 @@ impl<'a> Vcm<'a> {
         // Only mirrors and glass so far.
         let mut all_specular = true;
         for length in 1..self.max_length {
+            out.rays += 1;
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
                 return;
             };
@@ -486,6 +671,8 @@ impl<'a> Vcm<'a> {
                     direct_caustic,
                 };
                 if to_eye {
+                    // Direct light is not traced to the eye (see trace_to_eye).
+                    out.rays += u64::from(length > 1);
                     self.trace_to_eye(&vertex, &bsdf, f, wl, &mut out.splats);
                 }
                 // Light reaching a vertex first is never merged (see the module's notes).
@@ -623,7 +810,15 @@ impl<'a> Vcm<'a> {
 
     /// Radiance along the camera ray `ray`, joined to the pass's light subpaths (`own`: the
     /// one this pixel connects to).
-    fn camera_path(&self, ray: Ray, pass: &PassData, own: usize, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
+    fn camera_path(
+        &self,
+        ray: Ray,
+        pass: &PassData,
+        own: usize,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        work: &mut CameraWork,
+    ) -> Spectrum {
         let f = &pass.factors;
         let scene = self.scene;
         let camera_pdf = self.sensor.importance(ray.dir);
@@ -654,6 +849,7 @@ impl<'a> Vcm<'a> {
         // Whether the first vertex lies where caustics are focused.
         let mut first_focused = false;
         for length in 1..=self.max_length {
+            work.rays += 1;
             let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
                 l += throughput * self.escaped(ray.dir, previous, last_pdf, &without_last_merge, length, wl);
                 break;
@@ -703,7 +899,7 @@ impl<'a> Vcm<'a> {
                     length,
                     dispersed,
                 };
-                l += self.direct(&v, f, wl, rng);
+                l += self.direct(&v, f, wl, rng, work);
                 let paths = &pass.paths;
                 if self.settings.connections && own + 1 < paths.ends.len() {
                     let (start, end) = (paths.ends[own] as usize, paths.ends[own + 1] as usize);
@@ -712,7 +908,9 @@ impl<'a> Vcm<'a> {
                     }
                 }
                 if merges_here && f.merge > 0.0 {
-                    l += self.merge(&v, pass);
+                    let merged = self.merge(&v, pass, work);
+                    work.merged += merged;
+                    l += merged;
                 }
             }
             let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
@@ -843,13 +1041,21 @@ impl<'a> Vcm<'a> {
 
     /// Next-event estimation at a camera vertex: every light when there are few, else one by
     /// power (as the path tracer).
-    fn direct(&self, v: &CameraVertex, f: &Factors, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
+    fn direct(
+        &self,
+        v: &CameraVertex,
+        f: &Factors,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        work: &mut CameraWork,
+    ) -> Spectrum {
         if v.length + 1 > self.max_length {
             return Spectrum::ZERO;
         }
         let lights = self.scene.lights();
         let mut l = Spectrum::ZERO;
         let mut one = |number: usize, pick: f32, rng: &mut Rng| {
+            work.rays += 1;
             if self.emitters.emits(number) {
                 let samples = self.direct_samples(number, v.length);
                 for _ in 0..samples {
@@ -954,7 +1160,7 @@ impl<'a> Vcm<'a> {
     }
 
     /// Merging: the light vertices within the radius of a camera vertex, as a density estimate.
-    fn merge(&self, v: &CameraVertex, pass: &PassData) -> Spectrum {
+    fn merge(&self, v: &CameraVertex, pass: &PassData, work: &mut CameraWork) -> Spectrum {
         let mut sum = Spectrum::ZERO;
         let focused = v.length == 1 && self.focus().contains(v.hit.point);
         let ng = v.hit.geometric_normal;
@@ -968,6 +1174,7 @@ impl<'a> Vcm<'a> {
             _ => (1.0, 0.0),
         };
         pass.grid.query(v.hit.point, pass.radius, |slot| {
+            work.candidates += 1;
             let z = &pass.merge_vertices[slot];
             if v.length + z.length > self.max_length || (focused && z.direct_caustic) {
                 return;
@@ -1034,6 +1241,15 @@ pub fn default_light_paths(width: usize, height: usize) -> u64 {
     ((width * height) as u64 * LIGHT_PATHS_PER_PIXEL).clamp(1, MAX_DEFAULT_LIGHT_PATHS)
 }
 
+/// The mean of a colour's channels, in the image's units.
+fn channel_mean(rgb: Vec3) -> f64 {
+    if rgb.is_finite() {
+        (rgb.x as f64 + rgb.y as f64 + rgb.z as f64) / 3.0
+    } else {
+        0.0
+    }
+}
+
 /// Both subpaths kept only the hero wavelength, so each scaled it by the number of wavelengths:
 /// one of the factors goes.
 fn both_dispersed(a: bool, b: bool) -> f32 {
@@ -1049,13 +1265,18 @@ impl Progressive for Vcm<'_> {
     /// camera paths' fixed part makes a half pass a little dearer than this says, so a time
     /// limit's plan errs on the short side).
     fn pass_cost(&self, pass: u64) -> f64 {
-        self.pass_light_paths(pass) as f64 / self.light_paths as f64
+        self.pass_light_paths(pass) as f64 / self.full_pass_paths() as f64
     }
 
     /// Light tracing and merging carry most of the image, and their noise falls with the
     /// number of light subpaths.
     fn pass_weight(&self, pass: u64) -> f64 {
         self.pass_cost(pass)
+    }
+
+    /// The balance pilot's count (the setting's when given).
+    fn chosen_paths_per_pass(&self) -> Option<u64> {
+        Some(self.full_pass_paths())
     }
 
     /// From the last pass's time per light subpath; before any pass, from the pilot run's
@@ -1066,13 +1287,15 @@ impl Progressive for Vcm<'_> {
         }
         let start = std::time::Instant::now();
         self.focus();
+        self.full_pass_paths();
         let left = seconds - start.elapsed().as_secs_f64();
         let last = *self.timing.lock().unwrap_or_else(|e| e.into_inner());
-        let per_path = match last {
-            Some(t) => t.seconds_per_light_path,
-            None => self.pilot_seconds.get().copied().unwrap_or(0.0) * PILOT_TO_PASS_COST,
+        let per_path = match (last, self.balance_seconds.get()) {
+            (Some(t), _) => t.seconds_per_light_path,
+            (None, Some(&balanced)) => balanced,
+            (None, None) => self.pilot_seconds.get().copied().unwrap_or(0.0) * PILOT_TO_PASS_COST,
         };
-        let full = per_path * self.light_paths as f64;
+        let full = per_path * self.full_pass_paths() as f64;
         Some(if full > 0.0 {
             (left / full).max(0.0)
         } else {
@@ -1083,9 +1306,8 @@ impl Progressive for Vcm<'_> {
     fn render_share(&self, pass: u64, share: f64, control: Control) -> Option<Vec<Vec3>> {
         // A pass stretched to a time limit ends a run that had no room for the next (at most a
         // full one): it stays within twice a full pass's memory.
-        let count = (share * self.light_paths as f64)
-            .round()
-            .clamp(1.0, 2.0 * self.light_paths as f64);
+        let full = self.full_pass_paths() as f64;
+        let count = (share * full).round().clamp(1.0, 2.0 * full);
         self.render_light_paths(pass, count as u64, control)
     }
 
@@ -1117,18 +1339,13 @@ impl Vcm<'_> {
         if !self.emitters.is_empty() {
             self.light_paths((pass, count), &f, &wl, control, &mut scratch.batches, &mut paths)?;
         }
-        let mut grid = std::mem::take(&mut scratch.grid);
-        grid.rebuild(&paths.merge_points, radius);
-        let mut merge_vertices = std::mem::take(&mut scratch.merge_vertices);
-        merge_vertices.clear();
-        merge_vertices.extend(grid.order().iter().map(|&i| paths.merge_vertices[i as usize]));
-        let pass_data = PassData {
+        let pass_data = PassData::arrange(
             paths,
-            grid,
-            merge_vertices,
-            factors: f,
+            std::mem::take(&mut scratch.grid),
+            std::mem::take(&mut scratch.merge_vertices),
+            f,
             radius,
-        };
+        );
         let camera = self.scene.camera();
         let (w, h) = (self.width, self.height);
         let focus_pixels = self.focus_pixels();
@@ -1142,10 +1359,11 @@ impl Vcm<'_> {
                 1
             };
             let mut sum = Vec3::ZERO;
+            let mut work = CameraWork::default();
             for _ in 0..samples {
                 let (jx, jy) = (rng.uniform(), rng.uniform());
                 let ray = camera.generate_ray((x as f32 + jx) / w as f32, 1.0 - (y as f32 + jy) / h as f32);
-                let v = wl.to_rgb(self.camera_path(ray, &pass_data, own, &wl, &mut rng));
+                let v = wl.to_rgb(self.camera_path(ray, &pass_data, own, &wl, &mut rng, &mut work));
                 if v.is_finite() {
                     sum += v;
                 }
