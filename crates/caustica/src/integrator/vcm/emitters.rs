@@ -37,9 +37,8 @@ pub struct Emitters {
     aim: Option<Aim>,
     /// Each light's beam, for the directional lights and suns.
     beams: Vec<Option<Beam>>,
-    /// The scene's sphere and the targets, for the sky's beams (one per direction).
+    /// The scene's sphere, for the sky's beams (one per direction).
     sphere: (Vec3, f32),
-    far_targets: Vec<Target>,
 }
 
 /// The share of a directional light's or sun's subpaths aimed at the mirrors and glass: their
@@ -57,8 +56,10 @@ pub struct Beam {
     plane_origin: Vec3,
     /// The scene's disc, centred on the plane's origin.
     scene_radius: f32,
-    /// The targets' discs on the plane.
-    targets: Vec<(Vec2, f32)>,
+    /// The targets' discs on the plane, the first `target_count` of them (held inline: the
+    /// sky builds a beam for every direction it samples or is seen in).
+    targets: [(Vec2, f32); MAX_TARGETS],
+    target_count: usize,
     /// π Σ r² over the targets.
     target_area: f32,
     /// The share of starts on the targets' discs (0 without targets).
@@ -69,7 +70,8 @@ pub struct Beam {
 
 impl Beam {
     /// The beam of a light travelling in `direction` (a sun's centre; `sun`: its cone) across
-    /// the scene's sphere (`center`, `radius`), `share` of it aimed at `targets`.
+    /// the scene's sphere (`center`, `radius`), `share` of it aimed at `targets` (more than
+    /// [`MAX_TARGETS`]: at one sphere around them, as [`Aim`] does).
     pub fn new(
         direction: Vec3,
         sun: Option<(f32, f32)>,
@@ -90,15 +92,27 @@ impl Beam {
             )
         };
         let scene_radius = disc(&Target { center, radius }).1;
-        let targets: Vec<(Vec2, f32)> = targets.iter().map(disc).collect();
-        let target_area: f32 = targets.iter().map(|(_, r)| PI * r * r).sum();
+        let all;
+        let targets = if targets.len() <= MAX_TARGETS {
+            targets
+        } else {
+            all = [around(targets)];
+            &all[..]
+        };
+        let mut discs = [(Vec2::ZERO, 0.0); MAX_TARGETS];
+        for (d, t) in discs.iter_mut().zip(targets) {
+            *d = disc(t);
+        }
+        let target_count = targets.len();
+        let target_area: f32 = discs[..target_count].iter().map(|(_, r)| PI * r * r).sum();
         let share = if target_area > 0.0 { share.clamp(0.0, 1.0) } else { 0.0 };
         Beam {
             direction,
             frame,
             plane_origin,
             scene_radius,
-            targets,
+            targets: discs,
+            target_count,
             target_area,
             share,
             sun,
@@ -109,8 +123,8 @@ impl Beam {
     fn sample(&self, u_lobe: f32, u_pick: f32, u: Vec2) -> Option<(Vec3, f32)> {
         let (center, radius) = if u_lobe < self.share {
             let mut x = u_pick * self.target_area;
-            let mut chosen = *self.targets.last()?;
-            for &(c, r) in &self.targets {
+            let mut chosen = *self.discs().last()?;
+            for &(c, r) in self.discs() {
                 let a = PI * r * r;
                 if x < a {
                     chosen = (c, r);
@@ -127,6 +141,11 @@ impl Beam {
         (pdf > 0.0).then(|| (self.plane_origin + self.frame.x * p.x + self.frame.y * p.y, pdf))
     }
 
+    /// The targets' discs on the plane.
+    fn discs(&self) -> &[(Vec2, f32)] {
+        &self.targets[..self.target_count]
+    }
+
     /// Area density of a start at `p` on the plane (the mixture's).
     fn plane_pdf(&self, p: Vec2) -> f32 {
         let inside = |c: Vec2, r: f32| (p - c).length_squared() <= r * r * (1.0 + 1e-5);
@@ -135,7 +154,7 @@ impl Beam {
             pdf += (1.0 - self.share) / (PI * self.scene_radius * self.scene_radius);
         }
         if self.share > 0.0 {
-            let count = self.targets.iter().filter(|&&(c, r)| inside(c, r)).count();
+            let count = self.discs().iter().filter(|&&(c, r)| inside(c, r)).count();
             pdf += self.share * count as f32 / self.target_area;
         }
         pdf
@@ -179,6 +198,16 @@ pub struct Aim {
 /// evaluation visits each target.
 const MAX_TARGETS: usize = 8;
 
+/// A sphere around all of `targets` (not empty).
+fn around(targets: &[Target]) -> Target {
+    let center = targets.iter().map(|t| t.center).sum::<Vec3>() / targets.len() as f32;
+    let radius = targets
+        .iter()
+        .map(|t| (t.center - center).length() + t.radius)
+        .fold(0.0, f32::max);
+    Target { center, radius }
+}
+
 impl Aim {
     /// Aiming `share` of the subpaths at `targets` (`None` when there is nothing to aim at).
     pub fn new(targets: &[Target], share: f32) -> Option<Aim> {
@@ -188,12 +217,7 @@ impl Aim {
         let targets = if targets.len() <= MAX_TARGETS {
             targets.to_vec()
         } else {
-            let center = targets.iter().map(|t| t.center).sum::<Vec3>() / targets.len() as f32;
-            let radius = targets
-                .iter()
-                .map(|t| (t.center - center).length() + t.radius)
-                .fold(0.0, f32::max);
-            vec![Target { center, radius }]
+            vec![around(targets)]
         };
         Some(Aim { targets, share })
     }
@@ -378,7 +402,6 @@ impl Emitters {
             .collect();
         let weights: Vec<f32> = numbers.iter().map(|&i| powers[i]).collect();
         let choice = (total > 0.0 && total.is_finite()).then(|| Distribution1D::new(&weights));
-        let far_targets = targets.to_vec();
         Emitters {
             probability,
             numbers,
@@ -386,7 +409,6 @@ impl Emitters {
             aim,
             beams,
             sphere,
-            far_targets,
         }
     }
 
@@ -663,7 +685,8 @@ impl Emitters {
 
     /// The sky's beam travelling in `dir`.
     fn sky_beam(&self, dir: Vec3) -> Beam {
-        Beam::new(dir, None, self.sphere, &self.far_targets, FAR_AIM_SHARE)
+        let targets = self.aim.as_ref().map_or(&[][..], |a| &a.targets[..]);
+        Beam::new(dir, None, self.sphere, targets, FAR_AIM_SHARE)
     }
 
     /// Emission's density (point × direction, choice included) of leaving emissive object
@@ -991,7 +1014,7 @@ mod tests {
             assert!((along / expected - 1.0).abs() < 1e-3, "{along} vs {expected}");
             let local = beam.frame.to_local(origin - beam.plane_origin);
             let p = Vec2::new(local.x, local.y);
-            on_targets += beam.targets.iter().any(|&(c, r)| (p - c).length_squared() <= r * r) as usize;
+            on_targets += beam.discs().iter().any(|&(c, r)| (p - c).length_squared() <= r * r) as usize;
         }
         // A third aimed, plus the uniform starts that fall on the targets' discs anyway.
         let share = on_targets as f64 / n as f64;
