@@ -605,3 +605,24 @@ fn vcm_balances_light_subpaths_against_camera_paths() {
     assert_eq!(count(DIFFUSE_BOX, 2), Some(diffuse));
     assert_eq!(count(PLANE, 2), Some(plane));
 }
+
+/// The balance weighs merging's variance as it stands over a run, the radius shrinking: where
+/// merging carries the light (a floor lit through a coated sheet of water, seen through it),
+/// a radius that shrinks (α = 2/3) asks for more light subpaths than one that keeps its size
+/// (α = 1), by up to √2.75 (merging's variance over the 64 passes the balance assumes is 2.75
+/// times the first pass's).
+#[test]
+fn vcm_balance_weighs_merging_as_its_radius_shrinks() {
+    let s = scene(COATED_SHEET);
+    let count = |alpha: f32| {
+        let settings = VcmSettings {
+            alpha,
+            ..VcmSettings::default()
+        };
+        Vcm::new(&s, settings, 32, 32, 7).chosen_paths_per_pass().unwrap()
+    };
+    let (shrinking, kept) = (count(2.0 / 3.0), count(1.0));
+    let ratio = shrinking as f64 / kept as f64;
+    eprintln!("balanced light subpaths: α = 2/3 {shrinking}, α = 1 {kept}, ratio {ratio:.3}");
+    assert!(ratio > 1.2 && ratio < 1.7, "{ratio}");
+}

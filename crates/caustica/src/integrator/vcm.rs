@@ -50,12 +50,13 @@ use crate::progress::Control;
 use crate::sampling::{power_heuristic, Rng};
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths, SAMPLES};
-use balance::{balanced_light_paths, PassCosts, PixelSpread, CANDIDATE_COST};
+use balance::{balanced_light_paths, merging_growth, PassCosts, PixelSpread, CANDIDATE_COST};
 use emitters::{Aim, Emitters};
 use focus::CausticFocus;
 use grid::HashGrid;
 use mis::{ConnectionPdfs, DirectPdfs, Factors, Partial};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Settings of vertex connection and merging.
 #[derive(Clone, Debug, PartialEq)]
@@ -321,6 +322,17 @@ pub struct Vcm<'a> {
     timing: std::sync::Mutex<Option<PassTiming>>,
 }
 
+/// The balance pilot's two halves of a pass's light subpaths.
+struct BalanceHalves {
+    data: [PassData; 2],
+    /// Each half's light tracing on the film (the mean of R, G, B).
+    splats: [Vec<f64>; 2],
+    /// A half's light estimates times this stand for a pass of the default count's.
+    scale: f64,
+    /// Light subpaths in each half.
+    half: u64,
+}
+
 /// A pass's seconds per light subpath, all its work counted (the camera paths' share too, which
 /// does not grow with the subpaths: a pass sized from a smaller one ends a little early, from a
 /// larger one a little late).
@@ -345,6 +357,11 @@ const BALANCE_SEED: u64 = 0x0062_616c_616e_6365;
 /// The balance pilot samples this share of the pixels, and at least [`MIN_BALANCE_PIXELS`].
 const BALANCE_PIXEL_SHARE: usize = 16;
 const MIN_BALANCE_PIXELS: usize = 2048;
+/// The run whose mean merging variance the balance weighs ([`balance::merging_growth`]): the
+/// default plan's passes. Not the run's own plan, which the parts of a split run do not share;
+/// the growth goes as the cube root of the passes, so a run of a tenth or ten times as many is
+/// off by about 2× in the variance and 1.5× in the count.
+const BALANCE_RUN_PASSES: u64 = super::session::DEFAULT_PASSES;
 /// The balanced count's bounds: one light subpath for this many pixels, and at least
 /// [`MIN_LIGHT_PATHS`]; [`MOST_LIGHT_PATHS_PER_PIXEL`] a pixel, at most
 /// [`MAX_DEFAULT_LIGHT_PATHS`].
@@ -443,25 +460,12 @@ impl<'a> Vcm<'a> {
         })
     }
 
-    /// The first `count` light subpaths of pass `pass` (a pilot's: it cannot be cancelled).
+    /// The first `count` light subpaths of pass `pass`, for a pilot (nothing cancels it).
     fn pilot_paths(&self, pass: u64, count: u64, f: &Factors, wl: &Wavelengths, to_eye: bool) -> LightPaths {
-        let batches: Vec<LightPaths> = (0..count.div_ceil(BATCH))
-            .into_par_iter()
-            .map(|b| {
-                let mut out = LightPaths::default();
-                for i in b * BATCH..((b + 1) * BATCH).min(count) {
-                    self.trace_light(pass, i, f, wl, to_eye, &mut out);
-                    out.ends.push(out.vertices.len() as u32);
-                }
-                out
-            })
-            .collect();
-        let mut all = LightPaths::default();
-        all.ends.push(0);
-        for batch in &batches {
-            all.append(batch);
-        }
-        all
+        let mut scratch = Scratch::default();
+        let never = AtomicBool::new(false);
+        let _ = self.light_paths((pass, count), f, wl, to_eye, &never, &mut scratch);
+        scratch.paths
     }
 
     /// Light subpaths in a full pass: the setting's, or else the balance pilot's count.
@@ -494,7 +498,6 @@ impl<'a> Vcm<'a> {
         // Every weight as in a pass of the default count; each half's light estimates scaled
         // up to stand for such a pass.
         let f = Factors::new(self.radius, default as f32);
-        let scale = default as f64 / half as f64;
         let wl = pass_wavelengths(self.spectral, self.seed, BALANCE_PASSES[0]);
         let halves = BALANCE_PASSES.map(|pass| {
             let paths = self.pilot_paths(pass, half, &f, &wl, true);
@@ -510,7 +513,6 @@ impl<'a> Vcm<'a> {
         });
         let sampled = pixels.min(MIN_BALANCE_PIXELS.max(pixels / BALANCE_PIXEL_SHARE)).max(1);
         let stride = pixels / sampled;
-        let camera = self.scene.camera();
         let camera_start = std::time::Instant::now();
         // A pixel from each run of `stride`.
         let chosen: Vec<usize> = (0..sampled)
@@ -519,41 +521,15 @@ impl<'a> Vcm<'a> {
                 j * stride + ((rng.uniform() * stride as f32) as usize).min(stride - 1)
             })
             .collect();
+        let pilot = BalanceHalves {
+            data: halves,
+            splats,
+            scale: default as f64 / half as f64,
+            half,
+        };
         let measured: Vec<(PixelSpread, CameraWork)> = chosen
             .par_iter()
-            .map(|&pixel| {
-                let mut rng = Rng::new(self.seed ^ BALANCE_SEED ^ 1, pixel as u64);
-                let (x, y) = (pixel % w, pixel / w);
-                let own = pixel % half as usize;
-                let mut work = CameraWork::default();
-                let (mut values, mut cameras) = ([0.0f64; 2], [0.0f64; 2]);
-                let mut light = 0.0;
-                for i in 0..2 {
-                    let (jx, jy) = (rng.uniform(), rng.uniform());
-                    let ray = camera.generate_ray((x as f32 + jx) / w as f32, 1.0 - (y as f32 + jy) / h as f32);
-                    // The same camera path (the same random numbers) joined to each half: the
-                    // camera strategies' part is the same, the light's differs.
-                    let mut twin = rng.clone();
-                    let merged_before = work.merged;
-                    let all = channel_mean(wl.to_rgb(self.camera_path(ray, &halves[0], own, &wl, &mut rng, &mut work)));
-                    let merged_a = channel_mean(wl.to_rgb(work.merged - merged_before));
-                    let mut other = CameraWork::default();
-                    self.camera_path(ray, &halves[1], own, &wl, &mut twin, &mut other);
-                    let merged_b = channel_mean(wl.to_rgb(other.merged));
-                    let light_a = scale * (merged_a + splats[0][pixel]);
-                    let light_b = scale * (merged_b + splats[1][pixel]);
-                    // A half's variance is half its squared difference from the other's.
-                    light += 0.5 * (light_a - light_b).powi(2);
-                    cameras[i] = all - merged_a;
-                    values[i] = cameras[i] + 0.5 * (light_a + light_b);
-                }
-                let spread = PixelSpread {
-                    camera: 0.5 * (cameras[0] - cameras[1]).powi(2),
-                    light: half as f64 * light / 2.0,
-                    mean: 0.5 * (values[0] + values[1]),
-                };
-                (spread, work)
-            })
+            .map(|&pixel| self.balance_pixel(pixel, &pilot, &wl))
             .collect();
         let camera_seconds = camera_start.elapsed().as_secs_f64() / (4 * chosen.len()) as f64;
         let spreads: Vec<PixelSpread> = measured.iter().map(|(s, _)| *s).collect();
@@ -565,17 +541,62 @@ impl<'a> Vcm<'a> {
         let samples_a_pass = pixels as f64;
         let costs = PassCosts {
             camera: rays as f64 / camera_samples * samples_a_pass,
-            per_light_path: (halves[0].paths.rays + halves[1].paths.rays) as f64 / (2 * half) as f64
+            per_light_path: (pilot.data[0].paths.rays + pilot.data[1].paths.rays) as f64 / (2 * half) as f64
                 + CANDIDATE_COST * candidates as f64 / camera_samples * samples_a_pass / half as f64,
         };
         let bounds = (
             (pixels as u64 / LEAST_SHARE_OF_PIXELS).max(MIN_LIGHT_PATHS),
             (pixels as u64 * MOST_LIGHT_PATHS_PER_PIXEL).clamp(MIN_LIGHT_PATHS, MAX_DEFAULT_LIGHT_PATHS),
         );
-        let count = balanced_light_paths(&spreads, costs, bounds).unwrap_or(default);
+        let growth = merging_growth(BALANCE_RUN_PASSES, self.settings.alpha);
+        let count = balanced_light_paths(&spreads, growth, costs, bounds).unwrap_or(default);
         let pass_seconds = light_seconds * count as f64 + camera_seconds * samples_a_pass;
         let _ = self.balance_seconds.set(pass_seconds / count as f64);
         count
+    }
+
+    /// The balance pilot at one pixel: two camera samples, each joined to both halves with the
+    /// same random numbers, so the camera strategies' part is the same and the light's differs.
+    fn balance_pixel(&self, pixel: usize, pilot: &BalanceHalves, wl: &Wavelengths) -> (PixelSpread, CameraWork) {
+        let (w, h) = (self.width, self.height);
+        let camera = self.scene.camera();
+        let scale = pilot.scale;
+        let mut rng = Rng::new(self.seed ^ BALANCE_SEED ^ 1, pixel as u64);
+        let (x, y) = (pixel % w, pixel / w);
+        let own = pixel % pilot.half as usize;
+        let mut work = CameraWork::default();
+        let (mut values, mut cameras) = ([0.0f64; 2], [0.0f64; 2]);
+        let (mut traced, mut merged, mut covariance) = (0.0, 0.0, 0.0);
+        for i in 0..2 {
+            let (jx, jy) = (rng.uniform(), rng.uniform());
+            let ray = camera.generate_ray((x as f32 + jx) / w as f32, 1.0 - (y as f32 + jy) / h as f32);
+            let mut twin = rng.clone();
+            let merged_before = work.merged;
+            let all = channel_mean(wl.to_rgb(self.camera_path(ray, &pilot.data[0], own, wl, &mut rng, &mut work)));
+            let merged_a = channel_mean(wl.to_rgb(work.merged - merged_before));
+            let mut other = CameraWork::default();
+            self.camera_path(ray, &pilot.data[1], own, wl, &mut twin, &mut other);
+            let merged_b = channel_mean(wl.to_rgb(other.merged));
+            cameras[i] = all - merged_a;
+            let (splat_a, splat_b) = (scale * pilot.splats[0][pixel], scale * pilot.splats[1][pixel]);
+            let (merged_a, merged_b) = (scale * merged_a, scale * merged_b);
+            values[i] = cameras[i] + 0.5 * (splat_a + splat_b + merged_a + merged_b);
+            // A half's variance is half its squared difference from the other's.
+            let (dt, dm) = (splat_a - splat_b, merged_a - merged_b);
+            traced += 0.5 * dt * dt;
+            merged += 0.5 * dm * dm;
+            covariance += 0.5 * dt * dm;
+        }
+        // Per light subpath: times their number, over the two samples.
+        let per_path = pilot.half as f64 / 2.0;
+        let spread = PixelSpread {
+            camera: 0.5 * (cameras[0] - cameras[1]).powi(2),
+            traced: per_path * traced,
+            merged: per_path * merged,
+            covariance: per_path * covariance,
+            mean: 0.5 * (values[0] + values[1]),
+        };
+        (spread, work)
     }
 
     /// Whether each pixel sees a focused cell directly: the ray through its centre ends in
@@ -769,26 +790,29 @@ impl<'a> Vcm<'a> {
     }
 
     /// The first `count` light subpaths of pass `pass`, traced in batches in parallel and kept
-    /// in index order in `all` (emptied first; `scratch` lends the batches' memory).
+    /// in index order in `scratch.paths` (emptied first; `scratch.batches` lends the batches'
+    /// memory). `None` when `cancel` is set. `to_eye`: joined to the eye (a pilot that only
+    /// looks for the focus does not).
     fn light_paths(
         &self,
         (pass, count): (u64, u64),
         f: &Factors,
         wl: &Wavelengths,
-        control: Control,
-        scratch: &mut Vec<LightPaths>,
-        all: &mut LightPaths,
+        to_eye: bool,
+        cancel: &AtomicBool,
+        scratch: &mut Scratch,
     ) -> Option<()> {
         let batch_count = count.div_ceil(BATCH) as usize;
-        scratch.resize_with(scratch.len().max(batch_count), LightPaths::default);
-        let complete = scratch[..batch_count].par_iter_mut().enumerate().all(|(b, out)| {
-            if control.cancelled() {
+        let batches = &mut scratch.batches;
+        batches.resize_with(batches.len().max(batch_count), LightPaths::default);
+        let complete = batches[..batch_count].par_iter_mut().enumerate().all(|(b, out)| {
+            if cancel.load(Ordering::Relaxed) {
                 return false;
             }
             out.clear();
             let b = b as u64;
             for i in b * BATCH..((b + 1) * BATCH).min(count) {
-                self.trace_light(pass, i, f, wl, true, out);
+                self.trace_light(pass, i, f, wl, to_eye, out);
                 out.ends.push(out.vertices.len() as u32);
             }
             true
@@ -796,9 +820,10 @@ impl<'a> Vcm<'a> {
         if !complete {
             return None;
         }
+        let all = &mut scratch.paths;
         all.clear();
         all.ends.push(0);
-        for batch in &scratch[..batch_count] {
+        for batch in &batches[..batch_count] {
             all.append(batch);
         }
         Some(())
@@ -1334,11 +1359,12 @@ impl Vcm<'_> {
             .try_lock()
             .map(|mut s| std::mem::take(&mut *s))
             .unwrap_or_default();
-        let mut paths = std::mem::take(&mut scratch.paths);
-        paths.clear();
-        if !self.emitters.is_empty() {
-            self.light_paths((pass, count), &f, &wl, control, &mut scratch.batches, &mut paths)?;
+        if self.emitters.is_empty() {
+            scratch.paths.clear();
+        } else {
+            self.light_paths((pass, count), &f, &wl, true, control.cancel, &mut scratch)?;
         }
+        let paths = std::mem::take(&mut scratch.paths);
         let pass_data = PassData::arrange(
             paths,
             std::mem::take(&mut scratch.grid),

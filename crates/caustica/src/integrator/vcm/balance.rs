@@ -8,16 +8,44 @@
 //! two orders of magnitude between scenes (BENCHMARKS.md: a Cornell box lit through a glass ball
 //! wants many light subpaths a pixel, a pool seen through its water a few, a lens in the sun
 //! fewer than one), so a pilot measures both sides on the scene itself ([`super::Vcm`]).
+//!
+//! Merging's part grows as the radius shrinks pass by pass (a density estimate's variance goes
+//! as one over the area it gathers from), so the pilot's merging variance, measured at the first
+//! pass's radius, is weighed as it stands averaged over a run ([`merging_growth`]).
+
+use crate::integrator::radius::radius_factor;
 
 /// What the balance pilot measured at one pixel, in the image's units (the mean of R, G, B).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PixelSpread {
     /// The variance of one camera sample's estimate with the light subpaths held fixed.
     pub camera: f64,
-    /// The variance of the light subpaths' part, times their number: one subpath's.
-    pub light: f64,
+    /// One light subpath's variance in light tracing's part (its splats on the film): the
+    /// variance of the light subpaths' part times their number.
+    pub traced: f64,
+    /// The same for merging's part, at the first pass's radius.
+    pub merged: f64,
+    /// The two parts' covariance, on the same terms.
+    pub covariance: f64,
     /// The pixel's value.
     pub mean: f64,
+}
+
+impl PixelSpread {
+    /// One light subpath's variance where merging's is `growth` times the first pass's.
+    pub fn light(&self, growth: f64) -> f64 {
+        self.traced + growth * self.merged + 2.0 * growth.sqrt() * self.covariance
+    }
+}
+
+/// How many times the first pass's merging variance merging's variance is, averaged over
+/// passes `0..passes`: the radius's area shrinks by `radius_factor²`.
+pub fn merging_growth(passes: u64, alpha: f32) -> f64 {
+    let passes = passes.max(1);
+    (0..passes)
+        .map(|pass| 1.0 / (radius_factor(pass, alpha) as f64).powi(2))
+        .sum::<f64>()
+        / passes as f64
 }
 
 /// What a pass costs, in rays (a gathered light vertex counts as [`CANDIDATE_COST`] of one).
@@ -40,9 +68,10 @@ pub const CANDIDATE_COST: f64 = 0.25;
 const DARK_SHARE: f64 = 0.1;
 
 /// The number of light subpaths a pass should trace, within `bounds` (least, most): the one
-/// that minimises the sum over `pixels` of each pixel's relative variance at equal time.
-/// `None` when the pilot saw no noise at all on one side (nothing to balance).
-pub fn balanced_light_paths(pixels: &[PixelSpread], costs: PassCosts, bounds: (u64, u64)) -> Option<u64> {
+/// that minimises the sum over `pixels` of each pixel's relative variance at equal time, with
+/// merging's variance `growth` times the pilot's. `None` when the pilot saw no noise at all on
+/// one side (nothing to balance).
+pub fn balanced_light_paths(pixels: &[PixelSpread], growth: f64, costs: PassCosts, bounds: (u64, u64)) -> Option<u64> {
     if pixels.is_empty() {
         return None;
     }
@@ -52,7 +81,7 @@ pub fn balanced_light_paths(pixels: &[PixelSpread], costs: PassCosts, bounds: (u
     for p in pixels {
         let scale = 1.0 / (p.mean * p.mean + floor).max(f64::MIN_POSITIVE);
         camera += scale * p.camera;
-        light += scale * p.light;
+        light += scale * p.light(growth);
     }
     let (least, most) = bounds;
     if !(camera.is_finite() && light.is_finite() && costs.camera.is_finite() && costs.per_light_path.is_finite()) {
@@ -78,7 +107,9 @@ mod tests {
     fn spread(camera: f64, light: f64) -> PixelSpread {
         PixelSpread {
             camera,
-            light,
+            traced: light,
+            merged: 0.0,
+            covariance: 0.0,
             mean: 1.0,
         }
     }
@@ -93,8 +124,10 @@ mod tests {
             camera: 3000.0,
             per_light_path: 2.0,
         };
-        let chosen = balanced_light_paths(&pixels, costs, (1, 100_000)).unwrap();
-        let (vc, vl): (f64, f64) = pixels.iter().fold((0.0, 0.0), |(c, l), p| (c + p.camera, l + p.light));
+        let chosen = balanced_light_paths(&pixels, 1.0, costs, (1, 100_000)).unwrap();
+        let (vc, vl): (f64, f64) = pixels
+            .iter()
+            .fold((0.0, 0.0), |(c, l), p| (c + p.camera, l + p.light(1.0)));
         let cost = |l: u64| (vc + vl / l as f64) * (costs.camera + costs.per_light_path * l as f64);
         let best = (1..100_000).min_by(|a, b| cost(*a).total_cmp(&cost(*b))).unwrap();
         assert!(chosen.abs_diff(best) <= 1, "chose {chosen}, the minimum is at {best}");
@@ -108,25 +141,72 @@ mod tests {
             camera: 100.0,
             per_light_path: 1.0,
         };
-        assert_eq!(balanced_light_paths(&[spread(1.0, 100.0)], costs, (1, 1000)), Some(100));
+        assert_eq!(
+            balanced_light_paths(&[spread(1.0, 100.0)], 1.0, costs, (1, 1000)),
+            Some(100)
+        );
         // A black pixel counts its noise against a tenth of the image's mean (here 0.05): its
         // light noise of 0.25 weighs as much as the bright pixel's 100.
         let dark = PixelSpread {
             mean: 0.0,
             ..spread(0.0, 0.25)
         };
-        let with_dark = balanced_light_paths(&[spread(1.0, 100.0), dark], costs, (1, 1000)).unwrap();
+        let with_dark = balanced_light_paths(&[spread(1.0, 100.0), dark], 1.0, costs, (1, 1000)).unwrap();
         assert!(with_dark.abs_diff(141) <= 1, "{with_dark}");
         assert_eq!(
-            balanced_light_paths(&[spread(1.0, 100.0)], costs, (150, 1000)),
+            balanced_light_paths(&[spread(1.0, 100.0)], 1.0, costs, (150, 1000)),
             Some(150)
         );
         assert_eq!(
-            balanced_light_paths(&[spread(0.0, 100.0)], costs, (7, 1000)),
+            balanced_light_paths(&[spread(0.0, 100.0)], 1.0, costs, (7, 1000)),
             Some(1000)
         );
-        assert_eq!(balanced_light_paths(&[spread(1.0, 0.0)], costs, (7, 1000)), Some(7));
-        assert_eq!(balanced_light_paths(&[spread(0.0, 0.0)], costs, (7, 1000)), None);
-        assert_eq!(balanced_light_paths(&[], costs, (7, 1000)), None);
+        assert_eq!(
+            balanced_light_paths(&[spread(1.0, 0.0)], 1.0, costs, (7, 1000)),
+            Some(7)
+        );
+        assert_eq!(balanced_light_paths(&[spread(0.0, 0.0)], 1.0, costs, (7, 1000)), None);
+        assert_eq!(balanced_light_paths(&[], 1.0, costs, (7, 1000)), None);
+    }
+
+    /// Over one pass the growth is one; over a run it follows the radius's shrinking, r² falling
+    /// like pass^(α−1), so the mean of 1/r² grows like pass^(1−α) / (2 − α).
+    #[test]
+    fn merging_grows_as_the_radius_shrinks() {
+        assert_eq!(merging_growth(1, 2.0 / 3.0), 1.0);
+        assert_eq!(merging_growth(0, 2.0 / 3.0), 1.0);
+        let g64 = merging_growth(64, 2.0 / 3.0);
+        let g512 = merging_growth(512, 2.0 / 3.0);
+        assert!(g64 > 2.0 && g64 < 4.0, "{g64}");
+        // Eight times the passes: about 8^(1/3) = 2 times the growth.
+        assert!((g512 / g64 - 2.0).abs() < 0.1, "{g64} {g512}");
+        // α = 1 keeps the radius.
+        assert!((merging_growth(64, 1.0) - 1.0).abs() < 1e-6);
+    }
+
+    /// Merging's variance weighs `growth` times; its covariance with light tracing's √growth
+    /// times; a count chosen for merging alone grows by √growth.
+    #[test]
+    fn merging_variance_is_weighed_by_its_growth() {
+        let p = PixelSpread {
+            camera: 1.0,
+            traced: 2.0,
+            merged: 3.0,
+            covariance: -0.5,
+            mean: 1.0,
+        };
+        assert!((p.light(4.0) - (2.0 + 12.0 - 2.0)).abs() < 1e-12);
+        let merging = PixelSpread {
+            traced: 0.0,
+            merged: 100.0,
+            covariance: 0.0,
+            ..p
+        };
+        let costs = PassCosts {
+            camera: 100.0,
+            per_light_path: 1.0,
+        };
+        assert_eq!(balanced_light_paths(&[merging], 1.0, costs, (1, 1000)), Some(100));
+        assert_eq!(balanced_light_paths(&[merging], 4.0, costs, (1, 1000)), Some(200));
     }
 }
