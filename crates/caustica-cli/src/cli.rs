@@ -279,7 +279,8 @@ pub struct ProgressiveOptions {
     #[arg(long, value_parser = ["clamp", "reinhard", "linear"])]
     pub tone_map: Option<String>,
     /// ppm, gi: first gather radius in pixels at the gather point (the footprint the blur starts
-    /// from); vcm: first merging radius in pixels [default: 2 for ppm and gi, 3 for vcm].
+    /// from); vcm: first merging radius in pixels [default: 2 for ppm and gi; 3 for vcm where the
+    /// eye sees a caustic's focus directly or `--photons` is given, else 2].
     #[arg(long)]
     pub footprint: Option<f32>,
     /// Black wherever the camera looks into a mirror or through glass, as in a particle tracer's

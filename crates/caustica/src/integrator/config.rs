@@ -335,6 +335,10 @@ impl RenderConfig {
                 connections: self.vertex_connections,
                 aim: !self.no_aim,
                 spectral: self.spectral,
+                balanced_footprint: match (self.radius, self.footprint) {
+                    (None, None) => VcmSettings::default().balanced_footprint,
+                    _ => None,
+                },
                 ..VcmSettings::default()
             }),
         };
@@ -532,7 +536,8 @@ mod tests {
     }
 
     /// Without `--footprint` each integrator starts from its own radius (`vcm` merges from 3
-    /// pixels, `ppm` and `gi` gather from 2); `--footprint` sets it for all, `--radius` wins.
+    /// pixels, 2 where its pilot balanced the count; `ppm` and `gi` gather from 2);
+    /// `--footprint` sets it for all, `--radius` wins.
     #[test]
     fn the_first_radius_is_each_integrators_own_unless_given() {
         let with = |kind, footprint, radius| RenderConfig {
@@ -552,6 +557,14 @@ mod tests {
             assert_eq!(first_radius(&with(kind, Some(1.5), Some(0.1))), World(0.1));
             assert!(with(kind, Some(0.0), None).integrator().is_err());
         }
+        // vcm's balanced scenes merge from 2 pixels unless a radius is given.
+        let balanced = |footprint, radius| match with(IntegratorKind::Vcm, footprint, radius).integrator().unwrap() {
+            Integrator::Vcm(s) => s.balanced_footprint,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(balanced(None, None), Some(2.0));
+        assert_eq!(balanced(Some(3.0), None), None);
+        assert_eq!(balanced(None, Some(0.1)), None);
         assert_eq!(
             with(IntegratorKind::Lt, Some(3.0), None).ignored_by_lt(),
             ["--footprint"]

@@ -84,6 +84,10 @@ pub struct VcmSettings {
     pub spectral: Option<bool>,
     /// Camera samples a pass in the pixels that see a caustic's focus (1: one, as elsewhere).
     pub focus_samples: usize,
+    /// The first merging radius in pixels where the balance pilot chose the count (the eye sees
+    /// no caustic's focus directly); `None` keeps `initial_radius` there too. `--radius` and
+    /// `--footprint` set `None`.
+    pub balanced_footprint: Option<f32>,
 }
 
 impl Default for VcmSettings {
@@ -97,6 +101,7 @@ impl Default for VcmSettings {
             aim: true,
             spectral: None,
             focus_samples: FOCUS_CAMERA_SAMPLES,
+            balanced_footprint: Some(BALANCED_FOOTPRINT),
         }
     }
 }
@@ -107,6 +112,11 @@ impl Default for VcmSettings {
 /// a pass (more light vertices to merge); 1 pixel doubled it. (`ppm`'s gathers keep 2:
 /// `--footprint` gives both.)
 pub const MERGING_FOOTPRINT: f32 = 3.0;
+
+/// The first merging radius in pixels of a scene the balance pilot balanced. Against a
+/// reference of `scenes/pool.ray` (a caustic net seen through water), 3 pixels' blur was most of
+/// vcm's error at 20 s; 2 pixels cut it 1.5× (BENCHMARKS.md, "The pool against a reference").
+pub const BALANCED_FOOTPRINT: f32 = 2.0;
 
 /// The share of light subpaths aimed at the bounding spheres of mirrors and glass: caustic
 /// paths become several times more frequent while the rest keep most of their subpaths.
@@ -305,8 +315,9 @@ pub struct Vcm<'a> {
     max_length: u32,
     /// The first pass's merging radius in scene units.
     radius: f32,
-    /// Light subpaths in a full pass: the setting's, or the balance pilot's on first use.
-    light_paths: std::sync::OnceLock<u64>,
+    /// Light subpaths in a full pass and the first pass's merging radius: the settings', or the
+    /// balance pilot's on first use.
+    balanced: std::sync::OnceLock<Balance>,
     /// The balance pilot's estimate of a full pass's seconds per light subpath.
     balance_seconds: std::sync::OnceLock<f64>,
     /// The first [`RAMP_PASSES`] passes trace half the light subpaths (the default count only).
@@ -320,6 +331,14 @@ pub struct Vcm<'a> {
     pilot_seconds: std::sync::OnceLock<f64>,
     /// How long the last pass took, for sizing the next to a time limit.
     timing: std::sync::Mutex<Option<PassTiming>>,
+}
+
+/// What the balance pilot chose.
+#[derive(Clone, Copy, Debug)]
+struct Balance {
+    light_paths: u64,
+    /// The first pass's merging radius in scene units.
+    radius: f32,
 }
 
 /// The balance pilot's two halves of a pass's light subpaths.
@@ -407,8 +426,11 @@ impl<'a> Vcm<'a> {
             // Segments: one more than the surfaces light may scatter at.
             max_length: super::config::scattering_surfaces(settings.max_depth).saturating_add(1),
             radius,
-            light_paths: match settings.light_paths_per_pass {
-                Some(count) => std::sync::OnceLock::from(count.max(1)),
+            balanced: match settings.light_paths_per_pass {
+                Some(count) => std::sync::OnceLock::from(Balance {
+                    light_paths: count.max(1),
+                    radius,
+                }),
                 None => std::sync::OnceLock::new(),
             },
             balance_seconds: std::sync::OnceLock::new(),
@@ -470,7 +492,16 @@ impl<'a> Vcm<'a> {
 
     /// Light subpaths in a full pass: the setting's, or else the balance pilot's count.
     fn full_pass_paths(&self) -> u64 {
-        *self.light_paths.get_or_init(|| self.balance_pilot())
+        self.balanced().light_paths
+    }
+
+    /// The first pass's merging radius.
+    fn first_radius(&self) -> f32 {
+        self.balanced().radius
+    }
+
+    fn balanced(&self) -> &Balance {
+        self.balanced.get_or_init(|| self.balance_pilot())
     }
 
     /// The balance pilot ([`balance`]): two independent halves of a pilot pass's light subpaths,
@@ -478,10 +509,13 @@ impl<'a> Vcm<'a> {
     /// The halves' difference is the light side's noise, the samples' the camera side's; rays
     /// counted are the costs. Its own random streams, so every run of a seed finds the same
     /// count (split runs merge into one).
-    fn balance_pilot(&self) -> u64 {
+    fn balance_pilot(&self) -> Balance {
         let (w, h) = (self.width, self.height);
         let pixels = self.pixels();
-        let default = default_light_paths(w, h);
+        let default = Balance {
+            light_paths: default_light_paths(w, h),
+            radius: self.radius,
+        };
         if self.scene.lights().is_empty() || self.emitters.is_empty() {
             return default;
         }
@@ -497,11 +531,15 @@ impl<'a> Vcm<'a> {
             .div_ceil(2);
         // Every weight as in a pass of the default count; each half's light estimates scaled
         // up to stand for such a pass.
-        let f = Factors::new(self.radius, default as f32);
+        let radius = match self.settings.balanced_footprint {
+            Some(px) => self.radius * px / MERGING_FOOTPRINT,
+            None => self.radius,
+        };
+        let f = Factors::new(radius, default.light_paths as f32);
         let wl = pass_wavelengths(self.spectral, self.seed, BALANCE_PASSES[0]);
         let halves = BALANCE_PASSES.map(|pass| {
             let paths = self.pilot_paths(pass, half, &f, &wl, true);
-            PassData::arrange(paths, HashGrid::default(), Vec::new(), f, self.radius)
+            PassData::arrange(paths, HashGrid::default(), Vec::new(), f, radius)
         });
         let light_seconds = start.elapsed().as_secs_f64() / (2 * half) as f64;
         let splats = halves.each_ref().map(|data| {
@@ -524,7 +562,7 @@ impl<'a> Vcm<'a> {
         let pilot = BalanceHalves {
             data: halves,
             splats,
-            scale: default as f64 / half as f64,
+            scale: default.light_paths as f64 / half as f64,
             half,
         };
         let measured: Vec<(PixelSpread, CameraWork)> = chosen
@@ -549,10 +587,13 @@ impl<'a> Vcm<'a> {
             (pixels as u64 * MOST_LIGHT_PATHS_PER_PIXEL).clamp(MIN_LIGHT_PATHS, MAX_DEFAULT_LIGHT_PATHS),
         );
         let growth = merging_growth(BALANCE_RUN_PASSES, self.settings.alpha);
-        let count = balanced_light_paths(&spreads, growth, costs, bounds).unwrap_or(default);
+        let count = balanced_light_paths(&spreads, growth, costs, bounds).unwrap_or(default.light_paths);
         let pass_seconds = light_seconds * count as f64 + camera_seconds * samples_a_pass;
         let _ = self.balance_seconds.set(pass_seconds / count as f64);
-        count
+        Balance {
+            light_paths: count,
+            radius,
+        }
     }
 
     /// The balance pilot at one pixel: two camera samples, each joined to both halves with the
@@ -1351,7 +1392,7 @@ impl Vcm<'_> {
         // The pilot run, once, before the passes' parallel work asks for it.
         self.focus();
         let start = std::time::Instant::now();
-        let radius = self.radius * radius_factor(pass, self.settings.alpha);
+        let radius = self.first_radius() * radius_factor(pass, self.settings.alpha);
         let f = Factors::new(radius, count as f32);
         // Another pass running at the same time (not the session's way) gets fresh memory.
         let mut scratch = self
