@@ -8,8 +8,10 @@
 //! - `transmissive` kt with `index` η: a smooth dielectric, reflecting the exact Fresnel fraction F
 //!   and transmitting (1 − F)·kt.
 //!
-//! Where the colours of one channel sum above 1 the lobes are scaled down together, so no
-//! material creates energy. Directions point away from the surface; `n` is the outward shading
+//! Where the colours of one channel sum above 1 the lobes are scaled down together, and the
+//! dielectric, whose Fresnel reflection may reach all the light (at grazing angles, or totally
+//! inside the glass) whatever kt is, keeps at each direction only the room the other lobes
+//! leave; so no material creates energy. Directions point away from the surface; `n` is the outward shading
 //! normal as the shape defines it.
 //!
 //! Materials with a physical description of their own (pbrt-v4 and glTF scenes, see
@@ -452,11 +454,12 @@ impl Bsdf {
         let eta = if self.outside { self.index } else { 1.0 / self.index };
         let cos_o = n.dot(wo).clamp(0.0, 1.0);
         let f = fresnel_dielectric(cos_o, eta);
+        let room = self.dielectric_room(f);
         if x < f {
             let wi = reflect(-wo, n);
             return Some(BsdfSample {
                 wi,
-                weight: Spectrum::ONE / p_dielectric,
+                weight: Spectrum::ONE * (room / p_dielectric),
                 pdf: p_dielectric * f,
                 specular: true,
                 transmitted: false,
@@ -470,7 +473,7 @@ impl Bsdf {
         };
         Some(BsdfSample {
             wi,
-            weight: self.transmission * (scale / p_dielectric),
+            weight: self.transmission * (room * scale / p_dielectric),
             pdf: p_dielectric * (1.0 - f),
             specular: true,
             transmitted: true,
@@ -547,10 +550,11 @@ impl Bsdf {
         let p = self.pick[3];
         let r = fresnel_dielectric(n.dot(wo).clamp(0.0, 1.0), self.index);
         let r = if r < 1.0 { 2.0 * r / (1.0 + r) } else { 1.0 };
+        let room = self.dielectric_room(r);
         if x < r {
             return Some(BsdfSample {
                 wi: reflect(-wo, n),
-                weight: self.wl.grey(1.0 / p),
+                weight: self.wl.grey(room / p),
                 pdf: p * r,
                 specular: true,
                 transmitted: false,
@@ -559,12 +563,31 @@ impl Bsdf {
         }
         Some(BsdfSample {
             wi: -wo,
-            weight: self.transmission / p,
+            weight: self.transmission * (room / p),
             pdf: p * (1.0 - r),
             specular: true,
             transmitted: true,
             dispersive: false,
         })
+    }
+
+    /// The share of the dielectric kept where it reflects `reflectance` (and transmits the rest
+    /// times kt): all of it unless with the other lobes' albedo (at most kd + ks + kr) it would
+    /// reflect more than all the light. A glass with a highlight (ks) reflecting totally inside
+    /// gained ks at every bounce there.
+    #[inline]
+    fn dielectric_room(&self, reflectance: f32) -> f32 {
+        let others = (self.diffuse + self.glossy + self.mirror).max_element();
+        if others <= 0.0 {
+            return 1.0;
+        }
+        let albedo = reflectance + (1.0 - reflectance) * self.transmission.max_element();
+        let room = (1.0 - others).max(0.0);
+        if albedo > room {
+            room / albedo
+        } else {
+            1.0
+        }
     }
 
     /// The share of light that crosses a clear coat on the way in and out (1 without a coat).
@@ -1065,6 +1088,37 @@ mod tests {
             reflected / n as f64
         );
         assert!((total / n as f64 - 1.0).abs() < 1e-4);
+    }
+
+    /// A glass with a highlight (kt + ks at 1 after scaling) never reflects more than all the
+    /// light: from outside, and from inside where the dielectric reflects totally (it gained
+    /// ks at every such bounce, and photons trapped in a lens grew without bound).
+    #[test]
+    fn glass_with_a_highlight_conserves_energy_inside_and_out() {
+        let p = SurfaceParams {
+            specular: Vec3::splat(0.3),
+            shininess: 64.0,
+            transmissive: Vec3::splat(0.85),
+            index: 1.5,
+            ..SurfaceParams::default()
+        };
+        let lobes = Lobes::new(&p);
+        for (wo, total_inside) in [
+            (Vec3::new(0.0, 0.0, 1.0), false),
+            (Vec3::new(0.6, 0.0, 0.8), false),
+            (Vec3::new(0.866, 0.0, -0.5), true),
+            (Vec3::new(0.3, 0.0, -0.954), false),
+        ] {
+            let wo = wo.normalize();
+            let bsdf = Bsdf::new(&lobes, Vec3::Z, Vec3::Z, wo, &RGB, None, None);
+            let a = albedo(&bsdf, wo, 5);
+            assert!(a <= 1.0 + 0.01, "{wo}: albedo {a}");
+            if total_inside {
+                // Total reflection keeps the room the highlight leaves (kt's share, 0.74); the
+                // highlight adds what of it stays above the surface.
+                assert!(a > 0.8, "{wo}: albedo {a}");
+            }
+        }
     }
 
     #[test]
