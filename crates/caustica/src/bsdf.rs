@@ -9,10 +9,13 @@
 //!   and transmitting (1 − F)·kt.
 //!
 //! Where the colours of one channel sum above 1 the lobes are scaled down together, and the
-//! dielectric, whose Fresnel reflection may reach all the light (at grazing angles, or totally
-//! inside the glass) whatever kt is, keeps at each direction only the room the other lobes
-//! leave; so no material creates energy. Directions point away from the surface; `n` is the outward shading
-//! normal as the shape defines it.
+//! dielectric, whose Fresnel reflection may reach all the light at grazing angles whatever kt
+//! is, keeps at each direction only the room the other lobes leave; so no material creates
+//! energy. The other lobes coat the outside only: seen from inside, a dielectric is the bare
+//! interface, reflecting the exact Fresnel fraction (all of it under total internal reflection)
+//! and transmitting what crosses the coated outside, the same share both ways (reciprocal).
+//! Directions point away from the surface; `n` is the outward shading normal as the shape
+//! defines it.
 //!
 //! Materials with a physical description of their own (pbrt-v4 and glTF scenes, see
 //! [`PhysicalMaterial`]) add lobes, built by [`Bsdf::physical`]:
@@ -72,6 +75,8 @@ pub struct Bsdf {
     diffuse_transmission: Spectrum,
     /// The dielectric is a thin sheet: it passes light straight through.
     thin: bool,
+    /// The outside's diffuse, glossy and mirror lobes' albedo bound ([`Lobes::reflection_bound`]).
+    reflection_bound: f32,
     /// The wavelengths, for colours computed per direction (a conductor's Fresnel reflectance).
     wl: Wavelengths,
 }
@@ -176,6 +181,13 @@ impl Bsdf {
         let Lobes {
             kd, ks, kr, kt, scale, ..
         } = *lobes;
+        // Inside a dielectric the other lobes, which coat its outside, do not act.
+        let bare_interface = !outside && lobes.pick[3] > 0.0;
+        let (kd, ks, kr, pick) = if bare_interface {
+            (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, [0.0, 0.0, 0.0, 1.0, 0.0, 0.0])
+        } else {
+            (kd, ks, kr, lobes.pick)
+        };
         // A colour at the wavelengths: the material's fitted spectrum (scaled like the colour)
         // where it has one, else the table's.
         let spectrum = |rgb: Vec3, fit: Option<SigmoidPolynomial>| match (wl, fit) {
@@ -211,11 +223,12 @@ impl Bsdf {
             transmission,
             index,
             dispersive,
-            pick: lobes.pick,
+            pick,
             coat: 0.0,
             microfacet: None,
             diffuse_transmission: Spectrum::ZERO,
             thin: false,
+            reflection_bound: lobes.reflection_bound,
             wl: *wl,
         }
     }
@@ -227,6 +240,8 @@ impl Bsdf {
         let cos_o = b.frame.z.dot(wo).clamp(0.0, 1.0);
         let clamp01 = |c: Vec3| c.clamp(Vec3::ZERO, Vec3::ONE);
         b.pick = [0.0; 6];
+        // No physical material joins a dielectric to other lobes: the thin sheet stands alone.
+        b.reflection_bound = 0.0;
         match *material {
             PhysicalMaterial::Conductor {
                 eta,
@@ -457,9 +472,11 @@ impl Bsdf {
         let room = self.dielectric_room(f);
         if x < f {
             let wi = reflect(-wo, n);
+            // Inside, the bare interface reflects all that Fresnel says.
+            let kept = if self.outside { room } else { 1.0 };
             return Some(BsdfSample {
                 wi,
-                weight: Spectrum::ONE * (room / p_dielectric),
+                weight: Spectrum::ONE * (kept / p_dielectric),
                 pdf: p_dielectric * f,
                 specular: true,
                 transmitted: false,
@@ -571,13 +588,14 @@ impl Bsdf {
         })
     }
 
-    /// The share of the dielectric kept where it reflects `reflectance` (and transmits the rest
-    /// times kt): all of it unless with the other lobes' albedo (at most kd + ks + kr) it would
-    /// reflect more than all the light. A glass with a highlight (ks) reflecting totally inside
-    /// gained ks at every bounce there.
+    /// The share of the dielectric kept on the outside where it reflects `reflectance` (and
+    /// transmits the rest times kt): all of it unless with the other lobes' albedo (at most
+    /// kd + ks + kr) it would reflect more than all the light. Refraction keeps the outside's
+    /// share from either side: Fresnel's reflectance, and so this share, is the same at both
+    /// ends of a refracted pair.
     #[inline]
     fn dielectric_room(&self, reflectance: f32) -> f32 {
-        let others = (self.diffuse + self.glossy + self.mirror).max_element();
+        let others = self.reflection_bound;
         if others <= 0.0 {
             return 1.0;
         }
@@ -1095,14 +1113,7 @@ mod tests {
     /// ks at every such bounce, and photons trapped in a lens grew without bound).
     #[test]
     fn glass_with_a_highlight_conserves_energy_inside_and_out() {
-        let p = SurfaceParams {
-            specular: Vec3::splat(0.3),
-            shininess: 64.0,
-            transmissive: Vec3::splat(0.85),
-            index: 1.5,
-            ..SurfaceParams::default()
-        };
-        let lobes = Lobes::new(&p);
+        let lobes = Lobes::new(&highlighted_glass());
         for (wo, total_inside) in [
             (Vec3::new(0.0, 0.0, 1.0), false),
             (Vec3::new(0.6, 0.0, 0.8), false),
@@ -1114,10 +1125,81 @@ mod tests {
             let a = albedo(&bsdf, wo, 5);
             assert!(a <= 1.0 + 0.01, "{wo}: albedo {a}");
             if total_inside {
-                // Total reflection keeps the room the highlight leaves (kt's share, 0.74); the
-                // highlight adds what of it stays above the surface.
-                assert!(a > 0.8, "{wo}: albedo {a}");
+                // The highlight coats the outside only: total reflection inside loses nothing.
+                assert!((a - 1.0).abs() < 1e-6, "{wo}: albedo {a}");
             }
+        }
+    }
+
+    /// A course glass with a highlight whose colours sum above 1 (scaled to kt 0.74, ks 0.26).
+    fn highlighted_glass() -> SurfaceParams {
+        SurfaceParams {
+            specular: Vec3::splat(0.3),
+            shininess: 64.0,
+            transmissive: Vec3::splat(0.85),
+            index: 1.5,
+            ..SurfaceParams::default()
+        }
+    }
+
+    #[test]
+    fn a_dielectric_seen_from_inside_is_the_bare_interface() {
+        let p = SurfaceParams {
+            diffuse: Vec3::splat(0.2),
+            reflective: Vec3::splat(0.1),
+            ..highlighted_glass()
+        };
+        let lobes = Lobes::new(&p);
+        let wo = Vec3::new(0.3, 0.0, -0.954).normalize();
+        let inside = Bsdf::new(&lobes, Vec3::Z, Vec3::Z, wo, &RGB, None, None);
+        assert!(!inside.is_smooth(), "no diffuse or glossy lobe inside");
+        let up = Vec3::new(0.1, 0.2, -0.97).normalize();
+        assert_eq!(inside.eval(wo, up), Spectrum::ZERO);
+        assert_eq!(inside.pdf(wo, up), 0.0);
+        let outside = Bsdf::new(&lobes, Vec3::Z, Vec3::Z, -wo, &RGB, None, None);
+        assert!(outside.is_smooth(), "the coat's lobes act outside");
+        // Every sample inside is the dielectric's: reflection by Fresnel, refraction otherwise.
+        let mut rng = Rng::new(9, 0);
+        for _ in 0..1000 {
+            let s = inside
+                .sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)
+                .unwrap();
+            assert!(s.specular);
+        }
+    }
+
+    #[test]
+    fn refraction_through_a_coated_glass_is_the_same_both_ways() {
+        // Under importance transport a refracted pair carries the same weight in either
+        // direction (radiance differs by the η² the transport mode says); the coat's room
+        // is taken at the outside end both ways.
+        let p = SurfaceParams {
+            diffuse: Vec3::splat(0.1),
+            ..highlighted_glass()
+        };
+        let lobes = Lobes::new(&p);
+        // u_lobe just below 1 picks refraction (the dielectric is the last course lobe).
+        for wo in [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(0.6, 0.0, 0.8),
+            Vec3::new(0.97, 0.0, 0.243),
+        ] {
+            let wo = wo.normalize();
+            let out = Bsdf::new(&lobes, Vec3::Z, Vec3::Z, wo, &RGB, None, None);
+            let s = out
+                .sample(wo, 0.999_999, glam::Vec2::ZERO, Transport::Importance)
+                .unwrap();
+            assert!(s.transmitted);
+            // Back from inside along the refracted direction.
+            let inside = Bsdf::new(&lobes, Vec3::Z, Vec3::Z, s.wi, &RGB, None, None);
+            let t = inside
+                .sample(s.wi, 0.999_999, glam::Vec2::ZERO, Transport::Importance)
+                .unwrap();
+            assert!(t.transmitted && (t.wi - wo).length() < 1e-4, "{t:?}");
+            // Weight times the event's probability is the lobe's throughput, whatever the pick.
+            let (a, b) = (s.weight.x * s.pdf, t.weight.x * t.pdf);
+            assert!((a - b).abs() < 1e-5 * a.max(b), "{wo}: {a} outside in, {b} inside out");
+            assert!(a <= lobes.kt.x * (1.0 - fresnel_dielectric(wo.z, 1.5)) + 1e-6);
         }
     }
 

@@ -167,6 +167,9 @@ pub struct Lobes {
     /// The chance of picking each lobe: diffuse, glossy, mirror, dielectric (and the physical
     /// model's microfacet and diffuse transmission, none here).
     pub pick: [f32; 6],
+    /// A bound on the diffuse, glossy and mirror lobes' albedo together (the largest channel of
+    /// kd + ks + kr): the dielectric keeps only the room below 1 they leave.
+    pub reflection_bound: f32,
 }
 
 impl Lobes {
@@ -205,6 +208,7 @@ impl Lobes {
             exponent: params.shininess.max(0.0),
             index: if params.index > 0.0 { params.index } else { 1.0 },
             pick,
+            reflection_bound: (kd + ks + kr).max_element(),
         }
     }
 }

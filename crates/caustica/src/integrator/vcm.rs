@@ -313,8 +313,9 @@ pub struct Vcm<'a> {
     spectral: bool,
     /// Longest path in segments (eye to light).
     max_length: u32,
-    /// The first pass's merging radius in scene units.
-    radius: f32,
+    /// The settings' first merging radius in scene units: the pilots' (the focus cells are
+    /// twice it); the passes start from [`Balance::radius`].
+    pilot_radius: f32,
     /// Light subpaths in a full pass and the first pass's merging radius: the settings', or the
     /// balance pilot's on first use.
     balanced: std::sync::OnceLock<Balance>,
@@ -425,7 +426,7 @@ impl<'a> Vcm<'a> {
             spectral: settings_spectral(&settings.spectral, scene),
             // Segments: one more than the surfaces light may scatter at.
             max_length: super::config::scattering_surfaces(settings.max_depth).saturating_add(1),
-            radius,
+            pilot_radius: radius,
             balanced: match settings.light_paths_per_pass {
                 Some(count) => std::sync::OnceLock::from(Balance {
                     light_paths: count.max(1),
@@ -468,7 +469,7 @@ impl<'a> Vcm<'a> {
             }
             let start = std::time::Instant::now();
             let count = (self.pixels() as u64).clamp(MIN_PILOT_PATHS, MAX_DEFAULT_LIGHT_PATHS);
-            let f = Factors::new(self.radius, count as f32);
+            let f = Factors::new(self.pilot_radius, count as f32);
             let wl = pass_wavelengths(self.spectral, self.seed, PILOT_PASS);
             let paths = self.pilot_paths(PILOT_PASS, count, &f, &wl, false);
             let _ = self.pilot_seconds.set(start.elapsed().as_secs_f64() / count as f64);
@@ -478,7 +479,7 @@ impl<'a> Vcm<'a> {
                 .zip(&paths.merge_vertices)
                 .filter(|(_, v)| v.direct_caustic)
                 .map(|(p, v)| (*p, wl.to_rgb(v.throughput).max_element()));
-            CausticFocus::new(caustic, 2.0 * self.radius)
+            CausticFocus::new(caustic, 2.0 * self.pilot_radius)
         })
     }
 
@@ -514,7 +515,7 @@ impl<'a> Vcm<'a> {
         let pixels = self.pixels();
         let default = Balance {
             light_paths: default_light_paths(w, h),
-            radius: self.radius,
+            radius: self.pilot_radius,
         };
         if self.scene.lights().is_empty() || self.emitters.is_empty() {
             return default;
@@ -532,8 +533,8 @@ impl<'a> Vcm<'a> {
         // Every weight as in a pass of the default count; each half's light estimates scaled
         // up to stand for such a pass.
         let radius = match self.settings.balanced_footprint {
-            Some(px) => self.radius * px / MERGING_FOOTPRINT,
-            None => self.radius,
+            Some(px) => self.pilot_radius * px / MERGING_FOOTPRINT,
+            None => self.pilot_radius,
         };
         let f = Factors::new(radius, default.light_paths as f32);
         let wl = pass_wavelengths(self.spectral, self.seed, BALANCE_PASSES[0]);
