@@ -57,6 +57,10 @@ pub enum IntegratorHint {
     Path,
     /// Progressive photon mapping.
     Ppm,
+    /// A light tracer (particle tracer).
+    LightTracer,
+    /// A bidirectional method: vertex connection and merging stands for it.
+    Bidirectional,
 }
 
 /// A pinhole camera: the eye and the image plane it looks through. The plane's centre lies at

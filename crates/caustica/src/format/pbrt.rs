@@ -680,17 +680,22 @@ impl<'f> Reader<'f> {
         let params = self.params()?;
         let hint = match kind.text.as_str() {
             "sppm" => IntegratorHint::Ppm,
+            "lightpath" => IntegratorHint::LightTracer,
             "path" | "volpath" | "simplepath" | "simplevolpath" => IntegratorHint::Path,
-            other => {
+            "bdpt" | "mlt" => {
                 self.warn(
                     format!(
-                        "the {other} integrator is not in caustica{}: rendered with path",
-                        if matches!(other, "bdpt" | "mlt") {
-                            " (vcm will stand for it when it exists)"
-                        } else {
-                            ""
-                        }
+                        "the {} integrator is not in caustica: rendered with vcm, whose strategies include \
+                         bidirectional path tracing's and add photon merging (consistent, not unbiased)",
+                        kind.text
                     ),
+                    kind.span.clone(),
+                );
+                IntegratorHint::Bidirectional
+            }
+            other => {
+                self.warn(
+                    format!("the {other} integrator is not in caustica: rendered with path"),
                     kind.span.clone(),
                 );
                 IntegratorHint::Path

@@ -202,6 +202,8 @@ impl RenderConfig {
             config.model = Some(Model::Physical);
             config.integrator = Some(match hints.integrator {
                 Some(IntegratorHint::Ppm) => IntegratorKind::Ppm,
+                Some(IntegratorHint::LightTracer) => IntegratorKind::Lt,
+                Some(IntegratorHint::Bidirectional) => IntegratorKind::Vcm,
                 Some(IntegratorHint::Path) | None => IntegratorKind::Path,
             });
         }
@@ -512,6 +514,8 @@ mod tests {
         for (hint, kind) in [
             (IntegratorHint::Path, IntegratorKind::Path),
             (IntegratorHint::Ppm, IntegratorKind::Ppm),
+            (IntegratorHint::LightTracer, IntegratorKind::Lt),
+            (IntegratorHint::Bidirectional, IntegratorKind::Vcm),
         ] {
             let hints = |n| RenderHints {
                 physical: true,

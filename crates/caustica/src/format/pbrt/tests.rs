@@ -84,9 +84,19 @@ fn film_sampler_and_integrator_become_hints() {
     assert_eq!(hints.max_depth, Some(7));
     assert_eq!(hints.photons_per_pass, Some(5000));
     assert!(hints.physical);
-    let bdpt = read_text("Integrator \"bdpt\"\nWorldBegin\n").unwrap().description;
-    assert_eq!(bdpt.hints.integrator, Some(IntegratorHint::Path));
-    assert!(bdpt.warnings.iter().any(|(w, _)| w.contains("vcm")));
+    for (name, hint, warns) in [
+        ("bdpt", IntegratorHint::Bidirectional, true),
+        ("mlt", IntegratorHint::Bidirectional, true),
+        ("lightpath", IntegratorHint::LightTracer, false),
+        ("volpath", IntegratorHint::Path, false),
+        ("ambientocclusion", IntegratorHint::Path, true),
+    ] {
+        let desc = read_text(&format!("Integrator \"{name}\"\nWorldBegin\n"))
+            .unwrap()
+            .description;
+        assert_eq!(desc.hints.integrator, Some(hint), "{name}");
+        assert_eq!(!desc.warnings.is_empty(), warns, "{name}: {:?}", desc.warnings);
+    }
 }
 
 #[test]
