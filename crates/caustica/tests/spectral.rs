@@ -152,6 +152,8 @@ fn spectral_rendering_of_the_reference_scenes_matches_rgb() {
         let render = |spectral: bool| {
             let config = RenderConfig {
                 model: Some("physical".parse().unwrap()),
+                // Photon mapping: the tolerance was set on its noise at this budget.
+                integrator: Some("ppm".parse().unwrap()),
                 width: 160,
                 passes: Some("48".into()),
                 photons: 40_000,

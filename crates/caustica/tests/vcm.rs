@@ -360,6 +360,60 @@ fn vcm_merges_a_wall_lit_caustic_where_the_direct_one_is_traced() {
     vcm_against_light_tracing(WALL_LIT_BALL, &[true], 0.04, 48);
 }
 
+/// [`SPOT_BALL`] with the ball a coarse mesh (8 rings of 12 facets) whose shading normals are
+/// interpolated: light subpaths, like photons, carry flux with Veach's correction for such
+/// normals at every bounce: every lit block within 2% of light tracing (measured −0.6% to
+/// +0.8%; without the correction −2.8% to +3.8%, and a tumbler's caustic 1.7% of the whole
+/// image brighter than the photon tracer's).
+#[test]
+fn vcm_agrees_with_light_tracing_through_smooth_shaded_glass() {
+    let src = SPOT_BALL.replace(
+        "sphere { material = { transmissive = (1, 1, 1); index = 1.5; } }",
+        &smooth_shaded_ball(8, 12),
+    );
+    let images = vcm_against_light_tracing(&src, &[true], 0.01, 48);
+    for &i in &images.lit {
+        let (got, expected) = (images.vcm[0][i], images.reference[i]);
+        assert!(
+            rel(got, expected) < 0.02,
+            "block {:?}: vcm {got} against lt {expected}",
+            images.blocks[i]
+        );
+    }
+}
+
+/// A unit ball as a polymesh of `rings` × `segments` facets with generated vertex normals, in
+/// glass.
+fn smooth_shaded_ball(rings: usize, segments: usize) -> String {
+    let mut points = vec!["(0, 1, 0)".to_string()];
+    for r in 1..rings {
+        let theta = PI * r as f32 / rings as f32;
+        for k in 0..segments {
+            let phi = 2.0 * PI * k as f32 / segments as f32;
+            let (x, y, z) = (theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin());
+            points.push(format!("({x}, {y}, {z})"));
+        }
+    }
+    let bottom = points.len();
+    points.push("(0, -1, 0)".to_string());
+    let at = |r: usize, k: usize| 1 + (r - 1) * segments + k % segments;
+    let mut faces = Vec::new();
+    for k in 0..segments {
+        // Wound so the normals face outwards.
+        faces.push(format!("(0, {}, {})", at(1, k + 1), at(1, k)));
+        faces.push(format!("({bottom}, {}, {})", at(rings - 1, k), at(rings - 1, k + 1)));
+        for r in 1..rings - 1 {
+            faces.push(format!("({}, {}, {})", at(r, k), at(r, k + 1), at(r + 1, k + 1)));
+            faces.push(format!("({}, {}, {})", at(r, k), at(r + 1, k + 1), at(r + 1, k)));
+        }
+    }
+    format!(
+        "polymesh {{ material = {{ transmissive = (1, 1, 1); index = 1.5; }}; points = ({}); faces = ({}); gennormals; }}",
+        points.join(", "),
+        faces.join(", ")
+    )
+}
+
 /// [`SPOT_BALL`]'s camera and ball on a smaller floor (so that light tracing's photons, which
 /// a directional light sends over the whole scene, find the ball often enough), lit by `light`.
 fn ball_lit_by(light: &str) -> String {

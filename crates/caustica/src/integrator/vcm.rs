@@ -43,7 +43,7 @@ use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{radius_factor, InitialRadius};
 use super::tiles::shade_tiles;
 use super::Progressive;
-use crate::bsdf::{Bsdf, BsdfSample, Transport};
+use crate::bsdf::{adjoint_correction, Bsdf, BsdfSample, Transport};
 use crate::light::emission::caustic_targets;
 use crate::math::{Ray, Vec3};
 use crate::progress::Control;
@@ -772,6 +772,13 @@ impl<'a> Vcm<'a> {
                 // smooth one: no merging here.
                 partial.scatter(f, sample.pdf, bsdf.pdf_reverse(wo, sample.wi), cos_out, false);
             }
+            // Flux, as the photon tracer carries it: Veach's correction for interpolated
+            // normals (1 on flat geometry). Without it a caustic through smooth-shaded glass
+            // came out 1.7% brighter than the photon tracer's.
+            let Some(correction) = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi) else {
+                return;
+            };
+            let weight = sample.weight * correction;
             // The photon tracer's roulette keeps the subpath's power near its start, except
             // that a bounce towards a mirror or glass where bounces are aimed goes on with the
             // little it carries (the point of aiming it); a diffuse bounce after it brings the
@@ -779,14 +786,14 @@ impl<'a> Vcm<'a> {
             let q = if towards_target {
                 1.0
             } else if sample.specular {
-                sample.weight.max_element().min(1.0)
+                weight.max_element().min(1.0)
             } else {
-                (sample.weight.max_element() * (throughput.max_element() / start).min(1.0)).min(1.0)
+                (weight.max_element() * (throughput.max_element() / start).min(1.0)).min(1.0)
             };
             if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
                 return;
             }
-            throughput *= sample.weight / q;
+            throughput *= weight / q;
             if sample.dispersive {
                 wl.terminate_secondary(&mut throughput, &mut dispersed);
             }
