@@ -14,7 +14,7 @@ use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{RenderConfig, RenderSession};
 use caustica::loader::{load, LoadSettings};
 use caustica::scene::Scene;
-use common::control;
+use common::{control, uv_sphere};
 use glam::{Mat3, Quat, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -123,34 +123,6 @@ fn the_pbrt_glass_ball_focuses_the_sun() {
         red(sx) && !red(1.0 - sx),
         "the red box is drawn at x = {sx}, not mirrored"
     );
-}
-
-/// A UV sphere as Blender triangulates one: rings × segments, smooth normals.
-fn uv_sphere(radius: f32, rings: u32, segments: u32) -> (Vec<Vec3>, Vec<Vec3>, Vec<u16>) {
-    let mut points = vec![Vec3::new(0.0, radius, 0.0)];
-    for r in 1..rings {
-        let theta = std::f32::consts::PI * r as f32 / rings as f32;
-        for s in 0..segments {
-            let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
-            points.push(radius * Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin()));
-        }
-    }
-    points.push(Vec3::new(0.0, -radius, 0.0));
-    let bottom = (points.len() - 1) as u16;
-    let ring = |r: u32, s: u32| (1 + (r - 1) * segments + s % segments) as u16;
-    let mut indices = Vec::new();
-    for s in 0..segments {
-        indices.extend([0, ring(1, s), ring(1, s + 1)]);
-        indices.extend([bottom, ring(rings - 1, s + 1), ring(rings - 1, s)]);
-    }
-    for r in 1..rings - 1 {
-        for s in 0..segments {
-            let (a, b, c, d) = (ring(r, s), ring(r, s + 1), ring(r + 1, s), ring(r + 1, s + 1));
-            indices.extend([a, c, d, a, d, b]);
-        }
-    }
-    let normals = points.iter().map(|p| p.normalize()).collect();
-    (points, normals, indices)
 }
 
 /// The scene as Blender 4's exporter writes it to a .glb: Y up, a camera node with a rotation

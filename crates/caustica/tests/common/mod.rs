@@ -106,3 +106,31 @@ pub fn report(film: &Film, reference: &Film, regions: &[Region]) -> (f32, String
     }
     (worst, text)
 }
+
+/// A UV sphere as Blender triangulates one: rings × segments, smooth normals.
+pub fn uv_sphere(radius: f32, rings: u32, segments: u32) -> (Vec<glam::Vec3>, Vec<glam::Vec3>, Vec<u16>) {
+    let mut points = vec![glam::Vec3::new(0.0, radius, 0.0)];
+    for r in 1..rings {
+        let theta = std::f32::consts::PI * r as f32 / rings as f32;
+        for s in 0..segments {
+            let phi = 2.0 * std::f32::consts::PI * s as f32 / segments as f32;
+            points.push(radius * glam::Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin()));
+        }
+    }
+    points.push(glam::Vec3::new(0.0, -radius, 0.0));
+    let bottom = (points.len() - 1) as u16;
+    let ring = |r: u32, s: u32| (1 + (r - 1) * segments + s % segments) as u16;
+    let mut indices = Vec::new();
+    for s in 0..segments {
+        indices.extend([0, ring(1, s), ring(1, s + 1)]);
+        indices.extend([bottom, ring(rings - 1, s + 1), ring(rings - 1, s)]);
+    }
+    for r in 1..rings - 1 {
+        for s in 0..segments {
+            let (a, b, c, d) = (ring(r, s), ring(r, s + 1), ring(r + 1, s), ring(r + 1, s + 1));
+            indices.extend([a, c, d, a, d, b]);
+        }
+    }
+    let normals = points.iter().map(|p| p.normalize()).collect();
+    (points, normals, indices)
+}
