@@ -325,6 +325,18 @@ impl Bsdf {
         self.pick[0] > 0.0 || self.pick[1] > 0.0 || self.pick[4] > 0.0 || self.pick[5] > 0.0
     }
 
+    /// Whether every smooth lobe is narrow: a Phong lobe of exponent at least
+    /// [`SHARP_EXPONENT`] or a GGX lobe of α at most [`SHARP_ALPHA`], with no diffuse lobe. A
+    /// photon estimate there weighs each photon by a peaked f and is noisy; a direction drawn
+    /// from the lobe is not, so photon mapping's camera paths go on through such a surface.
+    #[inline]
+    pub fn is_sharply_glossy(&self) -> bool {
+        let no_diffuse = self.pick[0] == 0.0 && self.pick[5] == 0.0;
+        let phong_sharp = self.pick[1] == 0.0 || self.exponent >= SHARP_EXPONENT;
+        let ggx_sharp = self.pick[4] == 0.0 || self.microfacet.is_some_and(|m| m.alpha <= SHARP_ALPHA);
+        no_diffuse && phong_sharp && ggx_sharp && self.is_smooth()
+    }
+
     /// Whether light arriving on the far side reaches `wo` through a smooth lobe (diffuse
     /// transmission): photons on both faces count at such a point.
     #[inline]
@@ -620,6 +632,14 @@ impl Bsdf {
 
 /// Below this GGX α a surface is a perfect mirror.
 pub const SMOOTH_ALPHA: f32 = 1e-3;
+
+/// From this Phong exponent on, a lobe is sharp ([`Bsdf::is_sharply_glossy`]): its peak f is
+/// 16 times a white Lambertian surface's.
+pub const SHARP_EXPONENT: f32 = 30.0;
+
+/// The GGX α of about the same width as [`SHARP_EXPONENT`]'s lobe (α = √(2 / (n + 2)), Walter
+/// et al. 2007).
+pub const SHARP_ALPHA: f32 = 0.25;
 
 impl Microfacet {
     /// Trowbridge–Reitz (GGX) density of microfacet normals at cosine `cos_h` from `n`.

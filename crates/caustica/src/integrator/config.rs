@@ -314,6 +314,7 @@ impl RenderConfig {
                 max_depth: depth,
                 specular_camera_paths,
                 spectral: self.spectral,
+                ..PpmSettings::default()
             }),
             IntegratorKind::Gi => Integrator::Gi(GiSettings {
                 photons_per_pass,

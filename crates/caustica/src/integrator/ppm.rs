@@ -40,6 +40,11 @@ pub struct PpmSettings {
     /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
     /// through glass is black, as in a particle tracer's image — for comparing with one).
     pub specular_camera_paths: bool,
+    /// Follow camera rays through sharp highlights ([`Bsdf::is_sharply_glossy`]) instead of
+    /// gathering photons there (off: the peaked lobe weighs the photons, as before 2026-12-03).
+    ///
+    /// [`Bsdf::is_sharply_glossy`]: crate::bsdf::Bsdf::is_sharply_glossy
+    pub glossy_camera_paths: bool,
     /// Carry light at sampled wavelengths instead of RGB (`None`: when the scene has a
     /// dispersive glass).
     pub spectral: Option<bool>,
@@ -53,6 +58,7 @@ impl Default for PpmSettings {
             initial_radius: InitialRadius::Pixels(2.0),
             max_depth: 64,
             specular_camera_paths: true,
+            glossy_camera_paths: true,
             spectral: None,
         }
     }
@@ -135,21 +141,24 @@ impl<'a> Ppm<'a> {
     }
 
     /// Radiance along a camera ray with the photons of one pass: smooth lobes are counted in
-    /// full at the first smooth surface (next-event estimation and photons), only specular ones
-    /// continue the path.
+    /// full at the first smooth surface that is not sharply glossy (next-event estimation and
+    /// photons); specular lobes and sharp highlights continue the path.
     fn radiance(&self, map: &PhotonMap, ray: Ray, radius_factor: f32, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
         camera_chain(
             self.scene,
             ray,
             self.settings.max_depth,
-            self.settings.specular_camera_paths,
+            (self.settings.specular_camera_paths, self.settings.glossy_camera_paths),
             wl,
             rng,
-            |hit, bsdf, wo, path_length, dispersed, left, rng| {
+            |hit, bsdf, wo, path_length, dispersed, left, gather, rng| {
+                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
+                if !gather {
+                    return direct;
+                }
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
                 let min_left = needed_bounces_left(self.settings.max_depth, left);
-                direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
-                    + map.radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
+                direct + map.radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
             },
             |hit, sample, _, _, _, _| {
                 if self.mis {

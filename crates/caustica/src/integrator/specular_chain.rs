@@ -1,5 +1,5 @@
-//! The camera paths of the photon-mapping integrators: a camera ray followed through mirrors
-//! and glass to the smooth surfaces where photons are gathered.
+//! The camera paths of the photon-mapping integrators: a camera ray followed through mirrors,
+//! glass and (for `ppm`) sharp highlights to the smooth surfaces where photons are gathered.
 
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
@@ -18,19 +18,26 @@ use crate::spectrum::{Spectrum, Wavelengths};
 /// mirror or glass first stops there. A dispersive glass leaves the hero wavelength alone; both
 /// closures are told whether that happened (photons that dispersed too must then not count the
 /// hero's weight twice, see [`crate::photon::DISPERSED`]).
+///
+/// With `through_glossy` (and `through_specular`), a surface whose smooth lobes are all sharp
+/// ([`Bsdf::is_sharply_glossy`]: a glass's or a metal's highlight) does not gather photons:
+/// `at_smooth` is told so (its `gather` argument) and adds direct light only, and the path goes
+/// on in the direction its BSDF draws, glossy or specular, until the last depth. The light a
+/// photon estimate would weigh by the lobe's peak is then found at the next surface; what it
+/// loses is light that reached the highlight from a point lamp by mirrors or glass alone.
 #[allow(clippy::too_many_arguments)]
 pub fn camera_chain<S, B>(
     scene: &Scene,
     ray: Ray,
     max_depth: u32,
-    through_specular: bool,
+    (through_specular, through_glossy): (bool, bool),
     wl: &Wavelengths,
     rng: &mut Rng,
     mut at_smooth: S,
     mut beyond: B,
 ) -> Spectrum
 where
-    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, &mut Rng) -> Spectrum,
+    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum,
     B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum,
 {
     let mut ray = ray;
@@ -38,23 +45,34 @@ where
     let mut terminated = false;
     let mut l = Spectrum::ZERO;
     let mut path_length = 0.0f32;
+    // Set when the last surface's `beyond` already counted the light this ray reaches straight
+    // from an emitter (a path gone on through a glossy lobe).
+    let mut emission_counted = false;
     for depth in 0..=max_depth {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-            // Only the camera and specular chains get here: the sky counts in full.
-            l += beta * scene.lights().escaped(ray.dir, wl);
+            // Only the camera, specular and glossy chains get here: the sky counts in full.
+            if !emission_counted {
+                l += beta * scene.lights().escaped(ray.dir, wl);
+            }
             break;
         };
         let hit = scene.surface(&ray, &isect);
         path_length += isect.t;
         let wo = -ray.dir;
-        // Only the camera and specular chains reach here: emission counts in full.
-        l += beta * super::direct::emitted(scene, &hit, wl);
+        // Only the camera, specular and glossy chains reach here: emission counts in full.
+        if !emission_counted {
+            l += beta * super::direct::emitted(scene, &hit, wl);
+        }
+        emission_counted = false;
         let bsdf = Bsdf::at(scene, &hit, wo, wl);
         if bsdf.is_black() {
             break;
         }
+        let last = depth == max_depth || depth == 0 && !through_specular;
+        let goes_on_glossy = through_glossy && through_specular && !last && bsdf.is_sharply_glossy();
         if bsdf.is_smooth() {
-            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, max_depth - depth, rng);
+            let left = max_depth - depth;
+            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, left, !goes_on_glossy, rng);
         }
         let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
             break;
@@ -63,9 +81,12 @@ where
             // Even at the last depth: light that comes straight from an emitter has scattered
             // at this surface only (the BSDF half of its direct light).
             l += beta * beyond(&hit, &sample, path_length, terminated, max_depth - depth, rng);
-            break;
+            if !goes_on_glossy {
+                break;
+            }
+            emission_counted = true;
         }
-        if depth == max_depth || depth == 0 && !through_specular {
+        if last {
             break;
         }
         beta *= sample.weight;
