@@ -418,3 +418,49 @@ fn ppm_goes_on_through_sharp_highlights() {
     eprintln!("seed to seed: through the highlight {spread_through}, gathering there {spread_gathered}");
     assert!(spread_through < 0.5 * spread_gathered);
 }
+
+/// A glass ball focuses a point lamp onto a floor that is a sharp highlight only (Phong,
+/// exponent 50); the camera looks at the floor from the lamp's mirror side, so it sees the
+/// caustic in the highlight. Only photons find that light (the lamp is a point seen through
+/// glass): the highlight keeps the photons that came by mirrors and glass alone.
+const CAUSTIC_IN_A_HIGHLIGHT: &str = "SBT-raytracer 1.0
+camera { position = (1.66, 0, 2.5); viewdir = (-0.555, 0, -0.832); updir = (0, 1, 0); fov = 30; }
+point_light { position = (-2, 0, 3); color = (8, 8, 8); constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
+scale(20, square { material = { specular = (0.8, 0.8, 0.8); shininess = 50; } })
+translate(-1, 0, 1.5, scale(0.5, sphere { material = { transmissive = (1, 1, 1); index = 1.5; } }))
+";
+
+/// `ppm`, going on through the highlight, still sees the caustic in it: the caustic's
+/// reflection agrees with light tracing's within 5% (measured: 0.1%); with no photons gathered
+/// at the highlight it read 0.02% of it.
+#[test]
+fn ppm_keeps_a_caustic_seen_in_a_highlight() {
+    let s = scene(CAUSTIC_IN_A_HIGHLIGHT);
+    let size = 64;
+    let lt = LightTracer::new(
+        &s,
+        LtSettings {
+            photons_per_pass: 200_000,
+            ..LtSettings::default()
+        },
+        size,
+        size,
+        1,
+    );
+    let ppm = Ppm::new(
+        &s,
+        PpmSettings {
+            photons_per_pass: 200_000,
+            ..PpmSettings::default()
+        },
+        size,
+        size,
+        2,
+    );
+    let (rows, cols) = ((20, 43), (20, 43));
+    let expected = render_passes(&lt, size, size, 0, 64).film().region_mean(rows, cols);
+    let got = render_passes(&ppm, size, size, 0, 32).film().region_mean(rows, cols);
+    eprintln!("the caustic in the highlight: lt {expected:?}, ppm {got:?}");
+    assert!(expected.x > 0.01);
+    assert_close("the caustic in the highlight", got, expected, 0.05);
+}

@@ -144,7 +144,7 @@ impl<'a> Gi<'a> {
             (s.specular_camera_paths, false),
             wl,
             rng,
-            |hit, bsdf, wo, path_length, dispersed, left, _gather, rng| {
+            |hit, bsdf, wo, path_length, dispersed, left, _caustic_only, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
                 let min_left = needed_bounces_left(s.max_depth, left);
                 direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)

@@ -17,7 +17,7 @@ use super::Progressive;
 use crate::math::{Ray, Vec3};
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count;
-use crate::photon::{is_direct, needed_bounces_left};
+use crate::photon::{is_caustic, is_direct, needed_bounces_left, Photon};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -40,8 +40,9 @@ pub struct PpmSettings {
     /// Follow camera rays through mirrors and glass (off: what a camera sees by a mirror or
     /// through glass is black, as in a particle tracer's image — for comparing with one).
     pub specular_camera_paths: bool,
-    /// Follow camera rays through sharp highlights ([`Bsdf::is_sharply_glossy`]) instead of
-    /// gathering photons there (off: the peaked lobe weighs the photons, as before 2026-12-03).
+    /// Follow camera rays through sharp highlights ([`Bsdf::is_sharply_glossy`]), which then
+    /// gather only the photons that came by mirrors and glass alone (off: the paths end there
+    /// and the peaked lobe weighs every photon, as before 2026-12-03).
     ///
     /// [`Bsdf::is_sharply_glossy`]: crate::bsdf::Bsdf::is_sharply_glossy
     pub glossy_camera_paths: bool,
@@ -142,7 +143,8 @@ impl<'a> Ppm<'a> {
 
     /// Radiance along a camera ray with the photons of one pass: smooth lobes are counted in
     /// full at the first smooth surface that is not sharply glossy (next-event estimation and
-    /// photons); specular lobes and sharp highlights continue the path.
+    /// photons); specular lobes and sharp highlights continue the path, a highlight counting
+    /// direct light and the photons that reached it by mirrors and glass alone.
     fn radiance(&self, map: &PhotonMap, ray: Ray, radius_factor: f32, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
         camera_chain(
             self.scene,
@@ -151,14 +153,12 @@ impl<'a> Ppm<'a> {
             (self.settings.specular_camera_paths, self.settings.glossy_camera_paths),
             wl,
             rng,
-            |hit, bsdf, wo, path_length, dispersed, left, gather, rng| {
-                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
-                if !gather {
-                    return direct;
-                }
+            |hit, bsdf, wo, path_length, dispersed, left, caustic_only, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
                 let min_left = needed_bounces_left(self.settings.max_depth, left);
-                direct + map.radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
+                let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
+                direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
+                    + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
             },
             |hit, sample, _, _, _, _| {
                 if self.mis {

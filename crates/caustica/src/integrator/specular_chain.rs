@@ -19,12 +19,14 @@ use crate::spectrum::{Spectrum, Wavelengths};
 /// closures are told whether that happened (photons that dispersed too must then not count the
 /// hero's weight twice, see [`crate::photon::DISPERSED`]).
 ///
-/// With `through_glossy` (and `through_specular`), a surface whose smooth lobes are all sharp
-/// ([`Bsdf::is_sharply_glossy`]: a glass's or a metal's highlight) does not gather photons:
-/// `at_smooth` is told so (its `gather` argument) and adds direct light only, and the path goes
-/// on in the direction its BSDF draws, glossy or specular, until the last depth. The light a
-/// photon estimate would weigh by the lobe's peak is then found at the next surface; what it
-/// loses is light that reached the highlight from a point lamp by mirrors or glass alone.
+/// With `through_glossy` (and `through_specular`), at a surface whose smooth lobes are all
+/// sharp ([`Bsdf::is_sharply_glossy`]: a glass's or a metal's highlight) the path goes on in
+/// the direction its BSDF draws, glossy or specular, until the last depth, and `at_smooth` is
+/// told (its `caustic_only` argument) to gather only the photons that came by mirrors and glass
+/// alone (L S+): the light the path going on cannot find from a point lamp. What comes by a
+/// diffuse bounce, which a photon estimate would weigh by the lobe's peak, is found further
+/// along instead; emitters and the sky the path meets after going on through the glossy lobe
+/// count no more (the BSDF sample there and those photons have counted them).
 #[allow(clippy::too_many_arguments)]
 pub fn camera_chain<S, B>(
     scene: &Scene,
@@ -45,13 +47,14 @@ where
     let mut terminated = false;
     let mut l = Spectrum::ZERO;
     let mut path_length = 0.0f32;
-    // Set when the last surface's `beyond` already counted the light this ray reaches straight
-    // from an emitter (a path gone on through a glossy lobe).
-    let mut emission_counted = false;
+    // Set once the path has gone on through a highlight's glossy lobe: the emitters it meets
+    // from there on were counted by that surface's BSDF sample (straight on) or its caustic
+    // photons (by mirrors and glass). Not by its specular lobes, which no photon reaches.
+    let mut past_highlight = false;
     for depth in 0..=max_depth {
         let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-            // Only the camera, specular and glossy chains get here: the sky counts in full.
-            if !emission_counted {
+            // Only the camera and specular chains get here: the sky counts in full.
+            if !past_highlight {
                 l += beta * scene.lights().escaped(ray.dir, wl);
             }
             break;
@@ -59,11 +62,10 @@ where
         let hit = scene.surface(&ray, &isect);
         path_length += isect.t;
         let wo = -ray.dir;
-        // Only the camera, specular and glossy chains reach here: emission counts in full.
-        if !emission_counted {
+        // Only the camera and specular chains reach here: emission counts in full.
+        if !past_highlight {
             l += beta * super::direct::emitted(scene, &hit, wl);
         }
-        emission_counted = false;
         let bsdf = Bsdf::at(scene, &hit, wo, wl);
         if bsdf.is_black() {
             break;
@@ -72,7 +74,7 @@ where
         let goes_on_glossy = through_glossy && through_specular && !last && bsdf.is_sharply_glossy();
         if bsdf.is_smooth() {
             let left = max_depth - depth;
-            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, left, !goes_on_glossy, rng);
+            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, left, goes_on_glossy, rng);
         }
         let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
             break;
@@ -84,7 +86,7 @@ where
             if !goes_on_glossy {
                 break;
             }
-            emission_counted = true;
+            past_highlight = true;
         }
         if last {
             break;

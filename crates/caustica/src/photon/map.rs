@@ -401,6 +401,19 @@ impl PhotonMap {
         (r, min_left): (f32, u8),
         dispersed: bool,
     ) -> Spectrum {
+        self.radiance_within_of(point, bsdf, wo, (r, min_left), dispersed, |_| true)
+    }
+
+    /// [`PhotonMap::radiance_within`] from the photons `kept` says count.
+    pub fn radiance_within_of(
+        &self,
+        point: Vec3,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        (r, min_left): (f32, u8),
+        dispersed: bool,
+        kept: impl Fn(&Photon) -> bool,
+    ) -> Spectrum {
         if self.photons.is_empty() || r.is_nan() || r <= 0.0 {
             return Spectrum::ZERO;
         }
@@ -408,7 +421,10 @@ impl PhotonMap {
         let mut sum = Spectrum::ZERO;
         self.tree.for_each_within(&self.photons, point, r * r, |slot, _| {
             let photon = &self.photons[slot as usize];
-            if photon.bounces_left() >= min_left && accepts(photon, point, n, r, bsdf.transmits_smoothly()) {
+            if photon.bounces_left() >= min_left
+                && accepts(photon, point, n, r, bsdf.transmits_smoothly())
+                && kept(photon)
+            {
                 sum += bsdf.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
             }
         });
