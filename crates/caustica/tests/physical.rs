@@ -143,32 +143,35 @@ fn photons_see_shading_normals_as_camera_paths_do() {
     let size = 32;
     let path = PathTracer::new(&s, PathSettings::default(), size, size, 3);
     let reference = mean(&render_passes(&path, size, size, 0, 1024).film());
-    let lt = LightTracer::new(
-        &s,
-        LtSettings {
-            photons_per_pass: 100_000,
-            ..LtSettings::default()
-        },
-        size,
-        size,
-        4,
-    );
-    let ppm = Ppm::new(
-        &s,
-        PpmSettings {
-            photons_per_pass: 50_000,
-            ..PpmSettings::default()
-        },
-        size,
-        size,
-        5,
-    );
+    let (lt, ppm) = lt_and_ppm(&s, size, (100_000, 50_000), (4, 5));
     let lt = mean(&render_passes(&lt, size, size, 0, 16).film());
     let ppm = mean(&render_passes(&ppm, size, size, 0, 16).film());
     eprintln!("floor: path {reference:?}, lt {lt:?}, ppm {ppm:?}");
     assert!(reference.x > 0.0);
     assert_close("lt", lt, reference, 0.02);
     assert_close("ppm", ppm, reference, 0.02);
+}
+
+/// A light tracer and a `ppm` renderer of `s` at `size`², with default settings but their
+/// photons a pass and seeds.
+fn lt_and_ppm<'a>(
+    s: &'a caustica::scene::Scene,
+    size: usize,
+    (lt_photons, ppm_photons): (u64, u64),
+    (lt_seed, ppm_seed): (u64, u64),
+) -> (LightTracer<'a>, Ppm<'a>) {
+    let lt_settings = LtSettings {
+        photons_per_pass: lt_photons,
+        ..LtSettings::default()
+    };
+    let ppm_settings = PpmSettings {
+        photons_per_pass: ppm_photons,
+        ..PpmSettings::default()
+    };
+    (
+        LightTracer::new(s, lt_settings, size, size, lt_seed),
+        Ppm::new(s, ppm_settings, size, size, ppm_seed),
+    )
 }
 
 /// Regions of the reference README (rows, columns inclusive), plus a shadow on the floor
@@ -437,26 +440,7 @@ translate(-1, 0, 1.5, scale(0.5, sphere { material = { transmissive = (1, 1, 1);
 fn ppm_keeps_a_caustic_seen_in_a_highlight() {
     let s = scene(CAUSTIC_IN_A_HIGHLIGHT);
     let size = 64;
-    let lt = LightTracer::new(
-        &s,
-        LtSettings {
-            photons_per_pass: 200_000,
-            ..LtSettings::default()
-        },
-        size,
-        size,
-        1,
-    );
-    let ppm = Ppm::new(
-        &s,
-        PpmSettings {
-            photons_per_pass: 200_000,
-            ..PpmSettings::default()
-        },
-        size,
-        size,
-        2,
-    );
+    let (lt, ppm) = lt_and_ppm(&s, size, (200_000, 200_000), (1, 2));
     let (rows, cols) = ((20, 43), (20, 43));
     let expected = render_passes(&lt, size, size, 0, 64).film().region_mean(rows, cols);
     let got = render_passes(&ppm, size, size, 0, 32).film().region_mean(rows, cols);
