@@ -73,6 +73,8 @@ class SceneError(ValueError):
     column: int
     reason: str
     help: str | None
+    excerpt: str
+    """The line around the place (a window of it when it is long) with a caret under it."""
 
 class InternalError(RuntimeError):
     """A bug in caustica (a Rust panic caught before it reached Python)."""

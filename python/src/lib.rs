@@ -13,7 +13,8 @@ mod photons;
 mod progressive;
 mod scene;
 
-use caustica::error::{line_col, Error};
+use caustica::diagnostic::Diagnostic;
+use caustica::error::Error;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
@@ -107,19 +108,24 @@ fn internal(panic: Box<dyn Any + Send>) -> PyErr {
 /// The library's error as the Python exception that fits it.
 pub(crate) fn to_py(py: Python<'_>, error: Error) -> PyErr {
     match error {
-        Error::Scene { path, text, error } => {
-            let (line, column) = line_col(&text, error.span.start);
-            let mut message = format!("{}:{line}:{column}: {}", path.display(), error.message);
-            if let Some(help) = &error.help {
+        Error::Scene { .. } => {
+            let d = Diagnostic::new(&error);
+            let Some(at) = &d.excerpt else {
+                return SceneError::new_err(d.headline());
+            };
+            let mut message = d.headline();
+            if let Some(help) = &d.help {
                 message.push_str(&format!("\nhelp: {help}"));
             }
             let err = SceneError::new_err(message);
             let value = err.value(py);
-            let _ = value.setattr("path", path.display().to_string());
-            let _ = value.setattr("line", line);
-            let _ = value.setattr("column", column);
-            let _ = value.setattr("reason", error.message);
-            let _ = value.setattr("help", error.help);
+            let _ = value.setattr("path", d.path.clone());
+            let _ = value.setattr("line", at.line);
+            let _ = value.setattr("column", at.column);
+            let _ = value.setattr("reason", d.message.clone());
+            let _ = value.setattr("help", d.help.clone());
+            // The line around the place, a window of it if it is long, with a caret under it.
+            let _ = value.setattr("excerpt", at.render());
             err
         }
         Error::InvalidSettings(message) => PyValueError::new_err(python_names(&message)),

@@ -107,3 +107,20 @@ def test_a_damaged_partial_file_is_refused(tmp_path):
     with pytest.raises(ValueError, match="no partial files"):
         caustica.merge([])
     assert not np.any([p.name.endswith(".tmp") for p in tmp_path.iterdir()])
+
+
+def test_an_error_far_along_one_long_line_shows_a_window_of_it(tmp_path):
+    # A glTF written on one line, cut short 200,000 characters in: its error lies past any
+    # column a report could pad to, and the excerpt must be a window, not the whole line.
+    body = '{"asset":{"version":"2.0","extras":{"note":"' + "x" * 200_000 + '"}},"scenes":[{"nodes":[0'
+    path = tmp_path / "cut.gltf"
+    path.write_text(body)
+    with pytest.raises(caustica.SceneError) as info:
+        caustica.Scene(path)
+    error = info.value
+    assert error.line == 1 and error.column > 200_000
+    assert str(error).startswith(f"{path}:1:{error.column}: ")
+    lines = error.excerpt.splitlines()
+    assert len(lines) == 3 and all(len(line) < 200 for line in lines)
+    assert "…" in lines[1] and "^" in lines[2]
+    assert len(str(error)) < 1000

@@ -20,8 +20,20 @@ pub const EXIT_INTERRUPTED: u8 = 130;
 pub const EXIT_INTERNAL: u8 = 1;
 
 fn main() -> ExitCode {
+    diagnostics::on_panic_exit(EXIT_INTERNAL);
     let cli = cli::Cli::parse();
+    if std::env::var_os("CAUSTICA_TEST_PANIC").is_some() {
+        // A deliberate bug on a worker thread, for the test of the exit codes.
+        rayon::join(|| panic!("CAUSTICA_TEST_PANIC is set"), || ());
+    }
     let cancel = interrupt::install();
+    let json = match &cli.command {
+        cli::Command::Render(args) => args.json,
+        cli::Command::Info(args) => args.json,
+        cli::Command::Photons(args) => args.json,
+        cli::Command::Compare(args) => args.json,
+        cli::Command::Bench(_) | cli::Command::Merge(_) => false,
+    };
     let result = match cli.command {
         cli::Command::Render(args) => commands::render::run(*args, cancel),
         cli::Command::Info(args) => commands::info::run(args),
@@ -35,13 +47,12 @@ fn main() -> ExitCode {
         // The reader of our output went away (`| head`): what it wanted was printed.
         Err(error) if stdout::is_closed_pipe(&error) => ExitCode::SUCCESS,
         Err(error) => {
-            let code = if error.is_bad_input() {
+            diagnostics::print(&error, json);
+            ExitCode::from(if error.is_bad_input() {
                 EXIT_BAD_INPUT
             } else {
                 EXIT_INTERNAL
-            };
-            eprintln!("{:?}", diagnostics::report(error));
-            ExitCode::from(code)
+            })
         }
     }
 }

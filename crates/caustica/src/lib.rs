@@ -13,6 +13,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod description;
+pub mod diagnostic;
 pub mod error;
 pub mod film;
 pub mod format;

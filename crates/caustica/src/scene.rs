@@ -219,7 +219,12 @@ impl Scene {
             meshes,
             triangles,
             triangle_refs,
-            warnings,
+            // A warning quoting a huge token is cut to a readable length here, once for every
+            // front end.
+            warnings: warnings
+                .iter()
+                .map(|w| crate::diagnostic::shorten(w).into_owned())
+                .collect(),
             hints,
             shape_bvh,
             triangle_bvh,
