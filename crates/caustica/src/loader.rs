@@ -3,6 +3,7 @@
 
 use crate::error::{ParseError, Result};
 use crate::format::{self, ReadOptions, SceneSource};
+use crate::integrator::darkness;
 use crate::presets;
 use crate::progress::{NoProgress, Progress};
 use crate::scene::{BuildSettings, Scene};
@@ -75,12 +76,12 @@ pub fn load(path: &Path, settings: &LoadSettings) -> Result<Scene> {
 }
 
 /// Builds a scene read with `settings`; when the dialect was detected rather than forced and
-/// the course render would come out black only because point or spot lights without
-/// coefficients fall off as 1/d² (the UT reading), the file is read again with the HKUST
-/// COMP 4411 defaults (no falloff), and that reading is kept if the file is valid there and it
-/// is not black. The same file can be a UT or an HKUST scene (stock samples are shared), so this
-/// is the one case where the text cannot choose; a warning says which reading was taken.
-/// Returns the source the scene was built from.
+/// the course render would come out black or nearly black (no probe reaches 5 % of white,
+/// [`darkness::NEARLY_BLACK`]) because point or spot lights fall off as 1/d² (the UT reading),
+/// the file is read again with the HKUST COMP 4411 defaults (no falloff), and that reading is
+/// kept if the file is valid there and it is not nearly black. The same file can be a UT or an
+/// HKUST scene (stock samples are shared), so this is the one case where the text cannot
+/// choose; a warning says which reading was taken. Returns the source the scene was built from.
 pub fn build_detected(
     source: SceneSource,
     settings: &LoadSettings,
@@ -93,10 +94,7 @@ pub fn build_detected(
     if settings.read.ray.dialect.is_some() || settings.read.format_of(&source.path) != format::Format::Ray {
         return Ok((source, scene));
     }
-    let Some(dark) = crate::integrator::darkness::darkness(&scene) else {
-        return Ok((source, scene));
-    };
-    if !dark.falloff {
+    if !darkness::dimmed_by_falloff(&scene) {
         return Ok((source, scene));
     }
     let mut options = settings.read.clone();
@@ -109,12 +107,12 @@ pub fn build_detected(
         return Ok((source, scene));
     };
     again.description.warnings.push((
-        "read with the HKUST COMP 4411 defaults (point lights without attenuation coefficients do not fall off): with the UT falloff 1/d² the image would be black; --dialect tokenizer or dictionary keeps that reading".into(),
+        "read with the HKUST COMP 4411 defaults (point lights without attenuation coefficients do not fall off): with the UT falloff 1/d² the image would be black or nearly so; --dialect tokenizer or dictionary keeps that reading".into(),
         0..0,
     ));
     locate_warnings(&mut again);
     match build_source_ref(&again, &settings.build, &NoProgress) {
-        Ok(hkust) if crate::integrator::darkness::darkness(&hkust).is_none() => Ok((again, hkust)),
+        Ok(hkust) if !darkness::nearly_black(&hkust) => Ok((again, hkust)),
         _ => Ok((source, scene)),
     }
 }
@@ -256,6 +254,62 @@ polymesh { points = ((0,0,0), (1,0,0), (0,1,0), (2,0,0)); faces = ((0,1,2), (0,1
             let total = text.len() as u64;
             assert_eq!(phases, [("parse".to_string(), total, total, true)], "{dialect:?}");
         }
+    }
+
+    /// A file both readers accept, its floor lit by a light 5 units above it: with the UT
+    /// falloff it keeps 1/25 of the light's colour there.
+    fn ambiguous(color: f32) -> String {
+        format!(
+            "SBT-raytracer 1.0
+camera {{ position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); }}
+point_light {{ position = (0, 0, 3); color = ({color}, {color}, {color}); }}
+translate(0, 0, -2, scale(20, square {{ material = {{ diffuse = (0.8, 0.8, 0.8); }} }}))
+"
+        )
+    }
+
+    fn load_ambiguous(color: f32) -> (SceneSource, Scene) {
+        let settings = LoadSettings::default();
+        let source = format::read_text(
+            Path::new("a.ray"),
+            ambiguous(color),
+            Path::new("."),
+            &settings.read,
+            &NoProgress,
+        )
+        .unwrap();
+        build_detected(source, &settings, &NoProgress).unwrap()
+    }
+
+    fn point_falloff(scene: &Scene) -> [f32; 3] {
+        match scene.lights().course_lights().next() {
+            Some(crate::light::Light::Point { attenuation, .. }) => *attenuation,
+            other => panic!("{other:?}"),
+        }
+    }
+
+    /// UT reading: 0.8/25 = 3.2 % of white at best, nearly black: read the HKUST way instead.
+    #[test]
+    fn a_nearly_black_ut_reading_is_read_the_hkust_way() {
+        let (source, scene) = load_ambiguous(1.0);
+        assert_eq!(point_falloff(&scene), [1.0, 0.0, 0.0]);
+        assert!(
+            source
+                .description
+                .warnings
+                .iter()
+                .any(|(w, _)| w.starts_with("read with the HKUST")),
+            "{:?}",
+            source.description.warnings
+        );
+    }
+
+    /// UT reading: 2 × 0.8/25 = 6.4 % of white, dim but above the threshold: kept.
+    #[test]
+    fn a_dim_ut_reading_above_the_threshold_is_kept() {
+        let (source, scene) = load_ambiguous(2.0);
+        assert_eq!(point_falloff(&scene), [0.0, 0.0, 1.0]);
+        assert!(source.description.warnings.iter().all(|(w, _)| !w.contains("HKUST")));
     }
 
     #[test]

@@ -12,6 +12,7 @@ mod fork_shapes;
 mod keywords;
 mod lexer;
 mod named_materials;
+mod quadric;
 mod skybox;
 mod suggest;
 mod tokenizer_dialect;

@@ -41,9 +41,11 @@ pub(crate) fn markers(text: &str) -> Markers {
             }
             Tok::Word => match (source, next) {
                 // Spellings only HKUST forks use (their spot and Warn lights, metaballs).
-                ("quaternion" | "focaldistance" | "central_direction" | "warn_light" | "metaballs", _) => {
-                    found.dictionary += 1
-                }
+                (
+                    "quaternion" | "focaldistance" | "central_direction" | "warn_light" | "warn_model_light"
+                    | "metaballs",
+                    _,
+                ) => found.dictionary += 1,
                 ("blend", Some(Tok::Equals)) => found.dictionary += 1,
                 ("texture", Some(Tok::Equals)) if tokens.get(i + 2).map(|t| t.tok) == Some(Tok::Quoted) => {
                     found.dictionary += 1
@@ -52,6 +54,8 @@ pub(crate) fn markers(text: &str) -> Markers {
                 ("gennormals", Some(Tok::Equals)) => found.dictionary += 1,
                 ("gennormals", Some(Tok::Semicolon)) => found.tokenizer += 1,
                 ("material", Some(Tok::LBrace)) if depth == 0 => found.dictionary += 1,
+                // The HKUST team fork's CSG block.
+                ("csg", Some(Tok::LBrace)) if depth == 0 => found.dictionary += 1,
                 ("material", Some(Tok::Equals)) if depth == 0 => found.tokenizer += 1,
                 // HKUST textures: `diffuse = "file.bmp"`.
                 (field, Some(Tok::Equals))
@@ -82,8 +86,8 @@ pub(crate) fn markers(text: &str) -> Markers {
 /// Dialect T is tried first unless the file has dialect-O markers and no dialect-T ones. When
 /// dialect T fails, dialect O is only taken if the file has O markers, or if T stopped at a key
 /// that O ignores and that is no misspelling of a known field (e.g. `focaldistance`). When both
-/// readers fail, a student-extension error wins, then the error of the marked dialect, then the
-/// one found further into the file (dialect T on a tie).
+/// readers fail, a student-extension error (one used where it cannot be skipped) wins, then the
+/// error of the marked dialect, then the one found further into the file (dialect T on a tie).
 pub(crate) fn parse_auto(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<RayScene, ParseError> {
     let found = markers(text);
     let o_first = found.dictionary > 0 && found.tokenizer == 0;
@@ -128,7 +132,7 @@ pub(crate) fn parse_auto(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Res
 
 /// The more useful of the two readers' errors.
 fn choose(t_error: ParseError, o_error: ParseError, o_marked: bool) -> ParseError {
-    // Both readers reject student extensions, so naming the extension is the best answer.
+    // An extension named where neither reader can skip it (as a value) is the best answer.
     let o_wins = is_extension_error(&o_error) || o_marked || o_error.span.start > t_error.span.start;
     if is_extension_error(&t_error) || !o_wins {
         t_error

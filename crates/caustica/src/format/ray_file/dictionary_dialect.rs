@@ -10,9 +10,10 @@ use super::ast::{
 use super::cursor::{Cursor, Reach};
 use super::fork_lights::{self, LightFields};
 use super::fork_shapes::{self, MetaballFields};
-use super::keywords::{extension_error, COLOUR_FIELDS, TOP_LEVEL};
+use super::keywords::{extension_error, is_extension, skipped_object, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok};
 use super::named_materials::NamedMaterials;
+use super::quadric;
 use super::skybox::{SkyboxFields, SKYBOX_FIELDS};
 use super::suggest;
 use super::tokenizer_dialect::field_mut;
@@ -276,6 +277,7 @@ impl<'a> Reader<'a> {
             "directional_light" => self.directional_light(child, head),
             "spot_light" => self.fork_light(child, head, fork_lights::SPOT_FIELDS),
             "area_light" => self.fork_light(child, head, fork_lights::AREA_FIELDS),
+            "warn_light" | "warn_model_light" => self.fork_light(child, head, fork_lights::WARN_FIELDS),
             "skybox" => self.skybox(child, head),
             "csg" => self.csg_block(child, head),
             "ambient_light" => {
@@ -309,15 +311,15 @@ impl<'a> Reader<'a> {
         }
     }
 
-    /// An unknown key: a student extension is an error, anything else a warning.
+    /// An unknown key, ignored with a warning (which names a student extension as one).
     fn ignore_key(&mut self, key: &Span, owner: &str) -> Result<(), ParseError> {
         let word = self.word(key);
-        if let Some(error) = extension_error(word, key) {
-            return Err(error);
-        }
-        self.scene
-            .warnings
-            .push((format!("{IGNORED_KEY} `{word}` in `{owner}`"), key.clone()));
+        let message = if is_extension(word) {
+            format!("{IGNORED_KEY} `{word}` in `{owner}`: a student extension of the course format that caustica does not read")
+        } else {
+            format!("{IGNORED_KEY} `{word}` in `{owner}`")
+        };
+        self.scene.warnings.push((message, key.clone()));
         Ok(())
     }
 
@@ -450,8 +452,8 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// `spot_light { … }` or `area_light { … }` in any course fork's spelling; other keys are
-    /// ignored with a warning, as the dictionary reader does.
+    /// `spot_light`, `area_light`, `warn_light` or `warn_model_light { … }` in any course fork's
+    /// spelling; other keys are ignored with a warning, as the dictionary reader does.
     fn fork_light(&mut self, id: usize, head: Span, allowed: &'static [&'static str]) -> Result<(), ParseError> {
         let owner = self.word(&head);
         let mut fields = LightFields::default();
@@ -472,12 +474,18 @@ impl<'a> Reader<'a> {
         }
         let span = head.start..self.tree[id].span.end;
         let falloff = if self.hkust { [1.0, 0.0, 0.0] } else { [0.0, 0.0, 1.0] };
-        let light = if owner == "spot_light" {
-            let (light, warnings) = fields.spot(span, falloff, self.hkust)?;
-            self.scene.warnings.extend(warnings);
-            light
-        } else {
-            fields.area(span, falloff, self.hkust)?
+        let light = match owner {
+            "spot_light" => {
+                let (light, warnings) = fields.spot(span, falloff, self.hkust)?;
+                self.scene.warnings.extend(warnings);
+                light
+            }
+            "area_light" => fields.area(span, falloff, self.hkust)?,
+            warn => {
+                let (light, warnings) = fields.warn(warn, span, falloff, self.hkust)?;
+                self.scene.warnings.extend(warnings);
+                light
+            }
         };
         self.scene.lights.push(light);
         Ok(())
@@ -548,6 +556,21 @@ impl<'a> Reader<'a> {
                         _ => return Err(self.expected("a material name", value)),
                     });
                 }
+                // An HKUST fork's procedural marble: its base colour stands in for it.
+                _ if COLOUR_FIELDS.contains(&word) && self.is_named(value, "marble") => {
+                    let color = self.marble_color(value)?;
+                    let message = match color {
+                        Some(color) => {
+                            *field_mut(&mut material, word) = Param::Constant(color);
+                            format!("the procedural `marble` texture of `{word}` is not modelled: its `color` is used")
+                        }
+                        None => {
+                            format!("the procedural `marble` texture of `{word}` is not modelled: `{word}` is unset")
+                        }
+                    };
+                    has_reflective |= word == "reflective";
+                    self.scene.warnings.push((message, self.tree[value].span.clone()));
+                }
                 _ if COLOUR_FIELDS.contains(&word) || word == "shininess" || word == "index" => {
                     let mut param = self.param(value, word)?;
                     if word == "shininess" {
@@ -570,6 +593,23 @@ impl<'a> Reader<'a> {
             material.reflective = material.specular.clone();
         }
         Ok(material)
+    }
+
+    /// The `color` of a `marble { … }` value, if it gives one.
+    fn marble_color(&self, id: usize) -> Result<Option<Vec3>, ParseError> {
+        let Kind::Named(body) = self.tree[id].kind else {
+            return Ok(None);
+        };
+        let entries = self.entries(body, "marble")?;
+        match entries.iter().find(|(k, _)| matches!(self.word(k), "color" | "colour")) {
+            Some(&(_, color)) => Ok(Some(self.vec3(color, "for the marble's `color`")?)),
+            None => Ok(None),
+        }
+    }
+
+    /// Whether node `id` is the named object `word { … }`.
+    fn is_named(&self, id: usize, word: &str) -> bool {
+        matches!(self.tree[id].kind, Kind::Named(_)) && self.word(&self.tree[id].head) == word
     }
 
     /// A colour or scalar: `(r, g, b)`, a number, `map("file")` or a bare `"file"` string.
@@ -652,8 +692,20 @@ impl<'a> Reader<'a> {
                     }
                     (transform_stack::from_rows(rows, &span)?, items[4])
                 }
-                "sphere" | "box" | "square" | "cylinder" | "cone" | "torus" | "metaballs" | "metaball" | "trimesh"
-                | "polymesh" => {
+                "sphere"
+                | "box"
+                | "square"
+                | "cylinder"
+                | "cone"
+                | "torus"
+                | "metaballs"
+                | "metaball"
+                | "trimesh"
+                | "polymesh"
+                | "quadric"
+                | "hyperboloid"
+                | "hyperbolic_paraboloid"
+                | "paraboloid" => {
                     return self.primitive(word, head, child, world);
                 }
                 // `subtraction(a, b)`, `intersection(a, b)`, `union(a, b, …)` (HKUST 2019).
@@ -669,14 +721,23 @@ impl<'a> Reader<'a> {
                     return Ok(());
                 }
                 _ => {
-                    if let Some(error) = extension_error(word, &head) {
-                        return Err(error);
+                    let error = ParseError::new(format!("unknown object `{word}`"), head.clone());
+                    if let Some(near) =
+                        suggest::nearest(word, TOP_LEVEL.iter().copied()).filter(|_| !is_extension(word))
+                    {
+                        return Err(error.with_help(suggest::did_you_mean(near)));
                     }
-                    let error = ParseError::new(format!("unknown object `{word}`"), head);
-                    return Err(match suggest::nearest(word, TOP_LEVEL.iter().copied()) {
-                        Some(near) => error.with_help(suggest::did_you_mean(near)),
-                        None => error,
-                    });
+                    // Another fork's object: the rest of the scene is read without it.
+                    let what = format!(
+                        "{word} {}",
+                        if matches!(self.tree[child].kind, Kind::Dict(_)) {
+                            "{ … }"
+                        } else {
+                            "( … )"
+                        }
+                    );
+                    self.scene.warnings.push((skipped_object(word, &what), span));
+                    return Ok(());
                 }
             };
             world = transform_stack::compose(world, local, &span)?;
@@ -722,12 +783,30 @@ impl<'a> Reader<'a> {
                 name => named.push((name, *value)),
             }
         }
-        let operation = operation.ok_or_else(|| {
-            ParseError::new(
-                "`csg` needs an `operation` such as `(\"a\", \"sub\", \"b\")`",
-                span.clone(),
-            )
-        })?;
+        let Some(operation) = operation else {
+            // Without an operation the operands are still solids of the scene: their union.
+            let start = self.scene.objects.len();
+            for &(_, object) in &named {
+                self.object_at(object, Mat4::IDENTITY, 1)?;
+            }
+            let objects: Vec<ObjectDesc> = self.scene.objects.drain(start..).collect();
+            let count = objects.len();
+            if count > 1 {
+                let union = fork_shapes::csg_object(
+                    crate::description::CsgOpDesc::Union,
+                    objects.into_iter().map(|o| vec![o]).collect(),
+                    span.clone(),
+                )?;
+                self.scene.objects.push(union);
+            } else {
+                self.scene.objects.extend(objects);
+            }
+            self.scene.warnings.push((
+                format!("`csg` has no `operation` (such as `(\"a\", \"sub\", \"b\")`): its {count} operand(s) are drawn as their union"),
+                span,
+            ));
+            return Ok(());
+        };
         let object = self.csg_operation(operation, &named, 0)?;
         self.scene.objects.push(object);
         Ok(())
@@ -817,6 +896,7 @@ impl<'a> Reader<'a> {
         let blobby = kind.starts_with("metaball");
         let mut mesh = MeshInput::default();
         let is_mesh = kind == "trimesh" || kind == "polymesh";
+        let mut coefficients = quadric::named(kind);
         for (key, value) in self.entries(id, kind)? {
             let word = self.word(&key);
             match word {
@@ -895,6 +975,21 @@ impl<'a> Reader<'a> {
                     mesh.materials = Some((list, self.tree[value].span.clone()));
                 }
                 "gennormals" if is_mesh => mesh.gennormals = self.boolean(value, "for `gennormals`")?,
+                "points" if kind == "quadric" => {
+                    let mut pairs = Vec::new();
+                    for item in self.list(value, word)? {
+                        pairs.push(self.tuple::<2>(item, "in the quadric's `points`")?);
+                    }
+                    coefficients = Some(quadric::from_pairs(&pairs).ok_or_else(|| {
+                        ParseError::new(
+                            format!(
+                                "a quadric's `points` are its ten coefficients A…J as five pairs ((A, B), (C, D), (E, F), (G, H), (I, J)), not {} pairs",
+                                pairs.len()
+                            ),
+                            self.tree[value].span.clone(),
+                        )
+                    })?);
+                }
                 _ => self.ignore_key(&key, kind)?,
             }
         }
@@ -907,7 +1002,26 @@ impl<'a> Reader<'a> {
                 major_radius: major,
                 minor_radius: minor,
             },
-            "metaballs" | "metaball" => blobs.finish(kind, &(head.start..self.tree[id].span.end))?,
+            "metaballs" | "metaball" => {
+                let block = head.start..self.tree[id].span.end;
+                match blobs.finish(kind, &block, &mut self.scene.warnings)? {
+                    Some(shape) => shape,
+                    None => return Ok(()),
+                }
+            }
+            _ if coefficients.is_some() => {
+                let block = head.start..self.tree[id].span.end;
+                match quadric::tessellate(&coefficients.expect("a quadric")) {
+                    Some(mesh) => ShapeDesc::Trimesh(Box::new(mesh)),
+                    None => {
+                        self.scene.warnings.push((
+                            format!("the `{kind}` has no surface inside the cube [-1, 1]³ it is bounded by; nothing is drawn"),
+                            block,
+                        ));
+                        return Ok(());
+                    }
+                }
+            }
             "cone" => ShapeDesc::Cone {
                 height,
                 bottom_radius: bottom,

@@ -11,6 +11,17 @@
 //! - `inner` and `outer` (half-angles, degrees): HKUST 2020 (Alsctiho/Comp4411-Trace), and
 //!   caustica's own spelling; `exponent` adds a cos^e falloff.
 //!
+//! Warn lights, spot lights whose brightness falls off as cos^p of the angle to their axis
+//! (Warn 1983) over the whole half-space in front of them:
+//! - `warn_model_light { central_direction; specular_exponent; xflapmin … zflapmax; }`: HKUST
+//!   2017 (snowboat/RayTracingS17);
+//! - `warn_light { normal; p; xmin … zmax; cutoff_distance; }`: an HKUST team fork
+//!   (COMP4411-Team/Trace);
+//! - `warn_light { direction; size; type; }`: HKUST 2019 (danvim/COMP4411-Trace), a beam of
+//!   radius `size` at unit distance whose cross-section `type` picks (read as a round beam).
+//!
+//! Flaps (a box the light is confined to) are not modelled; a warning says so.
+//!
 //! Area lights: `light_radius` (UT 2018, chipbuster/p2-raytracer) or `bottom_radius` (UT 2019,
 //! michaelasper/ray-tracer) makes a point light a ball of that radius; `u` and `v` (edge vectors
 //! from the corner `position`) make a parallelogram (COMP4411-Team/Trace).
@@ -57,11 +68,49 @@ pub(crate) const AREA_FIELDS: &[&str] = &[
     "quadratic_attenuation_coeff",
 ];
 
+/// Fields of `warn_light` and `warn_model_light`, in any fork's spelling.
+pub(crate) const WARN_FIELDS: &[&str] = &[
+    "position",
+    "color",
+    "colour",
+    "direction",
+    "central_direction",
+    "normal",
+    "target",
+    "specular_exponent",
+    "p",
+    "exponent",
+    "size",
+    "type",
+    "xflapmin",
+    "xflapmax",
+    "yflapmin",
+    "yflapmax",
+    "zflapmin",
+    "zflapmax",
+    "xmin",
+    "xmax",
+    "ymin",
+    "ymax",
+    "zmin",
+    "zmax",
+    "cutoff_distance",
+    "constant_attenuation_coeff",
+    "linear_attenuation_coeff",
+    "quadratic_attenuation_coeff",
+];
+
+/// The Warn lights' flaps: the box, in world coordinates, their light is confined to.
+const WARN_FLAPS: [&str; 12] = [
+    "xflapmin", "xflapmax", "yflapmin", "yflapmax", "zflapmin", "zflapmax", "xmin", "xmax", "ymin", "ymax", "zmin",
+    "zmax",
+];
+
 /// Whether `key` holds a vector (the others hold numbers).
 pub(crate) fn is_vector_field(key: &str) -> bool {
     matches!(
         key,
-        "position" | "color" | "colour" | "direction" | "central_direction" | "target" | "u" | "v"
+        "position" | "color" | "colour" | "direction" | "central_direction" | "normal" | "target" | "u" | "v"
     )
 }
 
@@ -144,6 +193,26 @@ impl LightFields {
         }
     }
 
+    /// The direction a light shines: one of `keys` (a `target` point is aimed at from `position`).
+    fn aim(&self, what: &str, keys: &[&str], position: Vec3, block: &Span) -> Result<Vec3, ParseError> {
+        let aims: Vec<&str> = keys.iter().copied().filter(|k| self.vec(k).is_some()).collect();
+        match aims.as_slice() {
+            [] => Err(self.required(what, keys[0], block)),
+            ["target"] => Ok(self.vec("target").map(|(t, _)| t - position).unwrap_or_default()),
+            [one] => Ok(self.vec(one).map(|(d, _)| d).unwrap_or_default()),
+            [_, second, ..] => {
+                let span = self.vec(second).map(|(_, s)| s).unwrap_or(block.clone());
+                Err(ParseError::new(
+                    format!(
+                        "give the light's aim once (`{}` and `{second}` are both given)",
+                        aims[0]
+                    ),
+                    span,
+                ))
+            }
+        }
+    }
+
     fn required(&self, what: &str, key: &str, block: &Span) -> ParseError {
         ParseError::new(format!("`{what}` needs a `{key}`"), block.clone())
     }
@@ -162,25 +231,12 @@ impl LightFields {
         let color = self
             .color()
             .ok_or_else(|| self.required("spot_light", "color", &block))?;
-        let aims: Vec<&str> = ["direction", "central_direction", "target"]
-            .into_iter()
-            .filter(|k| self.vec(k).is_some())
-            .collect();
-        let direction = match aims.as_slice() {
-            [] => return Err(self.required("spot_light", "direction", &block)),
-            ["target"] => self.vec("target").map(|(t, _)| t - position).unwrap_or_default(),
-            [one] => self.vec(one).map(|(d, _)| d).unwrap_or_default(),
-            [_, second, ..] => {
-                let span = self.vec(second).map(|(_, s)| s).unwrap_or(block);
-                return Err(ParseError::new(
-                    format!(
-                        "give the spot light's aim once (`{}` and `{second}` are both given)",
-                        aims[0]
-                    ),
-                    span,
-                ));
-            }
-        };
+        let direction = self.aim(
+            "spot_light",
+            &["direction", "central_direction", "target"],
+            position,
+            &block,
+        )?;
         let spellings: [(&[&str], &str); 4] = [
             (&["size", "blend"], "size"),
             (&["angle"], "angle"),
@@ -274,6 +330,94 @@ impl LightFields {
                 attenuation: self.attenuation(falloff, hkust),
                 inner_degrees: inner,
                 outer_degrees: outer,
+                exponent,
+                span: block,
+            },
+            warnings,
+        ))
+    }
+
+    /// The Warn light these fields describe (`what` is its keyword): a spot light lit over the
+    /// half-space it faces with a cos^p falloff, or a hard beam of radius `size` at unit distance.
+    pub fn warn(
+        self,
+        what: &str,
+        block: Span,
+        falloff: [f32; 3],
+        hkust: bool,
+    ) -> Result<(LightDesc, Vec<(String, Span)>), ParseError> {
+        let position = self
+            .vec("position")
+            .ok_or_else(|| self.required(what, "position", &block))?
+            .0;
+        let color = self.color().ok_or_else(|| self.required(what, "color", &block))?;
+        let direction = self.aim(
+            what,
+            &["direction", "central_direction", "normal", "target"],
+            position,
+            &block,
+        )?;
+        let exponents: Vec<(f32, Span)> = ["specular_exponent", "p", "exponent"]
+            .iter()
+            .filter_map(|k| self.num(k))
+            .collect();
+        let exponent = match exponents.as_slice() {
+            [] => 0.0,
+            [(e, span)] if !(*e >= 0.0 && e.is_finite()) => {
+                return Err(ParseError::new(
+                    format!("the Warn exponent must be 0 or more, not {e}"),
+                    span.clone(),
+                ))
+            }
+            [(e, _)] => *e,
+            [_, (_, span), ..] => return Err(ParseError::new("give the Warn light's exponent once", span.clone())),
+        };
+        let half_angle = match self.num("size") {
+            Some((size, span)) if !(size > 0.0 && size.is_finite()) => {
+                return Err(ParseError::new(format!("`size` must be positive, not {size}"), span))
+            }
+            Some((size, _)) => size.atan().to_degrees(),
+            None => 90.0,
+        };
+        let mut warnings = self.warnings.clone();
+        if let Some((kind, span)) = self.num("type") {
+            warnings.push((
+                format!("the beam's shape (`type = {kind}`) is not modelled: the Warn light's beam is round"),
+                span,
+            ));
+        }
+        let flaps: Vec<(&str, f32, Span)> = WARN_FLAPS
+            .iter()
+            .filter_map(|k| self.num(k).map(|(v, s)| (*k, v, s)))
+            .collect();
+        if !flaps.is_empty() {
+            let list: Vec<String> = flaps.iter().map(|(k, v, _)| format!("{k} = {v}")).collect();
+            let start = flaps.iter().map(|(_, _, s)| s.start).min().unwrap_or(block.start);
+            let end = flaps.iter().map(|(_, _, s)| s.end).max().unwrap_or(block.end);
+            warnings.push((
+                format!(
+                    "the Warn light's flaps ({}) are not modelled: it also lights what lies outside them",
+                    list.join(", ")
+                ),
+                start..end,
+            ));
+        }
+        if let Some((c, span)) = self.num("cutoff_distance") {
+            warnings.push((
+                format!(
+                    "`cutoff_distance = {c}` is not modelled: the light falls off with its attenuation coefficients"
+                ),
+                span,
+            ));
+        }
+        Ok((
+            LightDesc::Spot {
+                position,
+                direction,
+                color,
+                attenuation: self.attenuation(falloff, hkust),
+                inner_degrees: half_angle,
+                outer_degrees: half_angle,
                 exponent,
                 span: block,
             },

@@ -58,8 +58,14 @@ impl MetaballFields {
         Ok(())
     }
 
-    /// The shape: `keyword` is `metaballs` (field) or `metaball` (smooth union).
-    pub fn finish(self, keyword: &str, block: &Span) -> Result<ShapeDesc, ParseError> {
+    /// The shape: `keyword` is `metaballs` (field) or `metaball` (smooth union); `None` (with a
+    /// warning) for a `metaball` without balls, whose fork gave it no default ones.
+    pub fn finish(
+        self,
+        keyword: &str,
+        block: &Span,
+        warnings: &mut Vec<(String, Span)>,
+    ) -> Result<Option<ShapeDesc>, ParseError> {
         let smooth = keyword == "metaball";
         let radius = self.radius.as_ref().map_or(1.0, |(r, _)| *r);
         let balls: Vec<(Vec3, f32)> = match self.balls {
@@ -88,10 +94,12 @@ impl MetaballFields {
                 balls.into_iter().map(|(c, r)| (c, r.unwrap_or(radius))).collect()
             }
             None if smooth => {
-                return Err(ParseError::new(
-                    "`metaball` needs its balls: `ball = ((x, y, z), …);`",
+                warnings.push((
+                    "skipped `metaball { … }` without balls (`ball = ((x, y, z), …);`): there is nothing to draw"
+                        .into(),
                     block.clone(),
-                ))
+                ));
+                return Ok(None);
             }
             None => [Vec3::ZERO, Vec3::new(1.0, 0.5, 0.0), Vec3::new(0.0, 0.9, 0.0)]
                 .into_iter()
@@ -118,7 +126,7 @@ impl MetaballFields {
             let threshold = self.threshold.map_or(0.25, |(t, _)| t);
             BlobModelDesc::Field { threshold }
         };
-        Ok(ShapeDesc::Metaballs(Box::new(MetaballsDesc { balls, model })))
+        Ok(Some(ShapeDesc::Metaballs(Box::new(MetaballsDesc { balls, model }))))
     }
 }
 

@@ -1,5 +1,6 @@
 //! The course forks' files: old-Mac line ends, the HKUST skeleton's defaults, and the extensions
-//! students wrote (spot and area lights, skyboxes), read by both readers.
+//! students wrote (spot, area and Warn lights, skyboxes, quadrics, CSG, skipped objects), read by
+//! both readers.
 
 use super::ast::*;
 use super::{parse, ParseOptions};
@@ -377,8 +378,19 @@ fn metaballs_in_each_fork() {
         "metaballs { balls = ((0,0,0,2), (1,0,0)); radius = 0.5; threshold = 0.4; }",
     ));
     assert_eq!(m.balls, vec![(Vec3::ZERO, 2.0), (Vec3::X, 0.5)]);
-    let (err, _) = fail("metaball { size = 1; }", Some(Dialect::Tokenizer));
-    assert!(err.message.contains("needs its balls"));
+    // A `metaball` without balls has nothing to draw: skipped, with a warning at it.
+    for dialect in [Dialect::Tokenizer, Dialect::Hkust] {
+        let scene = read_as(
+            "metaball { material = {}; size = 1; } sphere { material = {}; }",
+            Some(dialect),
+        )
+        .unwrap();
+        assert_eq!(scene.objects.len(), 1);
+        assert!(matches!(scene.objects[0].shape, ShapeDesc::Sphere));
+        let (message, span) = &scene.warnings[0];
+        assert!(message.starts_with("skipped `metaball"), "{message}");
+        assert_eq!(span.start, HEADER.len());
+    }
     let (err, covered) = fail("metaballs { balls = ((0,0)); }", Some(Dialect::Tokenizer));
     assert!(err.message.contains("not 2 numbers"));
     assert_eq!(covered, "(0,0)");
@@ -457,4 +469,159 @@ fn csg_operations_in_dialect_o() {
     );
     assert!(err.message.contains("`xor`"));
     assert_eq!(covered, "\"xor\"");
+}
+
+/// Without `operation` a `csg` block's operands are still drawn: as their union, with a warning
+/// at the block.
+#[test]
+fn csg_block_without_operation_is_the_union_of_its_operands() {
+    use crate::description::CsgOpDesc;
+    let body = "material { name = m; }\n\
+                csg { primitives = (\"a\", \"b\"); a = sphere { material = m; }; b = translate(1, 0, 0, box { material = m; }); }";
+    let scene = read(body);
+    assert_eq!(scene.objects.len(), 1);
+    let u = csg(&scene, 0);
+    assert_eq!(u.op, CsgOpDesc::Union);
+    assert!(matches!(u.operands[0].shape, ShapeDesc::Sphere));
+    assert!(matches!(u.operands[1].shape, ShapeDesc::Box));
+    let (message, span) = &scene.warnings[0];
+    assert!(message.contains("has no `operation`"), "{message}");
+    let text = format!("{HEADER}{body}");
+    assert!(text[span.clone()].starts_with("csg {"));
+    // The block alone marks the team fork's dialect O; one operand is drawn as it is.
+    let scene = read("csg { primitives = (\"a\"); a = scale(2, sphere { material = { diffuse = (1, 1, 1); }; }); }");
+    assert_eq!(scene.dialect, Dialect::Hkust);
+    assert!(matches!(scene.objects[0].shape, ShapeDesc::Sphere));
+    assert!(scene.warnings[0].0.contains("its 1 operand(s)"));
+}
+
+// ---------------------------------------------------------------- Warn lights
+
+/// The three forks' Warn lights are spot lights: cos^p over the half-space they face (or a hard
+/// beam of radius `size` at unit distance); flaps and beam shapes are warned about, in place.
+#[test]
+fn warn_lights_of_each_fork() {
+    // HKUST 2017 (a dialect-O marker: no falloff without coefficients).
+    let body = "warn_model_light { position = (0, 0, 8); color = (1, 1, 1); central_direction = (0, 0, -1);\n\
+                specular_exponent = 16.0; xflapmin = -2; xflapmax = 2; zflapmax = 2; }";
+    let scene = read(body);
+    assert_eq!(scene.dialect, Dialect::Hkust);
+    let s = spot(&scene);
+    assert_eq!(
+        (s.0, s.1, s.2),
+        (Vec3::new(0.0, 0.0, 8.0), Vec3::NEG_Z, [1.0, 0.0, 0.0])
+    );
+    assert_eq!((s.3, s.4, s.5), (90.0, 90.0, 16.0));
+    let (message, span) = &scene.warnings[0];
+    assert!(
+        message.contains("flaps (xflapmin = -2, xflapmax = 2, zflapmax = 2)"),
+        "{message}"
+    );
+    let text = format!("{HEADER}{body}");
+    assert_eq!(line_col(&text, span.start), (3, 27));
+    assert!(text[span.clone()].starts_with("xflapmin = -2") && text[span.clone()].ends_with("zflapmax = 2"));
+    // The team fork: `normal` and `p`.
+    let scene = read(
+        "warn_light { cutoff_distance = 100; p = 100; xmin = -1; xmax = 1; position = (0, 2, 6); normal = (0, -1, -1); color = (1, 1, 1); }",
+    );
+    let s = spot(&scene);
+    assert_eq!((s.1, s.5), (Vec3::new(0.0, -1.0, -1.0), 100.0));
+    assert_eq!(scene.warnings.len(), 2, "{:?}", scene.warnings);
+    // HKUST 2019: a beam of radius 0.5 at unit distance, its shape drawn round.
+    let scene = read_as(
+        "warn_light { position = (1, 2, 1); direction = (-1, -2, -1); colour = (0.8, 0.8, 0.8); type = 3; size = 0.5; }",
+        Some(Dialect::Tokenizer),
+    )
+    .unwrap();
+    let s = spot(&scene);
+    assert!(
+        (s.3 - 0.5f32.atan().to_degrees()).abs() < 1e-4 && s.3 == s.4 && s.5 == 0.0,
+        "{s:?}"
+    );
+    assert_eq!(s.2, [0.0, 0.0, 1.0]);
+    assert!(scene.warnings[0].0.contains("`type = 3`"));
+    // Errors stay located.
+    let (err, covered) = fail(
+        "warn_light { position = (0,0,1); normal = (0,0,-1); direction = (0,0,-1); color = (1,1,1); }",
+        None,
+    );
+    assert!(err.message.contains("aim once"), "{}", err.message);
+    assert!(covered.starts_with("normal"), "{covered}");
+    let (err, _) = fail(
+        "warn_light { position = (0,0,1); normal = (0,0,-1); color = (1,1,1); p = -1; }",
+        None,
+    );
+    assert!(err.message.contains("0 or more"));
+}
+
+// ---------------------------------------------------------------- quadrics
+
+fn mesh(scene: &RayScene, i: usize) -> &TrimeshDesc {
+    match &scene.objects[i].shape {
+        ShapeDesc::Trimesh(m) => m,
+        other => panic!("{other:?}"),
+    }
+}
+
+/// The UT 2019 `quadric`: five pairs are the coefficients A..J; here the sphere
+/// x² + y² + z² − 0.25 = 0 under a transform, read as a mesh on that sphere.
+#[test]
+fn quadric_coefficients_are_read_as_pairs() {
+    let scene = read(
+        "material = { diffuse = (0.4, 0.8, 0.2); }\n\
+         translate(0, 0, 3, quadric { points = ((1, 1), (1, 0), (0, 0), (0, 0), (0, -0.25)); })",
+    );
+    let object = &scene.objects[0];
+    assert_eq!(object.material.diffuse, Param::Constant(Vec3::new(0.4, 0.8, 0.2)));
+    for p in &mesh(&scene, 0).points {
+        assert!((p.length() - 0.5).abs() < 1e-3, "{p}");
+        let world = object.world_from_object.transform_point3(*p);
+        assert!((world - Vec3::new(0.0, 0.0, 3.0)).length() < 0.51);
+    }
+    let (err, covered) = fail("quadric { points = ((1, 1), (1, 0)); }", None);
+    assert!(err.message.contains("five pairs"), "{}", err.message);
+    assert_eq!(covered, "((1, 1), (1, 0))");
+}
+
+/// `hyperboloid`, `hyperbolic_paraboloid` and `paraboloid` in either reader: the surface's
+/// equation holds at every vertex.
+#[test]
+fn named_quadrics_in_both_dialects() {
+    type Surface = fn(Vec3) -> f32;
+    let surfaces: [(&str, Surface); 3] = [
+        ("hyperboloid", |p| p.x * p.x + p.y * p.y - p.z * p.z - 1.0),
+        ("hyperbolic_paraboloid", |p| p.x * p.x - p.y * p.y - p.z),
+        ("paraboloid", |p| p.x * p.x + p.y * p.y - p.z),
+    ];
+    for dialect in [Dialect::Tokenizer, Dialect::Hkust] {
+        for (word, f) in surfaces {
+            let scene = read_as(
+                &format!("scale(4, 4, 2, {word} {{ material = {{ diffuse = (1,1,1); }}; }})"),
+                Some(dialect),
+            )
+            .unwrap_or_else(|e| panic!("{word}: {}", e.message));
+            let m = mesh(&scene, 0);
+            assert!(m.points.iter().all(|&p| f(p).abs() < 1e-3), "{word} in {dialect:?}");
+            assert_eq!(
+                scene.objects[0].world_from_object.transform_point3(Vec3::ONE),
+                Vec3::new(4.0, 4.0, 2.0)
+            );
+        }
+    }
+}
+
+/// The HKUST 2019 fork's procedural marble in a material: its `color` stands in, with a warning.
+#[test]
+fn marble_textures_fall_back_to_their_colour() {
+    let body = "material { name = m; }\n\
+                sphere { material = { diffuse = marble { color = (0.6, 0.0, 1.0); contrast = 0.8; }; specular = (0.5, 0.5, 0.5); }; }";
+    let scene = read(body);
+    let material = &scene.objects[0].material;
+    assert_eq!(material.diffuse, Param::Constant(Vec3::new(0.6, 0.0, 1.0)));
+    // `reflective` still follows `specular` when not given.
+    assert_eq!(material.reflective, Param::grey(0.5));
+    let (message, span) = &scene.warnings[0];
+    assert!(message.contains("`marble`"), "{message}");
+    let text = format!("{HEADER}{body}");
+    assert!(text[span.clone()].starts_with("marble {"));
 }

@@ -20,6 +20,8 @@ pub(crate) const RESERVED: &[&str] = &[
     "environment_light",
     "spot_light",
     "area_light",
+    "warn_light",
+    "warn_model_light",
     "skybox",
     "angle",
     "ambient_light",
@@ -37,6 +39,10 @@ pub(crate) const RESERVED: &[&str] = &[
     "torus",
     "metaballs",
     "metaball",
+    "quadric",
+    "hyperboloid",
+    "hyperbolic_paraboloid",
+    "paraboloid",
     "trimesh",
     "polymesh",
     "capped",
@@ -80,17 +86,12 @@ pub(crate) fn is_reserved(word: &str) -> bool {
     RESERVED.contains(&word)
 }
 
-/// Constructs added by students in forks of the course skeleton; caustica reads none of them.
+/// Constructs added by students in forks of the course skeleton whose meaning caustica cannot
+/// reproduce: as objects or fields they are skipped with a warning, elsewhere refused.
 pub(crate) const EXTENSIONS: &[&str] = &[
-    "warn_light",
-    "warn_model_light",
     "light_radius",
-    "quadric",
-    "hyperboloid",
-    "hyperbolic_paraboloid",
     "bump_mapping",
     "bump",
-    "objfile",
     "map_points",
     "particles",
     "emitter",
@@ -118,6 +119,22 @@ pub(crate) fn extension_error(word: &str, span: &Span) -> Option<ParseError> {
     })
 }
 
+/// Whether `word` names a student extension caustica does not read.
+pub(crate) fn is_extension(word: &str) -> bool {
+    EXTENSIONS.contains(&word)
+}
+
+/// The warning for an object or block that is skipped; `what` is how it is written.
+pub(crate) fn skipped_object(word: &str, what: &str) -> String {
+    if is_extension(word) {
+        format!("skipped `{what}`: `{word}` is a student extension of the course format that caustica does not read; the rest of the scene is read without it")
+    } else {
+        format!(
+            "skipped `{what}`: caustica does not know the object `{word}`; the rest of the scene is read without it"
+        )
+    }
+}
+
 /// Material colour fields, in the order the course documents them.
 pub(crate) const COLOUR_FIELDS: &[&str] = &[
     "emissive",
@@ -137,6 +154,8 @@ pub(crate) const TOP_LEVEL: &[&str] = &[
     "environment_light",
     "spot_light",
     "area_light",
+    "warn_light",
+    "warn_model_light",
     "skybox",
     "ambient_light",
     "material",
@@ -148,6 +167,10 @@ pub(crate) const TOP_LEVEL: &[&str] = &[
     "torus",
     "metaballs",
     "metaball",
+    "quadric",
+    "hyperboloid",
+    "hyperbolic_paraboloid",
+    "paraboloid",
     "trimesh",
     "polymesh",
     "translate",

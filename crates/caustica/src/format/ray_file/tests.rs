@@ -468,24 +468,66 @@ fn misspelled_keywords_get_suggestions() {
 }
 
 #[test]
-fn student_extensions_are_named() {
-    for (body, word) in [
-        ("translate(0,0,0, quadric {})", "quadric"),
-        (
-            "sphere { material = { diffuse = (1,1,1); bump_mapping = bump(\"x.png\"); } }",
-            "bump_mapping",
-        ),
-        ("polymesh { objfile = \"x.obj\"; }", "objfile"),
-        ("warn_light { position = (0,0,0); }", "warn_light"),
-        ("particles { }", "particles"),
-    ] {
-        let (err, covered) = fail(body);
-        assert_eq!(covered, word);
-        assert_eq!(
-            err.message,
-            format!("`{word}` is a student extension of the course format that caustica does not read")
+fn student_extensions_are_read_or_skipped_with_a_located_warning() {
+    let warned = |scene: &RayScene, text: &str, starts: &str| {
+        let full = format!("{HEADER}{text}");
+        assert!(
+            scene
+                .warnings
+                .iter()
+                .any(|(_, span)| full[span.clone()].starts_with(starts)),
+            "no warning at `{starts}` in {:?}",
+            scene.warnings
         );
+    };
+    // A quadric is read as a mesh of its surface.
+    let scene = read("translate(0,0,0, quadric {})");
+    assert!(matches!(scene.objects[0].shape, ShapeDesc::Trimesh(_)));
+    // A bump map is skipped; the sphere and the rest of its material stay.
+    let body = "sphere { material = { diffuse = (1,1,1); bump_mapping = bump(\"x.png\"); specular = (1,0,0); } }";
+    let scene = read(body);
+    assert_eq!(scene.objects.len(), 1);
+    assert_eq!(scene.objects[0].material.specular, Param::Constant(Vec3::X));
+    warned(&scene, body, "bump_mapping = bump(\"x.png\");");
+    // `objfile` names the mesh's file, as caustica's `file` does.
+    let scene = read("polymesh { objfile = \"x.obj\"; }");
+    assert_eq!(scene.mesh_files[0].path, Path::new("scenes/x.obj"));
+    // Objects of other forks are skipped, extensions or not, wherever an object may stand.
+    for body in [
+        "particles { material = { diffuse = (1,1,1); }; } sphere {}",
+        "meteorite { size = 2; speed = (1, 0, 0); } sphere {}",
+        "translate(1, 0, 0, meteorite(1, 2)); sphere {}",
+        "{ fluid { } } sphere {}",
+    ] {
+        let scene = read(body);
+        assert_eq!(scene.objects.len(), 1, "{body}");
+        let word = body.trim_start_matches(['{', ' ']).split([' ', '(']).next().unwrap();
+        let word = if word == "translate" { "meteorite" } else { word };
+        warned(&scene, body, word);
+        let message = &scene.warnings[0].0;
+        assert!(message.starts_with(&format!("skipped `{word}")), "{message}");
     }
+    // A required field is still required.
+    let (err, covered) = fail("warn_light { position = (0,0,0); color = (1,1,1); }");
+    assert_eq!(err.message, "`warn_light` needs a `direction`");
+    assert!(covered.starts_with("warn_light {"));
+}
+
+/// What is not skipped: misspellings of known objects, and blocks that do not close.
+#[test]
+fn unknown_objects_that_cannot_be_skipped() {
+    let (err, covered) = fail("sphre { }");
+    assert_eq!(covered, "sphre");
+    assert_eq!(err.help.as_deref(), Some("did you mean `sphere`?"));
+    let (err, covered) = fail("meteorite { size = (1, 2 }");
+    assert_eq!(err.message, "`}` does not close the `(` opened here");
+    assert_eq!(covered, "(1, 2 }");
+    let (err, covered) = fail("meteorite { size = 2;\nsphere {}");
+    assert_eq!(err.message, "`{` is never closed");
+    assert_eq!(covered, "{");
+    // A word that is no object, at the top level, is a syntax error as before.
+    let (err, _) = fail("meteorite = 2;");
+    assert!(err.message.starts_with("expected a camera, light"), "{}", err.message);
 }
 
 #[test]
@@ -608,8 +650,20 @@ fn dialect_o_errors() {
     assert!(err.message.contains("needs a `name`"));
     let err = read_as("spher { material = {}; }", Dialect::Dictionary).expect_err("typo");
     assert_eq!(err.help.as_deref(), Some("did you mean `sphere`?"));
-    let err = read_as("quadric { material = {}; }", Dialect::Dictionary).expect_err("extension");
-    assert!(err.message.starts_with("`quadric` is a student extension"));
+    // Other forks' objects are skipped with a warning; their quadrics are read.
+    let scene = read_as(
+        "fluid { material = {}; } sphere { material = {}; }",
+        Dialect::Dictionary,
+    )
+    .expect("skipped");
+    assert_eq!(scene.objects.len(), 1);
+    assert!(
+        scene.warnings[0].0.starts_with("skipped `fluid { … }`"),
+        "{:?}",
+        scene.warnings
+    );
+    let scene = read_as("quadric { material = {}; }", Dialect::Dictionary).expect("a quadric");
+    assert!(matches!(scene.objects[0].shape, ShapeDesc::Trimesh(_)));
     let err = read_as("translate(1, 2, sphere { material = {}; })", Dialect::Dictionary).expect_err("arity");
     assert!(err.message.contains("`translate` with (x, y, z, object)"));
     let err = read_as(

@@ -9,9 +9,10 @@ use super::ast::{
 use super::cursor::{Cursor, Reach};
 use super::fork_lights::{self, LightFields};
 use super::fork_shapes::{self, MetaballFields, METABALL_FIELDS};
-use super::keywords::{extension_error, is_reserved, COLOUR_FIELDS, TOP_LEVEL};
+use super::keywords::{extension_error, is_extension, is_reserved, skipped_object, COLOUR_FIELDS, TOP_LEVEL};
 use super::lexer::{self, Tok, Token};
 use super::named_materials::NamedMaterials;
+use super::quadric;
 use super::skybox::{SkyboxFields, SKYBOX_FIELDS};
 use super::suggest;
 use super::transform_stack::{self, TransformStack};
@@ -29,6 +30,10 @@ const ELEMENTS: &[&str] = &[
     "torus",
     "metaballs",
     "metaball",
+    "quadric",
+    "hyperboloid",
+    "hyperbolic_paraboloid",
+    "paraboloid",
     "trimesh",
     "polymesh",
     "translate",
@@ -82,6 +87,7 @@ const MESH_FIELDS: &[&str] = &[
     "gennormals",
     "texture_uv",
     "file",
+    "objfile",
 ];
 
 /// Parses a whole dialect-T file.
@@ -162,6 +168,7 @@ impl<'a> Parser<'a> {
                     "sun_light" => self.sun_light()?,
                     "spot_light" => self.fork_light(fork_lights::SPOT_FIELDS)?,
                     "area_light" => self.fork_light(fork_lights::AREA_FIELDS)?,
+                    "warn_light" | "warn_model_light" => self.fork_light(fork_lights::WARN_FIELDS)?,
                     "skybox" => self.skybox()?,
                     "csg" => {
                         return Err(ParseError::new(
@@ -234,6 +241,27 @@ impl<'a> Parser<'a> {
                 (Tok::Word, "metaballs" | "metaball") => {
                     self.cur.next();
                     self.metaballs(&token)?;
+                }
+                (Tok::Word, "quadric" | "hyperboloid" | "hyperbolic_paraboloid" | "paraboloid") => {
+                    self.cur.next();
+                    self.quadric(&token)?;
+                }
+                // An object of some fork that is not read: skipped with a warning.
+                (Tok::Word, _) if self.skippable_object(word, allowed) => {
+                    self.cur.next();
+                    let span = self.skip_group()?;
+                    self.cur.eat(Tok::Semicolon);
+                    let what = format!(
+                        "{word} {}",
+                        if self.cur.text[span.clone()].starts_with('{') {
+                            "{ … }"
+                        } else {
+                            "( … )"
+                        }
+                    );
+                    self.scene
+                        .warnings
+                        .push((skipped_object(word, &what), token.span.start..span.end));
                 }
                 (Tok::Word, "union" | "intersection" | "difference" | "subtraction") => {
                     self.cur.next();
@@ -437,11 +465,96 @@ impl<'a> Parser<'a> {
                 return Ok(());
             }
             let handled = token.tok == Tok::Word && field(self, &token, self.cur.text_of(&token))?;
+            if !handled && self.skip_extension_field(name)? {
+                continue;
+            }
             if !handled {
                 let list = allowed.iter().map(|f| format!("`{f}`")).collect::<Vec<_>>().join(", ");
                 return Err(self.bad_word(&format!("a `{name}` field ({list}) or `}}`"), allowed));
             }
         }
+    }
+
+    /// Whether the next word starts an object to skip: a word followed by `{` or `(` that is no
+    /// keyword of the format and no misspelling of one of `allowed`.
+    fn skippable_object(&self, word: &str, allowed: &[&str]) -> bool {
+        matches!(self.cur.peek_at(1).tok, Tok::LBrace | Tok::LParen)
+            && !is_reserved(word)
+            && (is_extension(word) || suggest::nearest(word, allowed.iter().copied()).is_none())
+    }
+
+    /// Consumes a bracketed group from its `{` or `(` to the matching closer; returns its span.
+    fn skip_group(&mut self) -> Result<Span, ParseError> {
+        let open = self.cur.next();
+        let mut stack = vec![open.clone()];
+        while let Some(top) = stack.last().cloned() {
+            let token = self.cur.next();
+            match token.tok {
+                Tok::LBrace | Tok::LParen => stack.push(token),
+                Tok::RBrace | Tok::RParen => {
+                    let wanted = if top.tok == Tok::LBrace {
+                        Tok::RBrace
+                    } else {
+                        Tok::RParen
+                    };
+                    if token.tok != wanted {
+                        return Err(ParseError::new(
+                            format!(
+                                "{} does not close the {} opened here",
+                                super::cursor::punct(token.tok),
+                                super::cursor::punct(top.tok)
+                            ),
+                            top.span.start..token.span.end,
+                        ));
+                    }
+                    stack.pop();
+                }
+                Tok::Eof => {
+                    return Err(ParseError::new(
+                        format!("{} is never closed", super::cursor::punct(top.tok)),
+                        top.span,
+                    ))
+                }
+                _ => {}
+            }
+        }
+        Ok(open.span.start..self.cur.prev_end())
+    }
+
+    /// A student-extension field `key = value` in a block of `owner`: skipped with a warning.
+    /// Returns whether the next field was one.
+    fn skip_extension_field(&mut self, owner: &str) -> Result<bool, ParseError> {
+        let token = self.cur.peek().clone();
+        let word = self.cur.text_of(&token);
+        if token.tok != Tok::Word || !is_extension(word) || self.cur.peek_at(1).tok != Tok::Equals {
+            return Ok(false);
+        }
+        self.cur.next();
+        self.cur.next();
+        // The value runs to the `;` (or the block's `}`) at its own depth.
+        loop {
+            match self.cur.peek().tok {
+                Tok::Semicolon => {
+                    self.cur.next();
+                    break;
+                }
+                Tok::RBrace | Tok::Eof => break,
+                Tok::LBrace | Tok::LParen => {
+                    self.skip_group()?;
+                }
+                Tok::RParen => return Err(self.cur.unexpected(&format!("`;` after the value of `{word}`"))),
+                _ => {
+                    self.cur.next();
+                }
+            }
+        }
+        self.scene.warnings.push((
+            format!(
+                "skipped `{word}` in `{owner}`: a student extension of the course format that caustica does not read"
+            ),
+            token.span.start..self.cur.prev_end(),
+        ));
+        Ok(true)
     }
 
     fn camera(&mut self) -> Result<(), ParseError> {
@@ -607,7 +720,8 @@ impl<'a> Parser<'a> {
         Ok(())
     }
 
-    /// `spot_light { … }` or `area_light { … }` in any course fork's spelling (fork_lights.rs).
+    /// `spot_light`, `area_light`, `warn_light` or `warn_model_light { … }` in any course fork's
+    /// spelling (fork_lights.rs).
     fn fork_light(&mut self, allowed: &'static [&'static str]) -> Result<(), ParseError> {
         let keyword = self.cur.next();
         let mut fields = LightFields::default();
@@ -632,12 +746,18 @@ impl<'a> Parser<'a> {
             allowed,
         )?;
         let span = keyword.span.start..self.cur.prev_end();
-        let light = if self.cur.text_of(&keyword) == "spot_light" {
-            let (light, warnings) = fields.spot(span, [0.0, 0.0, 1.0], false)?;
-            self.scene.warnings.extend(warnings);
-            light
-        } else {
-            fields.area(span, [0.0, 0.0, 1.0], false)?
+        let light = match self.cur.text_of(&keyword) {
+            "spot_light" => {
+                let (light, warnings) = fields.spot(span, [0.0, 0.0, 1.0], false)?;
+                self.scene.warnings.extend(warnings);
+                light
+            }
+            "area_light" => fields.area(span, [0.0, 0.0, 1.0], false)?,
+            warn => {
+                let (light, warnings) = fields.warn(warn, span, [0.0, 0.0, 1.0], false)?;
+                self.scene.warnings.extend(warnings);
+                light
+            }
         };
         self.scene.lights.push(light);
         Ok(())
@@ -863,6 +983,7 @@ impl<'a> Parser<'a> {
                     self.cur.eat(Tok::Semicolon);
                     *field_mut(&mut material, key) = value;
                 }
+                _ if self.skip_extension_field("material")? => {}
                 _ => {
                     let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `abbe`, `name`";
                     return Err(self.bad_word(&format!("a material field ({list}) or `}}`"), MATERIAL_FIELDS));
@@ -1037,9 +1158,66 @@ impl<'a> Parser<'a> {
             &allowed,
         )?;
         let block = keyword.span.start..self.cur.prev_end();
-        let shape = fields.finish(kind, &block)?;
+        let Some(shape) = fields.finish(kind, &block, &mut self.scene.warnings)? else {
+            return Ok(());
+        };
         let material = material.unwrap_or_else(|| self.default_material.clone());
         self.push_object(shape, material, keyword.span.clone());
+        Ok(())
+    }
+
+    /// `quadric`, `hyperboloid`, `hyperbolic_paraboloid` or `paraboloid { … }` (the keyword is
+    /// consumed; quadric.rs): a triangle mesh of the surface inside [-1, 1]³.
+    fn quadric(&mut self, keyword: &Token) -> Result<(), ParseError> {
+        let kind = self.cur.text_of(keyword);
+        let mut material = None;
+        let mut coefficients = quadric::named(kind).expect("a quadric keyword");
+        let allowed: &[&str] = if kind == "quadric" {
+            &["material", "name", "points"]
+        } else {
+            &["material", "name"]
+        };
+        self.block(
+            keyword,
+            |p, _, key| {
+                match key {
+                    "material" => {
+                        let base = p.default_material.clone();
+                        material = Some(p.material_stmt(&base)?);
+                    }
+                    "name" => p.name_attr()?,
+                    "points" if kind == "quadric" => {
+                        p.key_equals()?;
+                        let mut pairs = Vec::new();
+                        let span = p.list(key, |p| {
+                            pairs.push(p.tuple::<2>("in the quadric's `points`")?.0);
+                            Ok(())
+                        })?;
+                        coefficients = quadric::from_pairs(&pairs).ok_or_else(|| {
+                            ParseError::new(
+                                format!(
+                                    "a quadric's `points` are its ten coefficients A…J as five pairs ((A, B), (C, D), (E, F), (G, H), (I, J)), not {} pairs",
+                                    pairs.len()
+                                ),
+                                span,
+                            )
+                        })?;
+                    }
+                    _ => return Ok(false),
+                }
+                Ok(true)
+            },
+            allowed,
+        )?;
+        let block = keyword.span.start..self.cur.prev_end();
+        let material = material.unwrap_or_else(|| self.default_material.clone());
+        match quadric::tessellate(&coefficients) {
+            Some(mesh) => self.push_object(ShapeDesc::Trimesh(Box::new(mesh)), material, keyword.span.clone()),
+            None => self.scene.warnings.push((
+                format!("the `{kind}` has no surface inside the cube [-1, 1]³ it is bounded by; nothing is drawn"),
+                block,
+            )),
+        }
         Ok(())
     }
 
@@ -1087,7 +1265,8 @@ impl<'a> Parser<'a> {
             keyword,
             |p, _, key| {
                 match key {
-                    "file" => {
+                    // `objfile` is the UT 2016 photon-mapping fork's name for it.
+                    "file" | "objfile" => {
                         p.key_equals()?;
                         let (name, span) = p.identifier("(the OBJ or PLY file, in quotes) for `file`")?;
                         file = Some((scene_dir.join(name), span));
