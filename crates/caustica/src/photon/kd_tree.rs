@@ -391,6 +391,35 @@ impl KdTree {
         }
     }
 
+    /// The leaves left to right: each one's items (a range of the slice `build` reordered) and
+    /// the bounds of their finite positions (`lo > hi` when there are none).
+    pub fn leaf_cells(&self) -> Vec<(std::ops::Range<usize>, [f32; 3], [f32; 3])> {
+        let mut cells = Vec::with_capacity(self.leaves.len());
+        let mut stack = vec![Subtree {
+            size: self.nodes.len() as u32,
+            len: self.len,
+            ..Subtree::default()
+        }];
+        while let Some(cur) = stack.pop() {
+            if cur.size == 0 {
+                let b = self.leaves[cur.leaf as usize];
+                cells.push((cur.lo as usize..(cur.lo + cur.len) as usize, b.lo, b.hi));
+                continue;
+            }
+            let (left, right) = children(cur);
+            stack.push(right);
+            stack.push(left);
+        }
+        cells
+    }
+
+    /// The squared distance `k_nearest_where` measures from `p` to an item at `q`, rounded the
+    /// same way, so that results computed elsewhere match the tree's to the bit.
+    #[inline(always)]
+    pub fn dist2(q: Vec3, p: Vec3) -> f32 {
+        dist2(q.to_array(), p.to_array())
+    }
+
     /// Calls `f(slot, dist2)` for every item within squared distance `r2` (inclusive) of `p`,
     /// in tree order. A NaN query point or `r2` finds nothing.
     ///
