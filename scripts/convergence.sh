@@ -6,7 +6,7 @@
 # region's mean. Path lengths are cut as the reference's are (its particle tracer stops at 10
 # path segments: light from a diffuse surface has met at most 9 surfaces), so both run with
 # --depth 8: ppm keeps photons of at most 8 bounces and path scatters camera paths at most 9
-# times (see tests/physical.rs).
+# times (see crates/caustica/tests/it/physical.rs).
 #   usage: scripts/convergence.sh [REFERENCE_DIR] [LONGEST_SECONDS]
 set -euo pipefail
 cd "$(dirname "$0")/.."

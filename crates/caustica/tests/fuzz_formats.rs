@@ -468,3 +468,156 @@ element face 1\nproperty list uchar uint vertex_indices\nend_header\n"
         Ok(())
     });
 }
+
+// ---- long lines ------------------------------------------------------------------------------
+// Real glTF is written on one line, and pbrt and `.ray` files carry parameter lists of megabytes:
+// an error far along such a line must be located and reported in a few short lines.
+
+/// Columns past this are out of reach of a report that pads a line to its column (a format
+/// width is a `u16`).
+const FAR: usize = 70_000;
+
+/// Every refusal of a long-line case: a located scene error whose report is short.
+fn check_long(name: &str, result: &Result<format::SceneSource, Error>) -> Result<Option<usize>, String> {
+    check_error(result).map_err(|e| format!("{name}: {e}"))?;
+    let Err(error) = result else {
+        return Ok(None);
+    };
+    let diagnostic = caustica::diagnostic::Diagnostic::new(error);
+    let report = diagnostic.render();
+    let Some(at) = &diagnostic.excerpt else {
+        return Err(format!("{name}: no excerpt"));
+    };
+    let located = format!(":{}:{}: ", at.line, at.column);
+    if !report.lines().next().is_some_and(|l| l.contains(&located)) {
+        return Err(format!("{name}: the report's first line lacks `{located}`"));
+    }
+    if let Some(long) = report.lines().find(|l| l.chars().count() > 1000) {
+        return Err(format!("{name}: a report line of {} characters", long.chars().count()));
+    }
+    Ok(Some(at.column))
+}
+
+fn read(dir: &Path, name: &str, text: String) -> Result<format::SceneSource, Error> {
+    format::read_text(&dir.join(name), text, dir, &ReadOptions::default(), &NoProgress)
+}
+
+#[test]
+fn one_line_gltf_cut_at_many_points_is_refused_with_a_short_located_report() {
+    let dir = temp_dir();
+    // The seed glTF with a long `extras` string, then squeezed onto one line.
+    let seed = String::from_utf8(gltf_seed()).unwrap();
+    let padded = seed.replacen('{', &format!("{{\"extras\":{{\"note\":\"{}\"}},", "n".repeat(FAR)), 1);
+    let one_line: String = padded.chars().filter(|&c| c != '\n' && c != '\r').collect();
+    format::gltf::read(&dir.join("one.gltf"), one_line.clone().into_bytes(), &dir, &NoProgress)
+        .expect("the whole one-line file reads");
+    // Cuts inside the long string, and many after it, where every error lies far along the line.
+    let after = one_line.find(&"n".repeat(FAR)).unwrap() + FAR;
+    let cuts = (1..20)
+        .map(|i| after * i / 20)
+        .chain((0..200).map(|i| after + (one_line.len() - after) * i / 200));
+    for cut in cuts {
+        let bytes = one_line.as_bytes()[..cut].to_vec();
+        let result = format::gltf::read(&dir.join("cut.gltf"), bytes, &dir, &NoProgress);
+        assert!(result.is_err(), "cut at {cut} read as a scene");
+        let column = check_long(&format!("cut at {cut}"), &result).unwrap().unwrap();
+        assert!(cut < after || column > FAR, "cut at {cut} located at column {column}");
+    }
+}
+
+#[test]
+fn huge_parameter_lists_with_a_bad_value_far_along_are_located() {
+    let dir = temp_dir();
+    let numbers = |n: usize| (0..n).map(|i| format!("{}", i % 7)).collect::<Vec<_>>().join(" ");
+    let pbrt_bad = ["1.2.3", "\"text\"", "[", "nan", "\u{fffd}", "WorldEnd", "1e999"];
+    let mut cases = Vec::new();
+    for bad in pbrt_bad {
+        cases.push((
+            "bad.pbrt",
+            format!(
+                "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ {} {bad} 0 0 ] \"integer indices\" [0 1 2]\n",
+                numbers(3 * 12_000)
+            ),
+        ));
+    }
+    for bad in ["1.2.3", "x", "(", ";", "\u{7}", "}"] {
+        cases.push((
+            "bad.ray",
+            format!(
+                "SBT-raytracer 1.0\ncamera {{ position = (0,0,4); }}\npolymesh {{ points = ({}({bad}, 0, 0)); faces = ((0,1,2)); }}\n",
+                "(0, 0, 0), ".repeat(8_000)
+            ),
+        ));
+    }
+    // Deep nesting on one line, broken at its far end.
+    cases.push((
+        "nest.ray",
+        format!(
+            "SBT-raytracer 1.0\n{}sphere {{}} ]",
+            "translate(0, 0, 0, ".repeat(5_000)
+        ),
+    ));
+    cases.push((
+        "face.obj",
+        format!("v 0 0 0\nv 1 0 0\nv 0 1 0\nf {}9999999\n", "1 2 3 ".repeat(12_000)),
+    ));
+    cases.push(("vertex.obj", format!("v {} x\n", "0.5 ".repeat(20_000))));
+    let mut far = 0;
+    for (name, text) in cases {
+        let result = read(&dir, name, text);
+        if let Some(column) = check_long(name, &result).unwrap() {
+            far += usize::from(column > FAR);
+        }
+    }
+    assert!(far >= 10, "only {far} errors past column {FAR}");
+}
+
+#[test]
+fn bad_bytes_far_into_a_line_are_located_in_every_reader() {
+    let dir = temp_dir();
+    let junk = String::from_utf8_lossy(b"\xff\xfe\x00\x01\x80").into_owned();
+    let cases = [
+        (
+            "b.ray",
+            format!("SBT-raytracer 1.0\nsphere {{ {}{junk} }}\n", " ".repeat(FAR)),
+        ),
+        (
+            "b.pbrt",
+            format!("WorldBegin Shape \"sphere\" {}{junk}\n", " ".repeat(FAR)),
+        ),
+        ("b.obj", format!("v 0 0 0 {}{junk}\nf 1 1 1\n", " ".repeat(FAR))),
+        (
+            "b.gltf",
+            format!("{{\"asset\":{{\"version\":\"2.0\"}},{}{junk}}}", " ".repeat(FAR)),
+        ),
+    ];
+    for (name, text) in cases {
+        check_long(name, &read(&dir, name, text)).unwrap();
+    }
+    // PLY: a header line and a data line of megabytes, then bad bytes.
+    for ply in [
+        format!(
+            "ply\nformat ascii 1.0\ncomment {}\u{1}\nelement vertex 1\nend_header\n",
+            "c".repeat(FAR)
+        ),
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nend_header\n{}{junk}\n",
+            "0 ".repeat(FAR)
+        ),
+    ] {
+        let mut files = SourceFiles::new(Path::new("main.pbrt"), String::new());
+        if let Err(e) = ply::parse(&mut files, Path::new("m.ply"), ply.as_bytes()) {
+            let error = files.error(e);
+            let report = caustica::diagnostic::Diagnostic::new(&error).render();
+            assert!(report.lines().all(|l| l.chars().count() < 1000), "{report}");
+        }
+    }
+    // MTL: warnings only, never a panic.
+    let mut warnings = Vec::new();
+    let _ = format::obj::parse_mtl(
+        &format!("newmtl a\nKd {}{junk}\n", "1 ".repeat(FAR)),
+        0,
+        &dir,
+        &mut warnings,
+    );
+}

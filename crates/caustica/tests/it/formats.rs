@@ -6,8 +6,7 @@
 //! over the pixels) than the .ray image differs from itself rendered with another seed, and
 //! their means agree within 1%.
 
-mod common;
-
+use crate::common::control;
 use caustica::description::LightDesc;
 use caustica::film::Film;
 use caustica::format::obj::{CameraRequest, SceneOptions};
@@ -15,7 +14,6 @@ use caustica::format::ReadOptions;
 use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{RenderConfig, RenderSession};
 use caustica::loader::{load, LoadSettings};
-use common::control;
 use glam::{Mat3, Quat, Vec3};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};

@@ -1,7 +1,6 @@
 //! Spot lights, suns and the environment against closed forms, in every physical integrator.
 
-mod common;
-
+use crate::common::{control, rel, scene};
 use caustica::description::LightDesc;
 use caustica::film::Film;
 use caustica::format::ray_file::{self, ParseOptions};
@@ -11,7 +10,6 @@ use caustica::math::Vec3;
 use caustica::sampling::Rng;
 use caustica::scene::{build, BuildSettings, Scene};
 use caustica::spectrum::Wavelengths;
-use common::{control, rel, scene};
 use std::f32::consts::PI;
 use std::path::Path;
 

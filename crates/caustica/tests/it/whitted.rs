@@ -1,6 +1,6 @@
 //! The Whitted integrator against the §9 formula evaluated by hand, pixel by pixel.
 
-mod common;
+use crate::common;
 
 use caustica::integrator::whitted::{render, WhittedSettings};
 use caustica::integrator::ImageSettings;

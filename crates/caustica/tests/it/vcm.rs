@@ -4,8 +4,10 @@
 //! split runs that merge into one, and passes resized for a time limit that weigh their share. That the weights of all its strategies sum to one is a
 //! unit test beside them (integrator/vcm/mis.rs).
 
-mod common;
-
+use crate::common::{
+    assert_deterministic_and_merges, control, load_reference, region_error, rel, render_passes, report, scene,
+    uv_sphere, Region,
+};
 use caustica::film::Film;
 use caustica::integrator::lt::{LightTracer, LtSettings};
 use caustica::integrator::partial::Accumulator;
@@ -14,13 +16,9 @@ use caustica::integrator::radius::InitialRadius;
 use caustica::integrator::vcm::{Vcm, VcmSettings};
 use caustica::integrator::Progressive;
 use caustica::math::Vec3;
-use common::{
-    assert_deterministic_and_merges, control, load_reference, region_error, rel, render_passes, report, scene,
-    uv_sphere, Region,
-};
 use std::f32::consts::PI;
 
-/// A point light over a Lambertian floor seen from above (as in tests/light_tracing.rs): each
+/// A point light over a Lambertian floor seen from above (as in light_tracing.rs): each
 /// floor point sends L = ρ/π · I cos θ / d² towards the eye.
 const PLANE: &str = "SBT-raytracer 1.0
 camera { position = (0, 3, 0.001); viewdir = (0, -1, 0); updir = (0, 0, -1); fov = 30; }

@@ -2,12 +2,10 @@
 //! `../shared/reference/` is absent), and its contracts: the same image on any thread count,
 //! and split runs that merge into one.
 
-mod common;
-
+use crate::common::{assert_deterministic_and_merges, load_reference, rel, render_passes, report, scene, Region};
 use caustica::film::Film;
 use caustica::integrator::lt::{LightTracer, LtSettings};
 use caustica::math::Vec3;
-use common::{assert_deterministic_and_merges, load_reference, rel, render_passes, report, scene, Region};
 use std::f32::consts::PI;
 
 /// A point light of intensity I at height 1 over a Lambertian floor of albedo ρ, seen from
@@ -94,7 +92,7 @@ fn light_tracing_is_deterministic_and_merges() {
 }
 
 /// The reference README's regions (rows, columns inclusive), plus the floor's shadow beside the
-/// mirror sphere, as in tests/physical.rs.
+/// mirror sphere, as in physical.rs.
 const REGIONS: [Region; 7] = [
     ("glass caustic", (135, 139), (41, 45)),
     ("lit floor", (150, 158), (60, 90)),
@@ -106,7 +104,7 @@ const REGIONS: [Region; 7] = [
 ];
 
 /// The reference's particle tracer stops at 10 path segments; photons of at most 8 bounces meet
-/// at most 9 surfaces before the eye: `--depth` 8 (tests/physical.rs, REFERENCE_DEPTH).
+/// at most 9 surfaces before the eye: `--depth` 8 (physical.rs, REFERENCE_DEPTH).
 const REFERENCE_PHOTON_DEPTH: u32 = 8;
 
 /// On the point-light Cornell box light tracing reaches the focus of the glass sphere's caustic

@@ -1,7 +1,7 @@
 //! The course model's photon pass: how the budget is shared between lights, that it is stored
 //! exactly, and that a scene where no caustic can form stops at once and says why.
 
-mod common;
+use crate::common;
 
 use caustica::math::luminance;
 use caustica::photon::budget::trace_photons;

@@ -4,7 +4,7 @@
 //! Every shape here is convex, so a ray leaving a point of its surface to the outside can never
 //! meet it again: any hit on the way out is the surface shadowing itself.
 
-mod common;
+use crate::common;
 
 use caustica::integrator::whitted::{radiance, WhittedSettings};
 use caustica::material::SurfaceParams;

@@ -2,8 +2,7 @@
 //! images from an independent renderer (Mitsuba 3's particle tracer, in `../shared/reference/`;
 //! those tests skip when the folder is absent).
 
-mod common;
-
+use crate::common::{control, load_reference, rel, render_passes, report, scene, Region};
 use caustica::film::Film;
 use caustica::integrator::config::{scattering_surfaces, IntegratorKind, Model};
 use caustica::integrator::gi::{Gi, GiSettings};
@@ -12,7 +11,6 @@ use caustica::integrator::path::{PathSettings, PathTracer};
 use caustica::integrator::ppm::{Ppm, PpmSettings};
 use caustica::integrator::{partial::Accumulator, Progressive, RenderConfig, RenderSession};
 use caustica::math::Vec3;
-use common::{control, load_reference, rel, render_passes, report, scene, Region};
 
 fn mean(film: &Film) -> Vec3 {
     film.region_mean((0, film.height - 1), (0, film.width - 1))

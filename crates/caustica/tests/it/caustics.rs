@@ -1,6 +1,6 @@
 //! Caustic photon maps against analytic answers.
 
-mod common;
+use crate::common;
 
 use caustica::integrator::whitted::transmittance;
 use caustica::light::distance_attenuation;

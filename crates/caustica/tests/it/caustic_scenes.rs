@@ -7,14 +7,12 @@
 //! F = centre + 1.5 R · sun direction. The floor there must be several times brighter than open,
 //! sunlit floor.
 
-mod common;
-
+use crate::common::{control, uv_sphere};
 use caustica::film::Film;
 use caustica::integrator::config::{IntegratorKind, Model};
 use caustica::integrator::{RenderConfig, RenderSession};
 use caustica::loader::{load, LoadSettings};
 use caustica::scene::Scene;
-use common::{control, uv_sphere};
 use glam::{Mat3, Quat, Vec3};
 use std::path::{Path, PathBuf};
 

@@ -2,7 +2,7 @@
 //! sparse photons must give a smooth low glow (no disc around each photon), a dense cluster its
 //! own irradiance with a sharp edge.
 
-mod common;
+use crate::common;
 
 use caustica::math::Vec3;
 use caustica::photon::{EstimateSettings, Estimator, Photon, PhotonMap, PhotonStats};

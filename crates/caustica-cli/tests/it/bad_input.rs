@@ -121,12 +121,18 @@ fn catalogue() -> Vec<Case> {
             &["expected `,` between the numbers of a 3-tuple"],
         )
         .at("2:26"),
+        // A fork's Warn light is read, and one without its aim is refused at its place.
         case(
-            "student_extension",
+            "warn_light_without_direction",
             staged("warn_light { position = (0, 0, 0); color = (1, 1, 1); }\n"),
-            &["`warn_light` is a student extension"],
+            &["`warn_light` needs a `direction`"],
         )
         .at("4:1"),
+        // An object no fork's skeleton explains is skipped with a located warning.
+        case("unknown_object", staged("meteorite { speed = 3; }\nsphere {}\n"), &["skipped `meteorite { … }`"])
+            .run(Run::RenderLoud)
+            .succeeds()
+            .at("4:1"),
         // Meshes.
         case(
             "face_index_out_of_range",
@@ -268,7 +274,7 @@ fn crc32(bytes: &[u8]) -> u32 {
     !crc
 }
 
-/// The report with miette's wrapping undone: box-drawing margins dropped, whitespace collapsed.
+/// The report with its whitespace collapsed (margins and line breaks of the excerpt).
 fn flatten(stderr: &str) -> String {
     stderr
         .replace('│', " ")
@@ -375,5 +381,99 @@ fn a_missing_scene_file_is_bad_input() {
         .code(2);
     let stderr = String::from_utf8_lossy(&assert.get_output().stderr).into_owned();
     assert!(stderr.contains("absent.ray"), "{stderr}");
+    assert!(!out.exists());
+}
+
+/// An error past column 65,535 of a one-line file (the column a report could once not pad to):
+/// every command refuses it with exit 2 and a short located report, as text and as JSON.
+#[test]
+fn an_error_far_along_one_long_line_gets_a_short_located_report() {
+    let dir = temp_dir("long-line");
+    let gltf = dir.join("cut.gltf");
+    let body = format!(
+        "{{\"asset\":{{\"version\":\"2.0\"}},\"extras\":{{\"note\":\"{}\"}},\"scenes\":[{{\"nodes\":[0",
+        "x".repeat(100_000)
+    );
+    std::fs::write(&gltf, &body).unwrap();
+    let ray = dir.join("long.ray");
+    std::fs::write(
+        &ray,
+        format!(
+            "{STAGE}polymesh {{ points = ({}(1, 2, oops)); }}\n",
+            "(0, 0, 0), ".repeat(9_000)
+        ),
+    )
+    .unwrap();
+    let out = dir.join("out.png");
+    for (scene, column_past) in [(&gltf, 100_000), (&ray, 99_000)] {
+        for command in [&["render"][..], &["info"], &["photons"], &["render", "--json"]] {
+            let mut cmd = Command::cargo_bin("caustica").unwrap();
+            cmd.args(command).arg(scene);
+            if command[0] != "info" {
+                cmd.arg("-o").arg(&out);
+            }
+            let output = cmd.output().unwrap();
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            let what = format!("{command:?} {}", scene.display());
+            assert_eq!(output.status.code(), Some(2), "{what}: {stderr}");
+            assert!(!stderr.contains("panicked"), "{what}: {stderr}");
+            assert!(stderr.lines().all(|l| l.chars().count() < 300), "{what}: {stderr}");
+            let first = stderr.lines().next().unwrap_or_default();
+            let column: usize = first
+                .split(':')
+                .nth(if first.starts_with("error: ") { 3 } else { 2 })
+                .and_then(|c| c.parse().ok())
+                .unwrap_or_else(|| panic!("{what}: no file:line:col in {first}"));
+            assert!(column > column_past, "{what}: column {column}");
+            assert!(stderr.contains('^') && stderr.contains('…'), "{what}: {stderr}");
+            if command.contains(&"--json") {
+                let stdout = String::from_utf8_lossy(&output.stdout);
+                let json: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+                assert_eq!(json["error"]["kind"], "scene", "{stdout}");
+                assert_eq!(json["error"]["excerpt"]["column"], column, "{stdout}");
+                assert!(json["error"]["excerpt"]["text"].as_str().unwrap().chars().count() < 200);
+            }
+            assert!(!out.exists(), "{what} wrote an image");
+        }
+    }
+}
+
+/// Each exit code of the contract, from the release binary: 0 done, 2 bad input, 1 a bug (a
+/// panic on a worker thread, reported in one line without a backtrace).
+#[test]
+fn every_exit_code_means_what_the_help_says() {
+    let dir = temp_dir("exit-codes");
+    let scene = dir.join("ok.ray");
+    std::fs::write(&scene, staged("sphere {}\n")).unwrap();
+    let out = dir.join("ok.png");
+    let run = |extra: &[&str], panic: bool| {
+        let mut cmd = Command::cargo_bin("caustica").unwrap();
+        cmd.arg("render")
+            .arg(&scene)
+            .arg("-o")
+            .arg(&out)
+            .args(["--width", "8", "--quiet"]);
+        cmd.args(extra).env_remove("RUST_BACKTRACE");
+        if panic {
+            cmd.env("CAUSTICA_TEST_PANIC", "1");
+        }
+        cmd.output().unwrap()
+    };
+    assert_eq!(run(&[], false).status.code(), Some(0));
+    assert!(out.exists());
+    std::fs::remove_file(&out).unwrap();
+    assert_eq!(run(&["--aa", "0"], false).status.code(), Some(2));
+    let bug = run(&[], true);
+    let stderr = String::from_utf8_lossy(&bug.stderr);
+    assert_eq!(bug.status.code(), Some(1), "{stderr}");
+    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
+    assert!(
+        stderr.contains("internal error") && stderr.contains("a bug"),
+        "{stderr}"
+    );
+    assert!(
+        !stderr.contains("backtrace") && !stderr.contains("panicked"),
+        "{stderr}"
+    );
     assert!(!out.exists());
 }

@@ -4,7 +4,7 @@
 //! tracer makes too; those are listed below with the reason.
 //!
 //! It renders ~190 scenes (about a minute on two cores with `--release`), so it runs on request:
-//! `cargo test --release -p caustica --test corpus_render -- --ignored --nocapture`.
+//! `cargo test --release -p caustica --test it corpus_render -- --ignored --nocapture`.
 
 use caustica::error::Error;
 use caustica::integrator::{RenderConfig, RenderSession};
@@ -21,6 +21,14 @@ fn corpus_dir() -> PathBuf {
 /// Scenes whose course renders are black in the course ray tracer as well: (file, why).
 const BLACK_BY_DESIGN: &[(&str, &str)] = &[
     ("danvim__COMP4411-Trace__blank.ray", "an empty scene"),
+    (
+        "danvim__COMP4411-Trace__particles.ray",
+        "its only object is a particle system, skipped with a warning",
+    ),
+    (
+        "snowboat__RayTracingS17__emptyScene-testHeightField.ray",
+        "no object, only a Warn light",
+    ),
     ("michaelasper__ray-tracer__scene_blank.ray", "an empty scene"),
     (
         "StormyEmery__Computer-Graphics_RayTracer__box.ray",

@@ -1,8 +1,7 @@
 //! Spectral transport and dispersion against Snell's law, spectral against RGB rendering, and
 //! the sun against its limit, a directional light.
 
-mod common;
-
+use crate::common::{control, scene};
 use caustica::integrator::{RenderConfig, RenderSession};
 use caustica::loader::{load, LoadSettings};
 use caustica::math::Vec3;
@@ -11,7 +10,6 @@ use caustica::photon::trace::trace_count;
 use caustica::photon::{Photon, DISPERSED, REFRACTED};
 use caustica::scene::Scene;
 use caustica::spectrum::{cauchy_index, Wavelengths, CHANNEL_WAVELENGTHS};
-use common::{control, scene};
 use std::path::PathBuf;
 
 /// A 60° prism of flint glass (n_d 1.62, V 36.4) along z, apex up, lit from the left by a

@@ -2,14 +2,12 @@
 //! shadow's penumbra, a spot light's cone in the forks' spellings, HKUST point lights that do not
 //! fall off, skybox faces as the background, and CSG, torus and metaball silhouettes.
 
-mod common;
-
+use crate::common::scene;
 use caustica::integrator::whitted::{self, WhittedSettings};
 use caustica::loader::{from_text, LoadSettings};
 use caustica::math::{Ray, Vec3};
 use caustica::sampling::Rng;
 use caustica::scene::Scene;
-use common::scene;
 use std::path::Path;
 
 /// The course model's value along `ray` (no caustics).
