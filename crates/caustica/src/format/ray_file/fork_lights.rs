@@ -213,6 +213,18 @@ impl LightFields {
         }
     }
 
+    /// A `cutoff_distance`, which no light here models, gets a warning at its place.
+    fn warn_cutoff(&self, warnings: &mut Vec<(String, Span)>) {
+        if let Some((c, span)) = self.num("cutoff_distance") {
+            warnings.push((
+                format!(
+                    "`cutoff_distance = {c}` is not modelled: the light falls off with its attenuation coefficients instead of (1 − d/{c})²"
+                ),
+                span,
+            ));
+        }
+    }
+
     fn required(&self, what: &str, key: &str, block: &Span) -> ParseError {
         ParseError::new(format!("`{what}` needs a `{key}`"), block.clone())
     }
@@ -316,12 +328,7 @@ impl LightFields {
             other => other.map_or(0.0, |(e, _)| e),
         };
         let mut warnings = self.warnings.clone();
-        if let Some((c, span)) = self.num("cutoff_distance") {
-            warnings.push((
-                format!("`cutoff_distance = {c}` is not modelled: the light falls off with its attenuation coefficients instead of (1 − d/{c})²"),
-                span,
-            ));
-        }
+        self.warn_cutoff(&mut warnings);
         Ok((
             LightDesc::Spot {
                 position,
@@ -402,14 +409,7 @@ impl LightFields {
                 start..end,
             ));
         }
-        if let Some((c, span)) = self.num("cutoff_distance") {
-            warnings.push((
-                format!(
-                    "`cutoff_distance = {c}` is not modelled: the light falls off with its attenuation coefficients"
-                ),
-                span,
-            ));
-        }
+        self.warn_cutoff(&mut warnings);
         Ok((
             LightDesc::Spot {
                 position,
