@@ -700,8 +700,9 @@ impl KdTree {
         reach
     }
 
-    /// Calls `f(slot, dist2)` for every item whose ball (its radius in `reach`, or `floor` if
-    /// larger) holds `p` strictly inside, in tree order. A NaN query point finds nothing.
+    /// Calls `f(slot, dist2)` for every item whose ball (its radius in `reach`) holds `p`
+    /// strictly inside, or that lies within `floor` of it, in tree order. A NaN query point
+    /// finds nothing.
     pub fn for_each_reaching<T: KdPoint>(
         &self,
         reach: &Reach,
@@ -737,19 +738,97 @@ impl KdTree {
                 continue;
             }
             if cur.size == 0 {
-                for slot in cur.lo..cur.lo + cur.len {
-                    let d2 = dist2(items[slot as usize].position().to_array(), q);
-                    let r = reach.radius[slot as usize];
-                    if d2 < r * r || d2 < floor2 {
-                        f(slot, d2);
-                    }
-                }
+                reaching_in_leaf(reach, items, cur.lo..cur.lo + cur.len, q, floor2, &mut f);
                 continue;
             }
             let (left, right) = children(cur);
             stack[sp] = right;
             stack[sp + 1] = left;
             sp += 2;
+        }
+    }
+
+    /// The leaves (as item ranges, in tree order) that [`KdTree::for_each_reaching`] may visit
+    /// for any point within `delta` of `p` and any floor up to `floor`: a superset, so
+    /// [`KdTree::for_each_reaching_among`] over them finds, for such a point, what the whole
+    /// tree would, in the same order. Nearby queries (the samples of one pixel) then share one
+    /// descent of the tree.
+    pub fn leaves_reaching_near(&self, reach: &Reach, p: Vec3, floor: f32, delta: f32, out: &mut Vec<(u32, u32)>) {
+        out.clear();
+        if p.is_nan() || self.len == 0 || delta.is_nan() || delta < 0.0 || floor.is_nan() || floor < 0.0 {
+            return;
+        }
+        let q = p.to_array();
+        // Rounding of the box distances, which are taken from coordinates as large as |p|.
+        let slack = delta * 1.01 + 1e-5 * (1.0 + p.abs().max_element());
+        let near2 = slack * slack;
+        let floor2 = (floor + slack) * (floor + slack);
+        let mut stack = [Subtree::default(); SEARCH_STACK];
+        let mut sp = 1;
+        stack[0] = Subtree {
+            size: self.nodes.len() as u32,
+            len: self.len,
+            ..Subtree::default()
+        };
+        while sp > 0 {
+            sp -= 1;
+            let cur = stack[sp];
+            let (balls, points) = if cur.size == 0 {
+                (&reach.leaves[cur.leaf as usize], &self.leaves[cur.leaf as usize])
+            } else {
+                (&reach.inner[cur.node as usize], &self.inner[cur.node as usize])
+            };
+            if balls.dist2(q) > near2 && points.dist2(q) >= floor2 {
+                continue;
+            }
+            if cur.size == 0 {
+                out.push((cur.lo, cur.len));
+                continue;
+            }
+            let (left, right) = children(cur);
+            stack[sp] = right;
+            stack[sp + 1] = left;
+            sp += 2;
+        }
+    }
+
+    /// [`KdTree::for_each_reaching`] over the leaves [`KdTree::leaves_reaching_near`] found
+    /// near `p`.
+    pub fn for_each_reaching_among<T: KdPoint>(
+        &self,
+        reach: &Reach,
+        items: &[T],
+        leaves: &[(u32, u32)],
+        p: Vec3,
+        floor: f32,
+        mut f: impl FnMut(u32, f32),
+    ) {
+        assert!(items.len() == self.len() && reach.radius.len() == self.len());
+        if p.is_nan() {
+            return;
+        }
+        let floor2 = strict_bound(floor.max(0.0) * floor.max(0.0));
+        for &(lo, len) in leaves {
+            reaching_in_leaf(reach, items, lo..lo + len, p.to_array(), floor2, &mut f);
+        }
+    }
+}
+
+/// Calls `f(slot, dist2)` for the items of `slots` whose ball, or the floor's, holds `q`.
+#[inline(always)]
+fn reaching_in_leaf<T: KdPoint>(
+    reach: &Reach,
+    items: &[T],
+    slots: std::ops::Range<u32>,
+    q: [f32; 3],
+    floor2: f32,
+    f: &mut impl FnMut(u32, f32),
+) {
+    for slot in slots {
+        let d2 = dist2(items[slot as usize].position().to_array(), q);
+        let r = reach.radius[slot as usize];
+        if d2 < r * r || d2 < floor2 {
+            f(slot, d2);
         }
     }
 }

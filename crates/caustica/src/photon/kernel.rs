@@ -151,6 +151,92 @@ fn leaf_radii(
     radii
 }
 
+/// The kernels over a photon map: each photon's radius with the tree's reach over them, and the
+/// photons' normals and incoming directions decoded once, in tree order (an estimate visits a
+/// hundred kernels, and decoding them at every visit was a third of its time).
+pub(super) struct Kernels {
+    pub reach: Reach,
+    /// Unit normal and the direction the light came from (toward where it came from), per photon.
+    decoded: Vec<(Vec3, Vec3)>,
+}
+
+impl Kernels {
+    /// Kernels of `radii` (in tree order) over `photons`.
+    pub fn new(tree: &KdTree, photons: &[Photon], radii: Vec<f32>) -> Kernels {
+        Kernels {
+            reach: tree.reach(photons, radii),
+            decoded: photons.iter().map(|p| (p.normal(), -p.direction())).collect(),
+        }
+    }
+
+    /// Heap bytes they own.
+    pub fn heap_bytes(&self) -> usize {
+        self.reach.heap_bytes() + self.decoded.capacity() * std::mem::size_of::<(Vec3, Vec3)>()
+    }
+}
+
+/// The leaves around the last few points estimated on one thread, each list good for any point
+/// within its `delta` and any floor up to its own: the samples of a pixel, and of the pixels
+/// next to it, share one descent of the tree (it was two thirds of an estimate's visits).
+#[derive(Default)]
+pub(super) struct NearLeaves {
+    entries: Vec<NearEntry>,
+    next: usize,
+}
+
+struct NearEntry {
+    /// [`super::map::PhotonMap`]'s identity: the lists belong to one map's tree.
+    map: u64,
+    centre: Vec3,
+    delta: f32,
+    floor: f32,
+    leaves: Vec<(u32, u32)>,
+}
+
+/// Lists kept per thread: a camera path's points at its first few depths.
+const NEAR_ENTRIES: usize = 4;
+/// How far around its point a list serves, in floors (half a pixel each): a pixel and a half.
+const NEAR_FLOORS: f32 = 3.0;
+/// The widest floor a list serves, in floors of the point it was made for (the floor grows
+/// with the camera distance, a little across a pixel).
+const NEAR_FLOOR_SLACK: f32 = 1.25;
+
+impl NearLeaves {
+    /// The leaves an estimate at `p` with `floor` visits, from a list made nearby or a new one.
+    fn leaves(&mut self, map: u64, tree: &KdTree, reach: &Reach, p: Vec3, floor: f32) -> &[(u32, u32)] {
+        let found = self
+            .entries
+            .iter()
+            .position(|e| e.map == map && floor <= e.floor && p.distance(e.centre) <= e.delta);
+        let i = match found {
+            Some(i) => i,
+            None => {
+                let entry = NearEntry {
+                    map,
+                    centre: p,
+                    delta: NEAR_FLOORS * floor,
+                    floor: NEAR_FLOOR_SLACK * floor,
+                    leaves: Vec::new(),
+                };
+                let i = if self.entries.len() < NEAR_ENTRIES {
+                    self.entries.push(entry);
+                    self.entries.len() - 1
+                } else {
+                    let i = self.next;
+                    self.next = (self.next + 1) % NEAR_ENTRIES;
+                    let leaves = std::mem::take(&mut self.entries[i].leaves);
+                    self.entries[i] = NearEntry { leaves, ..entry };
+                    i
+                };
+                let e = &mut self.entries[i];
+                tree.leaves_reaching_near(reach, e.centre, e.floor, e.delta, &mut e.leaves);
+                i
+            }
+        };
+        &self.entries[i].leaves
+    }
+}
+
 /// How one estimate gathers.
 pub(super) struct Gather<'a> {
     pub scene: &'a Scene,
@@ -171,8 +257,9 @@ pub(super) struct Gather<'a> {
 pub(super) fn estimate(
     gather: &Gather,
     tree: &KdTree,
-    reach: &Reach,
+    kernels: &Kernels,
     photons: &[Photon],
+    (map, near): (u64, &mut NearLeaves),
     candidates: &mut Vec<Neighbor>,
     reflectance: impl Fn(Vec3) -> Vec3,
 ) -> (Vec3, f32) {
@@ -186,23 +273,30 @@ pub(super) fn estimate(
     } = *gather;
     let point = hit.point;
     let floor = min_radius.min(max_radius);
+    let reach = &kernels.reach;
     // The photons on this surface whose kernel (widened to the floor) holds the point.
     candidates.clear();
     let mut widest = 0.0f32;
     let mut narrowest = f32::INFINITY;
-    tree.for_each_reaching(reach, photons, point, floor, |slot, dist2| {
+    let mut accept = |slot, dist2| {
         let photon = &photons[slot as usize];
         let r = reach.radius(slot).max(floor);
         if dist2 >= r * r || (photon.position - point).dot(n).abs() > gather.max_plane_distance * r {
             return;
         }
-        if photon.normal().dot(n) < gather.min_normal_cosine {
+        if kernels.decoded[slot as usize].0.dot(n) < gather.min_normal_cosine {
             return;
         }
         widest = widest.max(r);
         narrowest = narrowest.min(r);
         candidates.push(Neighbor { slot, dist2 });
-    });
+    };
+    if floor > 0.0 && floor.is_finite() {
+        let leaves = near.leaves(map, tree, reach, point, floor);
+        tree.for_each_reaching_among(reach, photons, leaves, point, floor, &mut accept);
+    } else {
+        tree.for_each_reaching(reach, photons, point, floor, &mut accept);
+    }
     if candidates.is_empty() {
         return (Vec3::ZERO, 0.0);
     }
@@ -214,7 +308,7 @@ pub(super) fn estimate(
     let mut sum = Vec3::ZERO;
     for nb in candidates.iter() {
         let photon = &photons[nb.slot as usize];
-        let f = reflectance(-photon.direction());
+        let f = reflectance(kernels.decoded[nb.slot as usize].1);
         if f == Vec3::ZERO {
             continue;
         }

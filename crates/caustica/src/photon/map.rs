@@ -20,8 +20,8 @@
 //!   [`PhotonMap::radiance_nearest`]), with the BSDF the camera paths use.
 
 use super::budget::{trace_photons, PhotonSettings, PhotonStats};
-use super::kd_tree::{KdTree, Neighbor, Reach};
-use super::kernel::{self, Gather};
+use super::kd_tree::{KdTree, Neighbor};
+use super::kernel::{self, Gather, Kernels, NearLeaves};
 use super::{Photon, DISPERSED};
 use crate::bsdf::Bsdf;
 use crate::material::SurfaceParams;
@@ -94,9 +94,18 @@ pub struct PhotonMap {
     tree: KdTree,
     auto_radius: f32,
     /// The photons' kernels, for the kernel estimate.
-    reach: Option<Reach>,
+    kernels: Option<Kernels>,
     /// What the photon pass did.
     pub stats: PhotonStats,
+    /// Tells this map's per-thread lists of leaves from another's.
+    id: u64,
+}
+
+/// The next [`PhotonMap`]'s identity.
+static NEXT_MAP_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+fn next_map_id() -> u64 {
+    NEXT_MAP_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
 }
 
 /// A nearby estimate's radius times this bounds the first photon search: the density rarely
@@ -105,6 +114,7 @@ const NARROW_SCALE: f32 = 1.5;
 
 thread_local! {
     static NEIGHBORS: RefCell<Vec<Neighbor>> = const { RefCell::new(Vec::new()) };
+    static NEAR_LEAVES: RefCell<NearLeaves> = RefCell::new(NearLeaves::default());
 }
 
 impl PhotonMap {
@@ -121,8 +131,9 @@ impl PhotonMap {
             photons,
             tree,
             auto_radius: 0.0,
-            reach: None,
+            kernels: None,
             stats: PhotonStats::default(),
+            id: next_map_id(),
         }
     }
 
@@ -134,8 +145,9 @@ impl PhotonMap {
             photons,
             tree,
             auto_radius: 0.0,
-            reach: None,
+            kernels: None,
             stats,
+            id: next_map_id(),
         };
         let k = estimate.k.max(1);
         match estimate.estimator {
@@ -152,7 +164,7 @@ impl PhotonMap {
                 };
                 let max_radius = estimate.max_radius.unwrap_or(map.auto_radius);
                 let radii = kernel::kernel_radii(&map.tree, &map.photons, k, max_radius, estimate.min_normal_cosine);
-                map.reach = Some(map.tree.reach(&map.photons, radii));
+                map.kernels = Some(Kernels::new(&map.tree, &map.photons, radii));
             }
         }
         map
@@ -172,7 +184,7 @@ impl PhotonMap {
     pub fn heap_bytes(&self) -> usize {
         self.photons.capacity() * std::mem::size_of::<Photon>()
             + self.tree.heap_bytes()
-            + self.reach.as_ref().map_or(0, Reach::heap_bytes)
+            + self.kernels.as_ref().map_or(0, Kernels::heap_bytes)
     }
 
     /// Whether the map holds no photon.
@@ -270,8 +282,8 @@ impl PhotonMap {
         if max_r.is_nan() || max_r <= 0.0 {
             return (Vec3::ZERO, 0.0);
         }
-        match (settings.estimator, &self.reach) {
-            (Estimator::Kernels, Some(reach)) => {
+        match (settings.estimator, &self.kernels) {
+            (Estimator::Kernels, Some(kernels)) => {
                 let gather = Gather {
                     scene,
                     hit,
@@ -283,14 +295,17 @@ impl PhotonMap {
                     max_plane_distance: settings.max_plane_distance,
                 };
                 NEIGHBORS.with(|cell| {
-                    kernel::estimate(
-                        &gather,
-                        &self.tree,
-                        reach,
-                        &self.photons,
-                        &mut cell.borrow_mut(),
-                        reflectance,
-                    )
+                    NEAR_LEAVES.with(|near| {
+                        kernel::estimate(
+                            &gather,
+                            &self.tree,
+                            kernels,
+                            &self.photons,
+                            (self.id, &mut near.borrow_mut()),
+                            &mut cell.borrow_mut(),
+                            reflectance,
+                        )
+                    })
                 })
             }
             (Estimator::Kernels, None) => panic!("the photon map was built without kernels"),

@@ -239,3 +239,39 @@ fn reflection2_has_no_polka_dots() {
         "{with} dots with caustics, {without} without"
     );
 }
+
+/// The kernel estimate keeps, per thread, the tree's leaves near its last points; a second map
+/// estimated at the same points on the same thread must give its own values, exactly those a
+/// fresh thread gives, and so must nearby points sharing a list.
+#[test]
+fn nearby_estimates_share_leaves_only_within_their_own_map() {
+    let scene = common::scene(FLOOR);
+    let estimate = EstimateSettings::default();
+    let a = map(&estimate);
+    // Another tree: fewer photons, moved.
+    let shifted: Vec<Photon> = photons()
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| i % 3 != 0)
+        .map(|(_, p)| photon(p.position + Vec3::new(0.003, -0.002, 0.0)))
+        .collect();
+    let b = PhotonMap::from_photons(shifted, PhotonStats::default(), &estimate);
+    // Points across the cluster's edge, a pixel (0.004 here) or less apart.
+    let points: Vec<Vec3> = (0..400)
+        .map(|i| CLUSTER + Vec3::new(0.46 + 0.0011 * i as f32, 0.0007 * (i % 7) as f32, 0.0))
+        .collect();
+    let at = |map: &PhotonMap, p: Vec3| -> [f32; 4] {
+        let ray = caustica::math::Ray::new(p + Vec3::Z * 1e-3, -Vec3::Z);
+        let isect = scene.intersect(&ray, 2e-3).expect("the floor");
+        let hit = scene.surface(&ray, &isect);
+        let (e, r) = map.irradiance(&scene, &hit, Vec3::Z, &estimate, 0.004);
+        [e.x, e.y, e.z, r]
+    };
+    let values = |map: &PhotonMap| -> Vec<[f32; 4]> { points.iter().map(|&p| at(map, p)).collect() };
+    let fresh = |map: &PhotonMap| std::thread::scope(|s| s.spawn(|| values(map)).join().unwrap());
+    // Both maps at each point in turn, on this thread.
+    let (a_here, b_here): (Vec<_>, Vec<_>) = points.iter().map(|&p| (at(&a, p), at(&b, p))).unzip();
+    assert_eq!(a_here, fresh(&a));
+    assert_eq!(b_here, fresh(&b));
+    assert_ne!(a_here, b_here, "the two maps differ here");
+}

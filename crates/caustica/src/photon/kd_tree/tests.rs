@@ -408,3 +408,55 @@ fn tree_overhead_is_small() {
         assert!(n.div_ceil(nodes + 1) <= LEAF_MAX);
     }
 }
+
+/// Every (slot, dist2) whose ball strictly holds `p`, or within the floor (inclusive), in slot
+/// order.
+fn brute_reaching<T: KdPoint>(items: &[T], radius: &[f32], p: Vec3, floor: f32) -> Vec<(u32, f32)> {
+    let floor2 = floor * floor;
+    (0..items.len())
+        .filter_map(|i| {
+            let d2 = dist2(items[i].position().to_array(), p.to_array());
+            (d2 < radius[i] * radius[i] || d2 <= floor2).then_some((i as u32, d2))
+        })
+        .collect()
+}
+
+#[test]
+fn reaching_matches_brute_force_and_near_leaves_serve_nearby_points() {
+    let mut rng = Rng(9);
+    let mut leaves = Vec::new();
+    for (name, gen) in GENERATORS {
+        for n in [0, 1, 13, 100, 1000, 4000] {
+            let pts = gen(&mut rng, n);
+            let mut items = items_of(&pts);
+            let tree = KdTree::build(&mut items);
+            // Radii from tiny to wide, some zero, so balls of every size overlap.
+            let radius: Vec<f32> = (0..n)
+                .map(|i| if i % 7 == 0 { 0.0 } else { 0.3 * rng.f() * rng.f() })
+                .collect();
+            let reach = tree.reach(&items, radius.clone());
+            let pts: Vec<Vec3> = items.iter().map(|i| i.pos).collect();
+            for p in queries(&mut rng, &pts) {
+                for floor in [0.0, 1e-3, 0.02] {
+                    let ctx = format!("{name} n={n} p={p} floor={floor}");
+                    let mut found = Vec::new();
+                    tree.for_each_reaching(&reach, &items, p, floor, |slot, d2| found.push((slot, d2)));
+                    assert_eq!(found, brute_reaching(&items, &radius, p, floor), "{ctx}");
+                    // A list made around p serves points within delta and floors up to its own.
+                    let delta = 0.01;
+                    tree.leaves_reaching_near(&reach, p, floor, delta, &mut leaves);
+                    for _ in 0..8 {
+                        let dir = (rng.vec() - Vec3::splat(0.5)).normalize_or_zero();
+                        let q = p + dir * (delta * rng.f());
+                        let f = floor * rng.f();
+                        let mut near = Vec::new();
+                        tree.for_each_reaching_among(&reach, &items, &leaves, q, f, |slot, d2| near.push((slot, d2)));
+                        let mut whole = Vec::new();
+                        tree.for_each_reaching(&reach, &items, q, f, |slot, d2| whole.push((slot, d2)));
+                        assert_eq!(near, whole, "{ctx} q={q} f={f}");
+                    }
+                }
+            }
+        }
+    }
+}
