@@ -124,31 +124,99 @@ fn leaf_radii(
         let q = &photons[slot as usize];
         scratch.candidates.push((q.position, q.normal_code(), q.normal()));
     });
-    for photon in &leaf[1..] {
+    let mut r_done = vec![r0.sqrt()];
+    for (i, photon) in leaf.iter().enumerate().skip(1) {
         // The ball around this photon that the gathered candidates surely cover.
         let covered = reach - (photon.position - centre).length() - MARGIN * reach;
-        let (code, normal) = (photon.normal_code(), photon.normal());
-        scratch.dist2.clear();
-        for &(position, c, n) in &scratch.candidates {
-            if c == code || n.dot(normal) >= min_normal_cosine {
-                let d2 = KdTree::dist2(position, photon.position);
-                if d2 <= max2 {
-                    scratch.dist2.push(d2);
-                }
-            }
-        }
-        let everything = covered > max_radius * (1.0 + MARGIN);
-        let found = scratch.dist2.len();
-        let r2 = if found >= k {
-            let (_, kth, _) = scratch.dist2.select_nth_unstable_by(k - 1, f32::total_cmp);
-            let kth = *kth;
-            (everything || (covered > 0.0 && kth < covered * covered)).then_some(kth)
-        } else {
-            everything.then_some(max2)
-        };
-        radii.push(r2.unwrap_or_else(|| tree_search(photon, &mut scratch.neighbors)));
+        // The nearest leaf-mate done on the same surface (the same normal code, so the same
+        // photons count for both) bounds this one's radius to its own ± their distance.
+        let mate = (0..i)
+            .filter(|&j| leaf[j].normal_code() == photon.normal_code())
+            .map(|j| (leaf[j].position.distance(photon.position), r_done[j]))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        let r2 = mate
+            .and_then(|(e, r)| band_kth(photon, r, e, covered, k, max2, min_normal_cosine, scratch))
+            .or_else(|| covered_kth(photon, covered, k, max2, min_normal_cosine, scratch));
+        let r2 = r2.unwrap_or_else(|| tree_search(photon, &mut scratch.neighbors));
+        r_done.push(r2.sqrt());
+        radii.push(r2);
     }
     radii
+}
+
+/// The k-th squared distance from `photon` among the gathered candidates on its surface, when
+/// it lies within `e` of `r`: those nearer than r − e are counted and only those between
+/// r − e and r + e ranked. `None` when the band does not hold the k-th, or reaches past what
+/// the candidates cover.
+#[allow(clippy::too_many_arguments)]
+fn band_kth(
+    photon: &Photon,
+    r: f32,
+    e: f32,
+    covered: f32,
+    k: usize,
+    max2: f32,
+    min_normal_cosine: f32,
+    scratch: &mut LeafScratch,
+) -> Option<f32> {
+    const MARGIN: f32 = 1e-4;
+    let outer = (r + e) * (1.0 + MARGIN);
+    if outer.is_nan() || outer >= covered || k == 0 {
+        return None;
+    }
+    let inner = (r - e) * (1.0 - MARGIN);
+    let inner2 = if inner > 0.0 { inner * inner } else { -1.0 };
+    let outer2 = (outer * outer).min(max2);
+    let (code, normal) = (photon.normal_code(), photon.normal());
+    let at = photon.position;
+    let band = &mut scratch.dist2;
+    band.clear();
+    band.resize(scratch.candidates.len(), 0.0);
+    let (mut nearer, mut in_band) = (0usize, 0usize);
+    for &(position, c, n) in &scratch.candidates {
+        let same = c == code || n.dot(normal) >= min_normal_cosine;
+        let d2 = KdTree::dist2(position, at);
+        nearer += (same & (d2 < inner2)) as usize;
+        band[in_band] = d2;
+        in_band += (same & (d2 >= inner2) & (d2 <= outer2)) as usize;
+    }
+    if nearer >= k || nearer + in_band < k {
+        return None;
+    }
+    let (_, kth, _) = band[..in_band].select_nth_unstable_by(k - 1 - nearer, f32::total_cmp);
+    Some(*kth)
+}
+
+/// The k-th squared distance from `photon` among all the gathered candidates on its surface
+/// (`max2` when fewer than k lie within it), or `None` when they may not hold it.
+fn covered_kth(
+    photon: &Photon,
+    covered: f32,
+    k: usize,
+    max2: f32,
+    min_normal_cosine: f32,
+    scratch: &mut LeafScratch,
+) -> Option<f32> {
+    const MARGIN: f32 = 1e-4;
+    let max_radius = max2.sqrt();
+    let (code, normal) = (photon.normal_code(), photon.normal());
+    scratch.dist2.clear();
+    for &(position, c, n) in &scratch.candidates {
+        if c == code || n.dot(normal) >= min_normal_cosine {
+            let d2 = KdTree::dist2(position, photon.position);
+            if d2 <= max2 {
+                scratch.dist2.push(d2);
+            }
+        }
+    }
+    let everything = covered > max_radius * (1.0 + MARGIN);
+    if scratch.dist2.len() >= k && k > 0 {
+        let (_, kth, _) = scratch.dist2.select_nth_unstable_by(k - 1, f32::total_cmp);
+        let kth = *kth;
+        (everything || (covered > 0.0 && kth < covered * covered)).then_some(kth)
+    } else {
+        everything.then_some(max2)
+    }
 }
 
 /// The kernels over a photon map: each photon's radius with the tree's reach over them, and the
