@@ -19,7 +19,7 @@
 
 use super::kd_tree::{KdTree, Neighbor, Reach};
 use super::Photon;
-use crate::math::Vec3;
+use crate::math::{Vec3, Vec4};
 use crate::scene::{Scene, SurfaceHit};
 use rayon::prelude::*;
 use std::f32::consts::PI;
@@ -35,6 +35,7 @@ use std::f32::consts::PI;
 pub(super) fn kernel_radii(
     tree: &KdTree,
     photons: &[Photon],
+    normals: &[Vec3],
     k: usize,
     max_radius: f32,
     min_normal_cosine: f32,
@@ -46,7 +47,7 @@ pub(super) fn kernel_radii(
         .map_init(LeafScratch::default, |scratch, (range, lo, hi)| {
             leaf_radii(
                 tree,
-                photons,
+                (photons, normals),
                 range.clone(),
                 (*lo, *hi),
                 k,
@@ -68,14 +69,52 @@ struct LeafScratch {
     neighbors: Vec<Neighbor>,
     /// Gathered candidates: position, normal code and normal.
     candidates: Vec<(Vec3, [u8; 2], Vec3)>,
+    /// Their coordinates by axis, padded to whole lanes with far-away points, for the band scan.
+    lanes: [Vec<f32>; 3],
+    /// Which candidates lie on the surface of the normal code `same_code` (1 or 0, padded).
+    same: Vec<f32>,
+    same_code: Option<[u8; 2]>,
     dist2: Vec<f32>,
+}
+
+/// Candidates the band scan tests at once.
+const LANES: usize = 4;
+
+impl LeafScratch {
+    /// Lays the gathered candidates out for the band scan.
+    fn lay_out(&mut self) {
+        for (axis, lane) in self.lanes.iter_mut().enumerate() {
+            lane.clear();
+            lane.extend(self.candidates.iter().map(|c| c.0[axis]));
+            // Padding no band holds: +inf away (and never NaN).
+            lane.resize(self.candidates.len().div_ceil(LANES) * LANES, f32::INFINITY);
+        }
+        self.same_code = None;
+    }
+
+    /// Marks the candidates on the surface of a photon with `code` and `normal`.
+    fn mark_same(&mut self, code: [u8; 2], normal: Vec3, min_normal_cosine: f32) {
+        if self.same_code == Some(code) {
+            return;
+        }
+        self.same.clear();
+        self.same.extend(self.candidates.iter().map(|&(_, c, n)| {
+            if c == code || n.dot(normal) >= min_normal_cosine {
+                1.0
+            } else {
+                0.0
+            }
+        }));
+        self.same.resize(self.lanes[0].len(), 0.0);
+        self.same_code = Some(code);
+    }
 }
 
 /// The squared kernel radii of the photons of one leaf.
 #[allow(clippy::too_many_arguments)]
 fn leaf_radii(
     tree: &KdTree,
-    photons: &[Photon],
+    (photons, normals): (&[Photon], &[Vec3]),
     range: std::ops::Range<usize>,
     (lo, hi): ([f32; 3], [f32; 3]),
     k: usize,
@@ -122,8 +161,11 @@ fn leaf_radii(
     scratch.candidates.clear();
     tree.for_each_within(photons, centre, reach * reach, |slot, _| {
         let q = &photons[slot as usize];
-        scratch.candidates.push((q.position, q.normal_code(), q.normal()));
+        scratch
+            .candidates
+            .push((q.position, q.normal_code(), normals[slot as usize]));
     });
+    scratch.lay_out();
     let mut r_done = vec![r0.sqrt()];
     for (i, photon) in leaf.iter().enumerate().skip(1) {
         // The ball around this photon that the gathered candidates surely cover.
@@ -167,18 +209,36 @@ fn band_kth(
     let inner = (r - e) * (1.0 - MARGIN);
     let inner2 = if inner > 0.0 { inner * inner } else { -1.0 };
     let outer2 = (outer * outer).min(max2);
-    let (code, normal) = (photon.normal_code(), photon.normal());
-    let at = photon.position;
+    scratch.mark_same(photon.normal_code(), photon.normal(), min_normal_cosine);
+    let [px, py, pz] = photon.position.to_array().map(Vec4::splat);
+    let (inner2, outer2) = (Vec4::splat(inner2), Vec4::splat(outer2));
     let band = &mut scratch.dist2;
     band.clear();
-    band.resize(scratch.candidates.len(), 0.0);
+    band.resize(scratch.same.len(), 0.0);
     let (mut nearer, mut in_band) = (0usize, 0usize);
-    for &(position, c, n) in &scratch.candidates {
-        let same = c == code || n.dot(normal) >= min_normal_cosine;
-        let d2 = KdTree::dist2(position, at);
-        nearer += (same & (d2 < inner2)) as usize;
-        band[in_band] = d2;
-        in_band += (same & (d2 >= inner2) & (d2 <= outer2)) as usize;
+    let [xs, ys, zs] = &scratch.lanes;
+    let lanes = xs
+        .chunks_exact(LANES)
+        .zip(ys.chunks_exact(LANES))
+        .zip(zs.chunks_exact(LANES));
+    // Four candidates at a time in glam's Vec4 (vector registers where the target has them),
+    // rounded as `KdTree::dist2` rounds.
+    for (((x, y), z), same) in lanes.zip(scratch.same.chunks_exact(LANES)) {
+        let (dx, dy, dz) = (
+            Vec4::from_slice(x) - px,
+            Vec4::from_slice(y) - py,
+            Vec4::from_slice(z) - pz,
+        );
+        let d2 = dx * dx + dy * dy + dz * dz;
+        let same = Vec4::from_slice(same).cmpeq(Vec4::ONE);
+        nearer += ONES[(same & d2.cmplt(inner2)).bitmask() as usize] as usize;
+        let mut inside = (same & d2.cmpge(inner2) & d2.cmple(outer2)).bitmask();
+        // Few candidates fall in the band: only those are written.
+        while inside != 0 {
+            band[in_band] = d2[inside.trailing_zeros() as usize];
+            in_band += 1;
+            inside &= inside - 1;
+        }
     }
     if nearer >= k || nearer + in_band < k {
         return None;
@@ -186,6 +246,9 @@ fn band_kth(
     let (_, kth, _) = band[..in_band].select_nth_unstable_by(k - 1 - nearer, f32::total_cmp);
     Some(*kth)
 }
+
+/// Set bits in each 4-bit mask.
+const ONES: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
 
 /// The k-th squared distance from `photon` among all the gathered candidates on its surface
 /// (`max2` when fewer than k lie within it), or `None` when they may not hold it.
@@ -224,22 +287,25 @@ fn covered_kth(
 /// hundred kernels, and decoding them at every visit was a third of its time).
 pub(super) struct Kernels {
     pub reach: Reach,
-    /// Unit normal and the direction the light came from (toward where it came from), per photon.
-    decoded: Vec<(Vec3, Vec3)>,
+    /// Unit normals, per photon.
+    normals: Vec<Vec3>,
+    /// The directions the light came from (toward where it came from), per photon.
+    incoming: Vec<Vec3>,
 }
 
 impl Kernels {
-    /// Kernels of `radii` (in tree order) over `photons`.
-    pub fn new(tree: &KdTree, photons: &[Photon], radii: Vec<f32>) -> Kernels {
+    /// Kernels of `radii` over `photons` with their decoded `normals` (all in tree order).
+    pub fn new(tree: &KdTree, photons: &[Photon], normals: Vec<Vec3>, radii: Vec<f32>) -> Kernels {
         Kernels {
             reach: tree.reach(photons, radii),
-            decoded: photons.iter().map(|p| (p.normal(), -p.direction())).collect(),
+            normals,
+            incoming: photons.iter().map(|p| -p.direction()).collect(),
         }
     }
 
     /// Heap bytes they own.
     pub fn heap_bytes(&self) -> usize {
-        self.reach.heap_bytes() + self.decoded.capacity() * std::mem::size_of::<(Vec3, Vec3)>()
+        self.reach.heap_bytes() + (self.normals.capacity() + self.incoming.capacity()) * std::mem::size_of::<Vec3>()
     }
 }
 
@@ -352,7 +418,7 @@ pub(super) fn estimate(
         if dist2 >= r * r || (photon.position - point).dot(n).abs() > gather.max_plane_distance * r {
             return;
         }
-        if kernels.decoded[slot as usize].0.dot(n) < gather.min_normal_cosine {
+        if kernels.normals[slot as usize].dot(n) < gather.min_normal_cosine {
             return;
         }
         widest = widest.max(r);
@@ -376,11 +442,13 @@ pub(super) fn estimate(
     let mut sum = Vec3::ZERO;
     for nb in candidates.iter() {
         let photon = &photons[nb.slot as usize];
-        let f = reflectance(kernels.decoded[nb.slot as usize].1);
+        let f = reflectance(kernels.incoming[nb.slot as usize]);
         if f == Vec3::ZERO {
             continue;
         }
-        if !occluders.is_empty() && !scene.segment_clear_of(&occluders, point, n, photon.position, photon.normal()) {
+        if !occluders.is_empty()
+            && !scene.segment_clear_of(&occluders, point, n, photon.position, kernels.normals[nb.slot as usize])
+        {
             continue;
         }
         let r = reach.radius(nb.slot).max(floor);
@@ -443,7 +511,8 @@ mod tests {
         for mut p in [photons(20_000), crossing(20_000)] {
             let tree = KdTree::build(&mut p);
             for (k, max_radius) in [(1, 0.3), (3, 0.3), (10, 0.05), (100, 0.2), (100, 0.01), (400, 10.0)] {
-                let batched = kernel_radii(&tree, &p, k, max_radius, 0.7);
+                let normals: Vec<Vec3> = p.iter().map(Photon::normal).collect();
+                let batched = kernel_radii(&tree, &p, &normals, k, max_radius, 0.7);
                 let mut out = Vec::new();
                 for (i, photon) in p.iter().enumerate() {
                     let (code, normal) = (photon.normal_code(), photon.normal());

@@ -163,8 +163,16 @@ impl PhotonMap {
                     KERNEL_REACH * bounds.extent().length()
                 };
                 let max_radius = estimate.max_radius.unwrap_or(map.auto_radius);
-                let radii = kernel::kernel_radii(&map.tree, &map.photons, k, max_radius, estimate.min_normal_cosine);
-                map.kernels = Some(Kernels::new(&map.tree, &map.photons, radii));
+                let normals: Vec<Vec3> = map.photons.iter().map(Photon::normal).collect();
+                let radii = kernel::kernel_radii(
+                    &map.tree,
+                    &map.photons,
+                    &normals,
+                    k,
+                    max_radius,
+                    estimate.min_normal_cosine,
+                );
+                map.kernels = Some(Kernels::new(&map.tree, &map.photons, normals, radii));
             }
         }
         map
