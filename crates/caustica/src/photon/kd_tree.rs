@@ -748,18 +748,27 @@ impl KdTree {
         }
     }
 
-    /// The leaves (as item ranges, in tree order) that [`KdTree::for_each_reaching`] may visit
-    /// for any point within `delta` of `p` and any floor up to `floor`: a superset, so
+    /// The items (their slots, in tree order) that [`KdTree::for_each_reaching`] may find for
+    /// any point within `delta` of `p` and any floor up to `floor`: a superset, so
     /// [`KdTree::for_each_reaching_among`] over them finds, for such a point, what the whole
     /// tree would, in the same order. Nearby queries (the samples of one pixel) then share one
-    /// descent of the tree.
-    pub fn leaves_reaching_near(&self, reach: &Reach, p: Vec3, floor: f32, delta: f32, out: &mut Vec<(u32, u32)>) {
+    /// descent of the tree and one pass over its leaves.
+    pub fn reaching_near<T: KdPoint>(
+        &self,
+        reach: &Reach,
+        items: &[T],
+        p: Vec3,
+        floor: f32,
+        delta: f32,
+        out: &mut Vec<u32>,
+    ) {
+        assert!(items.len() == self.len() && reach.radius.len() == self.len());
         out.clear();
         if p.is_nan() || self.len == 0 || delta.is_nan() || delta < 0.0 || floor.is_nan() || floor < 0.0 {
             return;
         }
         let q = p.to_array();
-        // Rounding of the box distances, which are taken from coordinates as large as |p|.
+        // Rounding of the distances, which are taken from coordinates as large as |p|.
         let slack = delta * 1.01 + 1e-5 * (1.0 + p.abs().max_element());
         let near2 = slack * slack;
         let floor2 = (floor + slack) * (floor + slack);
@@ -782,7 +791,14 @@ impl KdTree {
                 continue;
             }
             if cur.size == 0 {
-                out.push((cur.lo, cur.len));
+                // An item reaches a point within delta only if it reaches within delta of `p`.
+                for slot in cur.lo..cur.lo + cur.len {
+                    let d = dist2(items[slot as usize].position().to_array(), q).sqrt();
+                    let r = reach.radius[slot as usize].max(floor);
+                    if d <= (r + slack) * 1.0001 {
+                        out.push(slot);
+                    }
+                }
                 continue;
             }
             let (left, right) = children(cur);
@@ -792,13 +808,12 @@ impl KdTree {
         }
     }
 
-    /// [`KdTree::for_each_reaching`] over the leaves [`KdTree::leaves_reaching_near`] found
-    /// near `p`.
+    /// [`KdTree::for_each_reaching`] over the items [`KdTree::reaching_near`] found near `p`.
     pub fn for_each_reaching_among<T: KdPoint>(
         &self,
         reach: &Reach,
         items: &[T],
-        leaves: &[(u32, u32)],
+        slots: &[u32],
         p: Vec3,
         floor: f32,
         mut f: impl FnMut(u32, f32),
@@ -807,9 +822,14 @@ impl KdTree {
         if p.is_nan() {
             return;
         }
+        let q = p.to_array();
         let floor2 = strict_bound(floor.max(0.0) * floor.max(0.0));
-        for &(lo, len) in leaves {
-            reaching_in_leaf(reach, items, lo..lo + len, p.to_array(), floor2, &mut f);
+        for &slot in slots {
+            let d2 = dist2(items[slot as usize].position().to_array(), q);
+            let r = reach.radius[slot as usize];
+            if d2 < r * r || d2 < floor2 {
+                f(slot, d2);
+            }
         }
     }
 }

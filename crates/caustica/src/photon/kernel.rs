@@ -324,7 +324,7 @@ struct NearEntry {
     centre: Vec3,
     delta: f32,
     floor: f32,
-    leaves: Vec<(u32, u32)>,
+    slots: Vec<u32>,
 }
 
 /// Lists kept per thread: a camera path's points at its first few depths.
@@ -337,7 +337,7 @@ const NEAR_FLOOR_SLACK: f32 = 1.25;
 
 impl NearLeaves {
     /// The leaves an estimate at `p` with `floor` visits, from a list made nearby or a new one.
-    fn leaves(&mut self, map: u64, tree: &KdTree, reach: &Reach, p: Vec3, floor: f32) -> &[(u32, u32)] {
+    fn slots(&mut self, map: u64, tree: &KdTree, (reach, photons): (&Reach, &[Photon]), p: Vec3, floor: f32) -> &[u32] {
         let found = self
             .entries
             .iter()
@@ -350,7 +350,7 @@ impl NearLeaves {
                     centre: p,
                     delta: NEAR_FLOORS * floor,
                     floor: NEAR_FLOOR_SLACK * floor,
-                    leaves: Vec::new(),
+                    slots: Vec::new(),
                 };
                 let i = if self.entries.len() < NEAR_ENTRIES {
                     self.entries.push(entry);
@@ -358,16 +358,16 @@ impl NearLeaves {
                 } else {
                     let i = self.next;
                     self.next = (self.next + 1) % NEAR_ENTRIES;
-                    let leaves = std::mem::take(&mut self.entries[i].leaves);
-                    self.entries[i] = NearEntry { leaves, ..entry };
+                    let slots = std::mem::take(&mut self.entries[i].slots);
+                    self.entries[i] = NearEntry { slots, ..entry };
                     i
                 };
                 let e = &mut self.entries[i];
-                tree.leaves_reaching_near(reach, e.centre, e.floor, e.delta, &mut e.leaves);
+                tree.reaching_near(reach, photons, e.centre, e.floor, e.delta, &mut e.slots);
                 i
             }
         };
-        &self.entries[i].leaves
+        &self.entries[i].slots
     }
 }
 
@@ -426,8 +426,8 @@ pub(super) fn estimate(
         candidates.push(Neighbor { slot, dist2 });
     };
     if floor > 0.0 && floor.is_finite() {
-        let leaves = near.leaves(map, tree, reach, point, floor);
-        tree.for_each_reaching_among(reach, photons, leaves, point, floor, &mut accept);
+        let slots = near.slots(map, tree, (reach, photons), point, floor);
+        tree.for_each_reaching_among(reach, photons, slots, point, floor, &mut accept);
     } else {
         tree.for_each_reaching(reach, photons, point, floor, &mut accept);
     }

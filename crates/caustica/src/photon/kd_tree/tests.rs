@@ -424,7 +424,7 @@ fn brute_reaching<T: KdPoint>(items: &[T], radius: &[f32], p: Vec3, floor: f32) 
 #[test]
 fn reaching_matches_brute_force_and_near_leaves_serve_nearby_points() {
     let mut rng = Rng(9);
-    let mut leaves = Vec::new();
+    let mut slots = Vec::new();
     for (name, gen) in GENERATORS {
         for n in [0, 1, 13, 100, 1000, 4000] {
             let pts = gen(&mut rng, n);
@@ -442,15 +442,15 @@ fn reaching_matches_brute_force_and_near_leaves_serve_nearby_points() {
                     let mut found = Vec::new();
                     tree.for_each_reaching(&reach, &items, p, floor, |slot, d2| found.push((slot, d2)));
                     assert_eq!(found, brute_reaching(&items, &radius, p, floor), "{ctx}");
-                    // A list made around p serves points within delta and floors up to its own.
+                    // Slots listed around p serve points within delta and floors up to its own.
                     let delta = 0.01;
-                    tree.leaves_reaching_near(&reach, p, floor, delta, &mut leaves);
+                    tree.reaching_near(&reach, &items, p, floor, delta, &mut slots);
                     for _ in 0..8 {
                         let dir = (rng.vec() - Vec3::splat(0.5)).normalize_or_zero();
                         let q = p + dir * (delta * rng.f());
                         let f = floor * rng.f();
                         let mut near = Vec::new();
-                        tree.for_each_reaching_among(&reach, &items, &leaves, q, f, |slot, d2| near.push((slot, d2)));
+                        tree.for_each_reaching_among(&reach, &items, &slots, q, f, |slot, d2| near.push((slot, d2)));
                         let mut whole = Vec::new();
                         tree.for_each_reaching(&reach, &items, q, f, |slot, d2| whole.push((slot, d2)));
                         assert_eq!(near, whole, "{ctx} q={q} f={f}");
