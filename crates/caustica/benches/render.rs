@@ -7,7 +7,7 @@
 //!
 //! Settings: 128 pixels wide (height from the camera), 1 sample per pixel (`ring-aa3`: 3×3),
 //! 20,000 stored photons, k = 100, seed 0, all threads. The full-size table comes from
-//! `caustica bench` (BENCHMARKS.md).
+//! `caustica bench` (BENCHMARKS.md, "Whole renders").
 
 use std::hint::black_box;
 use std::path::Path;

@@ -74,7 +74,8 @@ pub struct VcmSettings {
     /// Connect every smooth camera vertex to every vertex of one light subpath (bidirectional
     /// path tracing's inner connections). Off, the strategies are the camera path's own (hitting
     /// emitters, next-event estimation), light tracing and merging, and camera paths cost far
-    /// less; on the Cornell box race that wins (BENCHMARKS.md).
+    /// less; on the Cornell box race that wins (docs/benchmarks/2026-12-02.md, "The caustics
+    /// race: vcm against Mitsuba 3").
     pub connections: bool,
     /// Aim [`AIM_SHARE`] of the light subpaths, and [`BOUNCE_AIM_SHARE`] of their bounces off
     /// Lambertian surfaces, at the mirrors and glass (`--no-aim`: none).
@@ -107,7 +108,8 @@ impl Default for VcmSettings {
 }
 
 /// The first pass's merging radius in pixels. Measured on the Cornell box race at equal
-/// passes (eight seeds, BENCHMARKS.md): 3 pixels against 2 cut the caustic region's error by
+/// passes (eight seeds, docs/benchmarks/2026-12-02.md, "The caustics race: vcm with more camera
+/// samples at the focus, and cheaper passes"): 3 pixels against 2 cut the caustic region's error by
 /// 44% at one pass and 14–39% at 3 and 9, level at 20, the focus level, for 2–15% more time
 /// a pass (more light vertices to merge); 1 pixel doubled it. (`ppm`'s gathers keep 2:
 /// `--footprint` gives both.)
@@ -115,14 +117,16 @@ pub const MERGING_FOOTPRINT: f32 = 3.0;
 
 /// The first merging radius in pixels of a scene the balance pilot balanced. Against a
 /// reference of `scenes/pool.ray` (a caustic net seen through water), 3 pixels' blur was most of
-/// vcm's error at 20 s; 2 pixels cut it 1.5× (BENCHMARKS.md, "The pool against a reference").
+/// vcm's error at 20 s; 2 pixels cut it 1.5× (docs/benchmarks/2026-12-03.md, "The pool against a
+/// reference").
 pub const BALANCED_FOOTPRINT: f32 = 2.0;
 
 /// The share of light subpaths aimed at the bounding spheres of mirrors and glass: caustic
 /// paths become several times more frequent while the rest keep most of their subpaths.
 /// Measured on the race (0.5–4 s, four seeds): 0.15 cut the focus error by 20–60% for
 /// 1.1–1.6× the caustic region's error; 0.3 and 0.5 took too many subpaths from the indirect
-/// light merged around the caustic (region error 1.4–2.2×).
+/// light merged around the caustic (region error 1.4–2.2×) (docs/benchmarks/2026-12-02.md,
+/// "The caustics race, aimed vcm").
 pub const AIM_SHARE: f32 = 0.15;
 
 /// The share of the light subpaths' bounces off Lambertian surfaces aimed at the mirrors and
@@ -130,15 +134,15 @@ pub const AIM_SHARE: f32 = 0.15;
 /// the first; unaimed, few subpaths carry it, and it was most of the area light's focus noise.
 /// A bounce towards a mirror or glass carries little power then (its density is the aimed
 /// mixture's) and skips the roulette, so such subpaths become many times more frequent.
-/// Measured on the race's boxes at three passes, 32 seeds (focus rms, caustic region, seconds
-/// a render): none 0.0151, 0.0054, 2.09 (area) and 0.0150, 0.0061, 1.92 (point); 0.05 of every
-/// bounce 0.0108, 0.0034, 2.23 and 0.0096, 0.0040, 2.07; 0.1 and 0.2 no better for the focus,
-/// in more time; aiming only the first bounce left the focus 0.0132 (area).
+/// 0.05 of every bounce cut the race's focus error by 29–36% for 7–8% more time; more, or only
+/// the first bounce, was no better (measured: docs/benchmarks/2026-12-03.md, "Aimed
+/// bounces").
 pub const BOUNCE_AIM_SHARE: f32 = 0.05;
 
 /// Light subpaths per pixel and pass where the eye sees a caustic's focus (elsewhere the
 /// balance pilot chooses, [`balance`]), and the weights of the pilot's estimates. Measured on
-/// the Cornell box race (BENCHMARKS.md), at equal time: 16 cut the focus's error by a fifth and
+/// the Cornell box race (docs/benchmarks/2026-12-02.md, "The caustics race: vcm with 16 light
+/// subpaths per pixel"), at equal time: 16 cut the focus's error by a fifth and
 /// the caustic region's by a sixth against 8; 24 was no better. The first passes trace half
 /// (see [`Vcm::pass_light_paths`]).
 pub const LIGHT_PATHS_PER_PIXEL: u64 = 16;
@@ -156,11 +160,11 @@ const LIGHT_SEED: u64 = PHOTON_SEED ^ 0x0076_636d;
 const FIRST_VERTEX_LIGHT_SAMPLES: u32 = 1;
 /// Camera samples a pass in a pixel that sees a focused cell by default. Their first vertices
 /// merge the light around the focus from the same light subpaths, and which of the few bright
-/// subpaths a single sample's disc catches is a large part of the focus's noise. Measured on
-/// the race's scenes at one pass, 32 seeds (focus error, caustic region relMSE): 1 sample
-/// 0.0351, 0.0380 (point) and 0.0323, 0.0377 (area); 4: 0.0270, 0.0305 (point); 8: 0.0253,
-/// 0.0291 and 0.0281, 0.0300; 16 no better than 8. The focus's pixels are a few hundred of
-/// the image's, so the pass takes no measurably longer.
+/// subpaths a single sample's disc catches is a large part of the focus's noise. At one pass, 8
+/// cut the focus's error by 13–28% and the caustic region's by 20–23% against 1; 16 was no
+/// better (measured: docs/benchmarks/2026-12-02.md, "The caustics race: vcm with more camera
+/// samples at the focus, and cheaper passes"). The focus's pixels are a few hundred of the
+/// image's, so the pass takes no measurably longer.
 pub const FOCUS_CAMERA_SAMPLES: usize = 8;
 /// Camera bounces before Russian roulette may end a camera path.
 const ROULETTE_DEPTH: u32 = 3;
@@ -391,9 +395,9 @@ const MOST_LIGHT_PATHS_PER_PIXEL: u64 = 4 * LIGHT_PATHS_PER_PIXEL;
 
 /// A first pass's time per light subpath, all its work counted, over the pilot run's (which
 /// neither joins subpaths to the eye nor merges them, nor pays for a pass's first memory).
-/// Measured on six scenes' first passes, on one and two threads: 1.6–2.2. On the race's boxes
-/// at 0.5 s (one thread, eight seeds), 2.0 ended the point box's pass at 0.51–0.53 s and the
-/// area box's at 0.49 s; 2.2 at 0.48 s and 0.44 s.
+/// Measured on six scenes' first passes, on one and two threads: 1.6–2.2; on the race's boxes
+/// at 0.5 s, 2.0 overran the limit and 2.2 stopped short of it (measured:
+/// docs/benchmarks/2026-12-02.md, "vcm fills the time limit").
 const PILOT_TO_PASS_COST: f64 = 2.1;
 
 impl<'a> Vcm<'a> {

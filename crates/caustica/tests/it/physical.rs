@@ -241,7 +241,7 @@ fn cornell_area_light_ppm_converges_to_the_reference() {
 
 /// The path tracer agrees with the reference on the area-light scene's back wall within 1%, and
 /// within 5% on the regions the mirror's caustic lights (its caustic converges too slowly to
-/// test here: see BENCHMARKS.md).
+/// test here: see BENCHMARKS.md, "The physical model against the reference").
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn cornell_area_light_path_matches_the_reference() {

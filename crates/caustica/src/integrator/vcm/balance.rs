@@ -5,9 +5,10 @@
 //! falls as one over their number `L`. For a pass of cost `c_C + c_L L`, the image's variance at
 //! equal time, `(V_C + v / L) (c_C + c_L L)`, is least at `L = sqrt(v c_C / (V_C c_L))`: where
 //! each side's share of the variance equals its share of the time. Where that lies differs by
-//! two orders of magnitude between scenes (BENCHMARKS.md: a Cornell box lit through a glass ball
-//! wants many light subpaths a pixel, a pool seen through its water a few, a lens in the sun
-//! fewer than one), so a pilot measures both sides on the scene itself ([`super::Vcm`]).
+//! two orders of magnitude between scenes (a Cornell box lit through a glass ball wants many
+//! light subpaths a pixel, a pool seen through its water a few, a lens in the sun fewer than
+//! one; measured: docs/benchmarks/2026-12-03.md, "Balanced passes"), so a pilot measures both
+//! sides on the scene itself ([`super::Vcm`]).
 //!
 //! Merging's part grows as the radius shrinks pass by pass (a density estimate's variance goes
 //! as one over the area it gathers from), so the pilot's merging variance, measured at the first
@@ -58,9 +59,9 @@ pub struct PassCosts {
 }
 
 /// A gathered light vertex's cost in rays: a distance, a normal and a BSDF test, a weight.
-/// Fitted to the balance pilot's own timings on seven scenes (BENCHMARKS.md, "Balanced
-/// passes"): a camera path's time is about one light ray's per ray it casts plus a quarter of
-/// one per light vertex it gathers.
+/// Fitted to the balance pilot's own timings on seven scenes (docs/benchmarks/2026-12-03.md,
+/// "Balanced passes"): a camera path's time is about one light ray's per ray it casts plus a
+/// quarter of one per light vertex it gathers.
 pub const CANDIDATE_COST: f64 = 0.25;
 
 /// Pixels darker than this share of the image's mean count their noise against it rather than

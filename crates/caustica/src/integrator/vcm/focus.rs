@@ -11,10 +11,9 @@ use crate::math::Vec3;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// A cell is focused when its caustic flux is this many times the mean over the cells that
-/// have any. Measured on the race's scenes at one pass, 16 seeds each: 4 left most of the
-/// dim caustic around the focus to light tracing alone (caustic region relMSE 0.069 point,
-/// 0.076 area); 8 to 24 merge it (0.042–0.052); 16 was also best after 32 passes (0.0020
-/// and 0.0019 against 0.0023–0.0024 for 4 and 32), with the focus unchanged.
+/// have any. 4 left most of the dim caustic around the focus to light tracing alone; 8 to 24
+/// merge it, 16 was also best after 32 passes, the focus unchanged (measured:
+/// docs/benchmarks/2026-12-02.md, "The caustics race, aimed vcm").
 const FOCUSED: f32 = 16.0;
 
 /// The focused cells.
