@@ -2,7 +2,7 @@
 //! `RenderConfig` and the few settings beside it.
 
 use crate::to_py;
-use caustica::integrator::RenderConfig;
+use caustica::integrator::{GivenOptions, RenderConfig};
 use caustica::loader::LoadSettings;
 use caustica::photon::Estimator;
 use pyo3::conversion::FromPyObjectOwned;
@@ -61,6 +61,9 @@ pub const PHOTONS: &[&str] = &[
 pub struct Options {
     /// Everything that shapes the image.
     pub config: RenderConfig,
+    /// Which of the options a scene file also sets were given (not None), so the file's own
+    /// settings fill the rest as on the command line ([`RenderConfig::over_scene`]).
+    pub given: GivenOptions,
     /// `threads`.
     pub threads: Option<usize>,
     /// `cone_quirks` and `dialect`, when either was given.
@@ -78,6 +81,7 @@ pub fn parse(
 ) -> PyResult<Options> {
     let mut options = Options {
         config: RenderConfig::default(),
+        given: GivenOptions::default(),
         threads: None,
         load: None,
         save_every: 10.0,
@@ -108,37 +112,53 @@ pub fn parse(
             value: &value,
         };
         let c = &mut options.config;
+        let g = &mut options.given;
         match key.as_str() {
             "model" => {
                 c.model = v
                     .optional(Value::text)?
                     .map(|s| s.parse())
                     .transpose()
-                    .map_err(|e| to_py(py, e))?
+                    .map_err(|e| to_py(py, e))?;
+                g.model_or_integrator |= c.model.is_some();
             }
             "integrator" => {
                 c.integrator = v
                     .optional(Value::text)?
                     .map(|s| s.parse())
                     .transpose()
-                    .map_err(|e| to_py(py, e))?
+                    .map_err(|e| to_py(py, e))?;
+                g.model_or_integrator |= c.integrator.is_some();
             }
-            "width" => c.width = v.whole()?,
-            "height" => c.height = v.optional(Value::whole)?,
+            "width" => {
+                c.width = v.whole()?;
+                g.width = true;
+            }
+            "height" => {
+                c.height = v.optional(Value::whole)?;
+                g.height = c.height.is_some();
+            }
             "aa" => c.aa = v.whole()?,
-            "depth" => c.depth = v.optional(Value::whole)?,
+            "depth" => {
+                c.depth = v.optional(Value::whole)?;
+                g.depth = c.depth.is_some();
+            }
             "threads" => options.threads = v.optional(Value::whole)?,
             "seed" => c.seed = v.whole()?,
             "photons" => {
                 c.photons = v.whole()?;
                 c.light_paths = Some(c.photons as u64);
+                g.photons = true;
             }
             "max_emitted" => c.max_emitted = v.optional(Value::whole)?,
             "photons_per_light" => c.photons_per_light = v.optional(Value::counts)?,
             "no_aim" => c.no_aim = v.flag()?,
             "max_memory" => c.max_memory = v.whole()?,
             "k" => c.k = v.whole()?,
-            "radius" => c.radius = v.optional(Value::number)?.map(|r| r as f32),
+            "radius" => {
+                c.radius = v.optional(Value::number)?.map(|r| r as f32);
+                g.radius = c.radius.is_some();
+            }
             "cone_filter" => c.cone_filter = v.number()? as f32,
             "estimate" => {
                 c.estimator = match v.text()?.as_str() {
@@ -152,8 +172,14 @@ pub fn parse(
                 }
             }
             "no_estimate_reuse" => c.no_estimate_reuse = v.flag()?,
-            "passes" => c.passes = v.optional(Value::passes)?,
-            "time" => c.time = v.optional(Value::number)?,
+            "passes" => {
+                c.passes = v.optional(Value::passes)?;
+                g.passes = c.passes.is_some();
+            }
+            "time" => {
+                c.time = v.optional(Value::number)?;
+                g.time = c.time.is_some();
+            }
             "partial" => c.partial = v.optional(Value::path)?,
             "footprint" => c.footprint = v.optional(Value::number)?.map(|px| px as f32),
             "alpha" => c.alpha = v.number()? as f32,

@@ -65,11 +65,12 @@ pub fn photons(py: Python<'_>, scene: Option<SceneArg>, options: Option<&Bound<'
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&cancel);
     let map = run_interruptible(py, &cancel, true, move || {
-        let config = options.config;
-        config.integrator()?;
-        let settings = config.photon_settings();
+        source.check_early(&options)?;
         let pool = thread_pool(options.threads)?;
         let loaded = source.load()?;
+        let config = options.config.over_scene(&options.given, loaded.scene.hints());
+        config.integrator()?;
+        let settings = config.photon_settings();
         let control = Control {
             progress: &NoProgress,
             cancel: &flag,

@@ -298,8 +298,12 @@ pub fn progressive(
     let thread = std::thread::Builder::new()
         .name("caustica-session".into())
         .spawn(move || {
+            let save_every = options.save_every;
             let start = || -> caustica::Result<_> {
-                let config = options.config;
+                source.check_early(&options)?;
+                let pool = thread_pool(options.threads)?;
+                let loaded = source.load()?;
+                let config = options.config.over_scene(&options.given, loaded.scene.hints());
                 let integrator = config.integrator()?;
                 let plan = if integrator.is_progressive() {
                     config.plan()?
@@ -310,8 +314,6 @@ pub fn progressive(
                         time_limit: None,
                     }
                 };
-                let pool = thread_pool(options.threads)?;
-                let loaded = source.load()?;
                 Ok((config, plan, pool, loaded))
             };
             let (config, plan, pool, loaded) = match catch_unwind(AssertUnwindSafe(start)) {
@@ -348,7 +350,7 @@ pub fn progressive(
                 cost_done: 0.0,
                 finished_after: false,
                 partial: config.partial,
-                save_every: options.save_every,
+                save_every,
                 last_save: Instant::now(),
                 finished: false,
             };

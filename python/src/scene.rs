@@ -3,6 +3,8 @@
 use crate::arrays::film_array;
 use crate::options::{self, Options};
 use crate::run_interruptible;
+use caustica::description::RenderHints;
+use caustica::format::Format;
 use caustica::integrator::config::thread_pool;
 use caustica::integrator::{image_size, RenderSession};
 use caustica::loader::{load_timed, LoadSettings};
@@ -145,6 +147,22 @@ impl SceneSource {
         }
     }
 
+    /// The options over what is known of the scene before it is read (a scene already read, or
+    /// a pbrt or glTF file's physical units), checked as the command line checks them first.
+    pub fn check_early(&self, options: &Options) -> caustica::Result<()> {
+        let hints = match self {
+            SceneSource::Loaded(scene) => scene.scene.hints().clone(),
+            SceneSource::File(path, settings) => RenderHints {
+                physical: path
+                    .as_deref()
+                    .is_some_and(|p| matches!(settings.read.format_of(p), Format::Pbrt | Format::Gltf)),
+                ..RenderHints::default()
+            },
+        };
+        options.config.clone().over_scene(&options.given, &hints).integrator()?;
+        Ok(())
+    }
+
     /// The scene, read now if need be.
     pub fn load(self) -> caustica::Result<Arc<LoadedScene>> {
         match self {
@@ -179,12 +197,13 @@ pub fn render<'py>(
     let cancel = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&cancel);
     let film = run_interruptible(py, &cancel, true, move || {
-        // In the command line's order: options, then the scene.
-        let config = options.config;
-        config.integrator()?;
-        let plan = config.plan()?;
+        // In the command line's order: options, then the scene, then the two together.
+        source.check_early(&options)?;
         let pool = thread_pool(options.threads)?;
         let loaded = source.load()?;
+        let config = options.config.over_scene(&options.given, loaded.scene.hints());
+        config.integrator()?;
+        let plan = config.plan()?;
         let mut session = RenderSession::new(&loaded.scene, config.render_options(loaded.scene_id.clone())?)?;
         let control = Control {
             progress: &NoProgress,

@@ -79,6 +79,88 @@ def test_the_built_in_scene_and_a_loaded_scene_render_as_the_command_line(tmp_pa
     assert np.array_equal(caustica.render(str(scenes / "ring.ray"), **options), builtin)
 
 
+# A pbrt-v4 file whose Film, Sampler and Integrator set the size, passes, depth and photons.
+PBRT = """LookAt 0 1.2 3  0 0.3 0  0 1 0
+Camera "perspective" "float fov" [40]
+Film "rgb" "integer xresolution" [40] "integer yresolution" [30]
+Sampler "independent" "integer pixelsamples" [3]
+Integrator "sppm" "integer maxdepth" [5] "integer photonsperiteration" [4000]
+WorldBegin
+LightSource "point" "point3 from" [0.5 2 0.5] "rgb I" [4 4 4]
+Material "diffuse" "rgb reflectance" [0.7 0.7 0.7]
+Shape "bilinearmesh" "point3 P" [-2 0 -2  2 0 -2  -2 0 2  2 0 2]
+Material "dielectric" "float eta" 1.5
+AttributeBegin
+  Translate 0 0.4 0
+  Shape "sphere" "float radius" [0.35]
+AttributeEnd
+"""
+
+
+def gltf_quad_under_a_light(path):
+    """A glTF 2.0 file (one JSON file, its buffer a data URI): a floor, a camera, a point light."""
+    import base64
+    import struct
+
+    positions = [-2, 0, -2, 2, 0, -2, 2, 0, 2, -2, 0, 2]
+    indices = [0, 2, 1, 0, 3, 2]
+    data = struct.pack("<12f", *positions) + struct.pack("<6H", *indices) + b"\0\0"
+    gltf = {
+        "asset": {"version": "2.0"},
+        "extensionsUsed": ["KHR_lights_punctual"],
+        "extensions": {"KHR_lights_punctual": {"lights": [{"type": "point", "intensity": 20.0}]}},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [
+            {"mesh": 0},
+            {"camera": 0, "translation": [0, 1.5, 3], "rotation": [-0.2588190, 0, 0, 0.9659258]},
+            {"translation": [0, 1.5, 0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+        ],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "aspectRatio": 1.5, "znear": 0.01}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorFactor": [0.8, 0.8, 0.8, 1], "metallicFactor": 0}}],
+        "buffers": [{"byteLength": len(data), "uri": "data:application/octet-stream;base64," + base64.b64encode(data).decode()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": 48},
+            {"buffer": 0, "byteOffset": 48, "byteLength": 12},
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3", "min": [-2, 0, -2], "max": [2, 0, 2]},
+            {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
+        ],
+    }
+    path.write_text(json.dumps(gltf))
+    return path
+
+
+@pytest.mark.parametrize(
+    "options",
+    [dict(), dict(width=24), dict(passes=2, photons=2000), dict(model="course", photons=2000), dict(depth=2)],
+    ids=str,
+)
+def test_a_pbrt_file_renders_as_the_command_line_with_its_own_settings(tmp_path, options):
+    """The file's Film, Sampler and Integrator fill what the options leave, as on the command line."""
+    path = tmp_path / "ball.pbrt"
+    path.write_text(PBRT)
+    ours = caustica.render(path, **options)
+    theirs = cli_image(tmp_path, path, options)
+    assert ours.shape == theirs.shape
+    if "width" not in options:
+        assert ours.shape == (30, 40, 3), "the Film's resolution"
+    assert np.array_equal(ours, theirs), f"largest difference {np.abs(ours - theirs).max()}"
+
+
+@pytest.mark.parametrize("options", [dict(width=32, passes=2), dict(width=32, model="course")], ids=str)
+def test_a_gltf_file_renders_as_the_command_line(tmp_path, options):
+    """glTF is in physical units: both front ends read it with the physical model by default."""
+    path = gltf_quad_under_a_light(tmp_path / "floor.gltf")
+    ours = caustica.render(path, **options)
+    theirs = cli_image(tmp_path, path, options)
+    assert ours.shape == theirs.shape
+    assert ours.max() > 0.0, "the floor is lit"
+    assert np.array_equal(ours, theirs), f"largest difference {np.abs(ours - theirs).max()}"
+
+
 def test_the_thread_count_does_not_change_the_image(scenes):
     options = dict(width=32, model="physical", passes=2, photons=3000)
     one = caustica.render(scenes / "glass_sphere.ray", threads=1, **options)

@@ -23,7 +23,7 @@ pub mod tiles;
 pub mod vcm;
 pub mod whitted;
 
-pub use config::RenderConfig;
+pub use config::{GivenOptions, RenderConfig};
 pub use session::{PassPlan, RenderOptions, RenderSession, Resize, RunSummary};
 pub use tiles::{image_size, ImageSettings};
 

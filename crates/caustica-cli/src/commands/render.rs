@@ -10,7 +10,7 @@ use caustica::film::ToneMap;
 use caustica::format::Format;
 use caustica::image_io::{check_writable, ImageFormat};
 use caustica::integrator::config::thread_pool;
-use caustica::integrator::config::{IntegratorKind, Model};
+use caustica::integrator::config::{GivenOptions, Model};
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
 use caustica::light::Light;
 use caustica::photon::Estimator;
@@ -23,51 +23,42 @@ use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
 
-/// The library's render options: the scene's own settings (`hints`), then the command line's.
+/// The library's render options: the command line's over the scene's own settings (`hints`).
 pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
     let p = &args.progressive;
-    let scene = RenderConfig::for_scene(hints);
-    let model = p.model.as_deref().map(str::parse::<Model>).transpose()?;
-    let integrator = p.integrator.as_deref().map(str::parse).transpose()?;
-    // A model or integrator given on the command line replaces the scene's choice of both.
-    let (model, integrator) = if model.is_some() || integrator.is_some() {
-        (model, integrator)
-    } else {
-        (scene.model, scene.integrator)
+    let defaults = RenderConfig::default();
+    let given = GivenOptions {
+        model_or_integrator: p.model.is_some() || p.integrator.is_some(),
+        width: args.width.is_some(),
+        height: args.height.is_some(),
+        depth: args.depth.is_some(),
+        photons: args.photon.photons.is_some(),
+        radius: args.radius.is_some(),
+        passes: p.passes.is_some(),
+        time: p.time.is_some(),
     };
-    // The scene's samples per pixel are passes of a physical integrator; the course model has none.
-    let course = model == Some(Model::Course) || integrator == Some(IntegratorKind::Whitted);
-    // The scene's depth, passes and photons are for any physical integrator: `--depth` means
-    // the same bounces in each of them.
-    let depth = args.depth.or(if course { None } else { scene.depth });
-    // With only --width, the height follows the camera rather than the scene's film.
-    let height = args.height.or(if args.width.is_none() { scene.height } else { None });
-    Ok(RenderConfig {
-        model,
-        integrator,
-        width: args.width.unwrap_or(scene.width),
-        height,
+    let asked = RenderConfig {
+        model: p.model.as_deref().map(str::parse::<Model>).transpose()?,
+        integrator: p.integrator.as_deref().map(str::parse).transpose()?,
+        width: args.width.unwrap_or(defaults.width),
+        height: args.height,
         aa: args.aa,
-        depth,
+        depth: args.depth,
         seed: args.seed,
-        photons: args.photon.photons.unwrap_or(scene.photons),
+        photons: args.photon.photons.unwrap_or(defaults.photons),
         light_paths: args.photon.photons.map(|p| p as u64),
         max_emitted: args.photon.max_emitted,
         photons_per_light: args.photon.photons_per_light.clone(),
         no_aim: args.photon.no_aim,
         k: args.k,
-        radius: args.radius.or(scene.radius),
+        radius: args.radius,
         cone_filter: args.cone_filter,
         estimator: match args.estimate.as_str() {
             "nearest" => Estimator::Nearest,
             _ => Estimator::Kernels,
         },
         no_estimate_reuse: args.no_estimate_reuse,
-        passes: p.passes.clone().or(if p.time.is_none() && !course {
-            scene.passes
-        } else {
-            None
-        }),
+        passes: p.passes.clone(),
         time: p.time,
         footprint: p.footprint,
         alpha: p.alpha,
@@ -80,7 +71,8 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         },
         max_memory: args.photon.max_memory,
         partial: p.partial.clone(),
-    })
+    };
+    Ok(asked.over_scene(&given, hints))
 }
 
 /// Runs the command; returns the exit code.

@@ -185,7 +185,66 @@ impl Default for RenderConfig {
     }
 }
 
+/// Which of a front end's options its user set, among those a scene file sets too
+/// ([`RenderConfig::over_scene`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GivenOptions {
+    /// `model` or `integrator`: either replaces the scene's choice of both.
+    pub model_or_integrator: bool,
+    /// `width` (`--width`).
+    pub width: bool,
+    /// `height`.
+    pub height: bool,
+    /// `depth`.
+    pub depth: bool,
+    /// `photons`.
+    pub photons: bool,
+    /// `radius`.
+    pub radius: bool,
+    /// `passes`.
+    pub passes: bool,
+    /// `time`: a time limit, under which the scene's passes do not apply.
+    pub time: bool,
+}
+
 impl RenderConfig {
+    /// These options (a front end's, `given` saying which its user set) over a scene file's own
+    /// settings ([`RenderConfig::for_scene`]): the one precedence the command line and Python
+    /// share, so a file renders the same pixels from both.
+    ///
+    /// - A model or integrator given replaces the scene's choice of both.
+    /// - The scene's depth and passes are for a physical integrator (the course model has none);
+    ///   its passes yield to a time limit given.
+    /// - With only a width given, the height follows the camera rather than the scene's film.
+    pub fn over_scene(self, given: &GivenOptions, hints: &RenderHints) -> RenderConfig {
+        let scene = RenderConfig::for_scene(hints);
+        let mut c = self;
+        if !given.model_or_integrator {
+            c.model = scene.model;
+            c.integrator = scene.integrator;
+        }
+        let course = c.model == Some(Model::Course) || c.integrator == Some(IntegratorKind::Whitted);
+        if !given.depth {
+            c.depth = if course { None } else { scene.depth };
+        }
+        if !given.height {
+            c.height = if given.width { None } else { scene.height };
+        }
+        if !given.width {
+            c.width = scene.width;
+        }
+        if !given.photons {
+            c.photons = scene.photons;
+        }
+        if !given.radius {
+            c.radius = scene.radius;
+        }
+        if !given.passes {
+            c.passes = if given.time || course { None } else { scene.passes };
+        }
+        c
+    }
+
     /// The defaults with a scene file's own settings applied (pbrt-v4's `Film`, `Sampler` and
     /// `Integrator`): a front end starts here and then sets the options its user gave.
     ///
@@ -575,5 +634,82 @@ mod tests {
             ["--footprint"]
         );
         assert!(with(IntegratorKind::Lt, None, None).ignored_by_lt().is_empty());
+    }
+
+    /// The precedence both front ends share: what the user gave wins; the scene fills the rest,
+    /// its depth and passes only for a physical integrator, its passes not under a time limit,
+    /// its height not when only a width was given.
+    #[test]
+    fn options_given_win_over_the_scenes_and_the_scene_fills_the_rest() {
+        let hints = RenderHints {
+            width: Some(40),
+            height: Some(30),
+            physical: true,
+            max_depth: Some(5),
+            samples: Some(3),
+            photons_per_pass: Some(4000),
+            radius: Some(0.5),
+            ..RenderHints::default()
+        };
+        let asked = RenderConfig {
+            width: 24,
+            height: Some(10),
+            depth: Some(2),
+            photons: 99,
+            radius: Some(0.1),
+            passes: Some("7".into()),
+            time: Some(1.5),
+            model: Some(Model::Course),
+            ..RenderConfig::default()
+        };
+        let none = asked.clone().over_scene(&GivenOptions::default(), &hints);
+        assert_eq!((none.width, none.height, none.depth), (40, Some(30), Some(4)));
+        assert_eq!(
+            (none.model, none.integrator),
+            (Some(Model::Physical), Some(IntegratorKind::Path))
+        );
+        assert_eq!(
+            (none.photons, none.radius, none.passes.as_deref()),
+            (4000, Some(0.5), Some("3"))
+        );
+        let all = GivenOptions {
+            model_or_integrator: true,
+            width: true,
+            height: true,
+            depth: true,
+            photons: true,
+            radius: true,
+            passes: true,
+            time: true,
+        };
+        assert_eq!(asked.clone().over_scene(&all, &hints), asked);
+        let width = asked.clone().over_scene(
+            &GivenOptions {
+                width: true,
+                ..GivenOptions::default()
+            },
+            &hints,
+        );
+        assert_eq!((width.width, width.height), (24, None), "the height follows the camera");
+        let course = asked.clone().over_scene(
+            &GivenOptions {
+                model_or_integrator: true,
+                ..GivenOptions::default()
+            },
+            &hints,
+        );
+        assert_eq!(
+            (course.model, course.depth, course.passes),
+            (Some(Model::Course), None, None)
+        );
+        assert_eq!(course.photons, 4000, "photons are the scene's for the course model too");
+        let timed = asked.over_scene(
+            &GivenOptions {
+                time: true,
+                ..GivenOptions::default()
+            },
+            &hints,
+        );
+        assert_eq!((timed.passes, timed.time), (None, Some(1.5)));
     }
 }
