@@ -764,6 +764,9 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
 }
 
 #[cfg(test)]
+mod chi2;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::sampling::Rng;
