@@ -10,6 +10,7 @@ mod common;
 
 mod caustic_scenes;
 mod caustics;
+mod closed_forms;
 mod corpus;
 mod corpus_render;
 mod density_estimate;
