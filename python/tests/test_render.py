@@ -98,7 +98,8 @@ AttributeEnd
 
 
 def gltf_quad_under_a_light(path):
-    """A glTF 2.0 file (one JSON file, its buffer a data URI): a floor, a camera, a point light."""
+    """A glTF 2.0 file: a floor, a camera, a point light. A `.gltf` path gets one JSON file with
+    its buffer as a data URI; a `.glb` path the binary container, the buffer in its BIN chunk."""
     import base64
     import struct
 
@@ -129,7 +130,14 @@ def gltf_quad_under_a_light(path):
             {"bufferView": 1, "componentType": 5123, "count": 6, "type": "SCALAR"},
         ],
     }
-    path.write_text(json.dumps(gltf))
+    if path.suffix == ".glb":
+        del gltf["buffers"][0]["uri"]
+        text = json.dumps(gltf).encode()
+        text += b" " * (-len(text) % 4)
+        chunks = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(data), 0x004E4942) + data
+        path.write_bytes(struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks)
+    else:
+        path.write_text(json.dumps(gltf))
     return path
 
 
@@ -150,15 +158,20 @@ def test_a_pbrt_file_renders_as_the_command_line_with_its_own_settings(tmp_path,
     assert np.array_equal(ours, theirs), f"largest difference {np.abs(ours - theirs).max()}"
 
 
+@pytest.mark.parametrize("suffix", [".gltf", ".glb"])
 @pytest.mark.parametrize("options", [dict(width=32, passes=2), dict(width=32, model="course")], ids=str)
-def test_a_gltf_file_renders_as_the_command_line(tmp_path, options):
+def test_a_gltf_file_renders_as_the_command_line(tmp_path, options, suffix):
     """glTF is in physical units: both front ends read it with the physical model by default."""
-    path = gltf_quad_under_a_light(tmp_path / "floor.gltf")
+    path = gltf_quad_under_a_light(tmp_path / ("floor" + suffix))
     ours = caustica.render(path, **options)
     theirs = cli_image(tmp_path, path, options)
     assert ours.shape == theirs.shape
     assert ours.max() > 0.0, "the floor is lit"
     assert np.array_equal(ours, theirs), f"largest difference {np.abs(ours - theirs).max()}"
+    if suffix == ".glb":
+        # The two containers of one model render the same.
+        other = gltf_quad_under_a_light(tmp_path / "floor.gltf")
+        assert np.array_equal(ours, caustica.render(other, **options))
 
 
 def test_the_thread_count_does_not_change_the_image(scenes):
