@@ -10,7 +10,7 @@ use caustica::film::ToneMap;
 use caustica::format::Format;
 use caustica::image_io::{check_writable, ImageFormat};
 use caustica::integrator::config::thread_pool;
-use caustica::integrator::config::{GivenOptions, Model};
+use caustica::integrator::config::{integrator_note, GivenOptions, Model};
 use caustica::integrator::{Integrator, RenderConfig, RenderSession};
 use caustica::light::Light;
 use caustica::photon::Estimator;
@@ -27,16 +27,7 @@ use std::time::{Duration, Instant};
 pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
     let p = &args.progressive;
     let defaults = RenderConfig::default();
-    let given = GivenOptions {
-        model_or_integrator: p.model.is_some() || p.integrator.is_some(),
-        width: args.width.is_some(),
-        height: args.height.is_some(),
-        depth: args.depth.is_some(),
-        photons: args.photon.photons.is_some(),
-        radius: args.radius.is_some(),
-        passes: p.passes.is_some(),
-        time: p.time.is_some(),
-    };
+    let given = given(args);
     let asked = RenderConfig {
         model: p.model.as_deref().map(str::parse::<Model>).transpose()?,
         integrator: p.integrator.as_deref().map(str::parse).transpose()?,
@@ -73,6 +64,21 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         partial: p.partial.clone(),
     };
     Ok(asked.over_scene(&given, hints))
+}
+
+/// Which of the options a scene file also sets the command line gave.
+fn given(args: &RenderArgs) -> GivenOptions {
+    let p = &args.progressive;
+    GivenOptions {
+        model_or_integrator: p.model.is_some() || p.integrator.is_some(),
+        width: args.width.is_some(),
+        height: args.height.is_some(),
+        depth: args.depth.is_some(),
+        photons: args.photon.photons.is_some(),
+        radius: args.radius.is_some(),
+        passes: p.passes.is_some(),
+        time: p.time.is_some(),
+    }
 }
 
 /// Runs the command; returns the exit code.
@@ -134,6 +140,8 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
         check_writable(o)?;
     }
     check_preview(&args, &output)?;
+    // Why this integrator, when the user did not choose it.
+    let integrator_why = integrator_note(&given(&args), scene.hints(), scene).filter(|_| progressive);
     if !quiet {
         for warning in scene.warnings() {
             eprintln!("warning: {warning}");
@@ -144,6 +152,9 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
             }
         }
         if progressive {
+            if let Some(note) = &integrator_why {
+                eprintln!("note: {note}");
+            }
             for note in physical_notes(scene) {
                 eprintln!("note: {note}");
             }
@@ -275,6 +286,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "output": shown(&output),
                 "partial": shown(&options.partial),
                 "integrator": session.integrator().name(),
+                "integrator_why": integrator_why,
                 "model": "physical",
                 "width": width,
                 "height": height,

@@ -241,3 +241,53 @@ fn an_obj_scene_takes_its_camera_and_lights_from_options() {
     assert_eq!(code, Some(2));
     assert!(stderr.contains("expected 6"), "{stderr}");
 }
+
+/// A file in physical units that names no integrator renders with vcm, which shows the caustic
+/// of a point light through glass, and says so; one that names `path` keeps it, with a note that
+/// its glass's caustic needs another; an integrator given on the command line says nothing.
+#[test]
+fn a_file_without_an_integrator_renders_its_caustics_and_says_why() {
+    let dir = temp_dir("default-integrator");
+    let glass = format!(
+        "Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 16\n{PBRT_STAGE}\
+         LightSource \"point\" \"point3 from\" [0 3 0] \"rgb I\" [5 5 5]\n\
+         Material \"dielectric\" \"float eta\" 1.5\nShape \"sphere\" \"float radius\" 0.5\n\
+         Material \"diffuse\"\nShape \"bilinearmesh\" \"point3 P\" [-3 -1 -3  3 -1 -3  -3 -1 3  3 -1 3]\n"
+    );
+    std::fs::write(dir.join("none.pbrt"), &glass).unwrap();
+    std::fs::write(dir.join("path.pbrt"), format!("Integrator \"path\"\n{glass}")).unwrap();
+    let render = |file: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            file,
+            "--json",
+            "--passes",
+            "1",
+            "--photons",
+            "2000",
+            "-o",
+            "o.png",
+        ];
+        args.extend_from_slice(extra);
+        let (code, stderr, stdout) = run(&dir, &args);
+        assert_eq!(code, Some(0), "{stderr}");
+        let json: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+        let why = json["integrator_why"].as_str().unwrap_or_default().to_string();
+        // Without --json the same note is printed.
+        let plain: Vec<&str> = args.iter().copied().filter(|a| *a != "--json").collect();
+        let (_, stderr, _) = run(&dir, &plain);
+        assert_eq!(stderr.contains(&format!("note: {why}")), !why.is_empty(), "{stderr}");
+        (json["integrator"].as_str().unwrap().to_string(), why)
+    };
+    let (integrator, why) = render("none.pbrt", &[]);
+    assert_eq!(integrator, "vcm");
+    assert!(why.starts_with("integrator vcm: the file names none"), "{why}");
+    let (integrator, why) = render("path.pbrt", &[]);
+    assert_eq!(integrator, "path");
+    assert!(
+        why.starts_with("integrator path: the file names it; a path tracer cannot show the caustics"),
+        "{why}"
+    );
+    let (integrator, why) = render("none.pbrt", &["--integrator", "ppm"]);
+    assert_eq!((integrator.as_str(), why.as_str()), ("ppm", ""));
+}

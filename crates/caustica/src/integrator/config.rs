@@ -248,6 +248,10 @@ impl RenderConfig {
     /// The defaults with a scene file's own settings applied (pbrt-v4's `Film`, `Sampler` and
     /// `Integrator`): a front end starts here and then sets the options its user gave.
     ///
+    /// A file in physical units (pbrt, glTF) that names no integrator renders with `vcm`: it
+    /// shows the caustics of point, spot and sun lights through glass and mirrors, which a path
+    /// tracer cannot, and everything a path tracer shows ([`integrator_note`] says so).
+    ///
     /// pbrt's `maxdepth` N counts scattering events (its paths have up to N + 1 segments), so
     /// every physical integrator gets `--depth` N − 1 ([`scattering_surfaces`] of it is N);
     /// pbrt's `maxdepth` 0, light seen only where it is emitted, has no `--depth` and becomes 0.
@@ -262,8 +266,8 @@ impl RenderConfig {
             config.integrator = Some(match hints.integrator {
                 Some(IntegratorHint::Ppm) => IntegratorKind::Ppm,
                 Some(IntegratorHint::LightTracer) => IntegratorKind::Lt,
-                Some(IntegratorHint::Bidirectional) => IntegratorKind::Vcm,
-                Some(IntegratorHint::Path) | None => IntegratorKind::Path,
+                Some(IntegratorHint::Bidirectional) | None => IntegratorKind::Vcm,
+                Some(IntegratorHint::Path) => IntegratorKind::Path,
             });
         }
         if let Some(n) = hints.max_depth {
@@ -530,6 +534,41 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
         .map_err(|e| Error::InvalidSettings(format!("cannot start worker threads: {e}")))
 }
 
+/// Which integrator renders a file in physical units and why, when its user chose none: the one
+/// the file names, or `vcm` where it names none; and, where the file names `path` but its mirrors
+/// or glass are lit by point, spot or sun lights, that a path tracer cannot show their caustics.
+/// `None` where the user chose, or the file is not in physical units.
+pub fn integrator_note(given: &GivenOptions, hints: &RenderHints, scene: &crate::scene::Scene) -> Option<String> {
+    if given.model_or_integrator || !hints.physical {
+        return None;
+    }
+    let Some(named) = hints.integrator else {
+        return Some(
+            "integrator vcm: the file names none, and vcm renders the caustics of point, spot and sun lights \
+             through glass and mirrors as well as all a path tracer renders (--integrator chooses another)"
+                .into(),
+        );
+    };
+    let kind = RenderConfig::for_scene(hints).integrator?;
+    let mut note = format!("integrator {}: the file names it", kind.name());
+    let delta_lights = scene.lights().iter().any(|l| {
+        matches!(
+            l,
+            crate::light::Light::Point { .. }
+                | crate::light::Light::Spot { .. }
+                | crate::light::Light::Directional { .. }
+                | crate::light::Light::Sun { .. }
+        )
+    });
+    if named == IntegratorHint::Path && delta_lights && !crate::light::emission::caustic_targets(scene).is_empty() {
+        note.push_str(
+            "; a path tracer cannot show the caustics its mirrors and glass cast from point, spot or sun \
+             lights: --integrator vcm shows them",
+        );
+    }
+    Some(note)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -666,7 +705,8 @@ mod tests {
         assert_eq!((none.width, none.height, none.depth), (40, Some(30), Some(4)));
         assert_eq!(
             (none.model, none.integrator),
-            (Some(Model::Physical), Some(IntegratorKind::Path))
+            (Some(Model::Physical), Some(IntegratorKind::Vcm)),
+            "a file in physical units that names no integrator renders with vcm"
         );
         assert_eq!(
             (none.photons, none.radius, none.passes.as_deref()),
