@@ -717,35 +717,9 @@ impl KdTree {
         }
         let q = p.to_array();
         let floor2 = strict_bound(floor.max(0.0) * floor.max(0.0));
-        let mut stack = [Subtree::default(); SEARCH_STACK];
-        let mut sp = 1;
-        stack[0] = Subtree {
-            size: self.nodes.len() as u32,
-            len: self.len,
-            ..Subtree::default()
-        };
-        while sp > 0 {
-            sp -= 1;
-            let cur = stack[sp];
-            // A subtree matters if some ball around its items, or the floor's ball around `p`,
-            // reaches across.
-            let (balls, points) = if cur.size == 0 {
-                (&reach.leaves[cur.leaf as usize], &self.leaves[cur.leaf as usize])
-            } else {
-                (&reach.inner[cur.node as usize], &self.inner[cur.node as usize])
-            };
-            if balls.dist2(q) > 0.0 && points.dist2(q) >= floor2 {
-                continue;
-            }
-            if cur.size == 0 {
-                reaching_in_leaf(reach, items, cur.lo..cur.lo + cur.len, q, floor2, &mut f);
-                continue;
-            }
-            let (left, right) = children(cur);
-            stack[sp] = right;
-            stack[sp + 1] = left;
-            sp += 2;
-        }
+        self.descend_reach(reach, q, 0.0, floor2, |lo, len| {
+            reaching_in_leaf(reach, items, lo..lo + len, q, floor2, &mut f)
+        });
     }
 
     /// The items (their slots, in tree order) that [`KdTree::for_each_reaching`] may find for
@@ -772,6 +746,22 @@ impl KdTree {
         let slack = delta * 1.01 + 1e-5 * (1.0 + p.abs().max_element());
         let near2 = slack * slack;
         let floor2 = (floor + slack) * (floor + slack);
+        self.descend_reach(reach, q, near2, floor2, |lo, len| {
+            // An item reaches a point within delta only if it reaches within delta of `p`.
+            for slot in lo..lo + len {
+                let d = dist2(items[slot as usize].position().to_array(), q).sqrt();
+                let r = reach.radius[slot as usize].max(floor);
+                if d <= (r + slack) * 1.0001 {
+                    out.push(slot);
+                }
+            }
+        });
+    }
+
+    /// Visits, in tree order, the leaves (`leaf(lo, len)`) whose subtrees are not pruned: a
+    /// subtree is skipped when the bounds of its balls lie farther than `near2` (squared) from
+    /// `q` and its points' bounds at `floor2` or farther.
+    fn descend_reach(&self, reach: &Reach, q: [f32; 3], near2: f32, floor2: f32, mut leaf: impl FnMut(u32, u32)) {
         let mut stack = [Subtree::default(); SEARCH_STACK];
         let mut sp = 1;
         stack[0] = Subtree {
@@ -791,14 +781,7 @@ impl KdTree {
                 continue;
             }
             if cur.size == 0 {
-                // An item reaches a point within delta only if it reaches within delta of `p`.
-                for slot in cur.lo..cur.lo + cur.len {
-                    let d = dist2(items[slot as usize].position().to_array(), q).sqrt();
-                    let r = reach.radius[slot as usize].max(floor);
-                    if d <= (r + slack) * 1.0001 {
-                        out.push(slot);
-                    }
-                }
+                leaf(cur.lo, cur.len);
                 continue;
             }
             let (left, right) = children(cur);
@@ -822,15 +805,8 @@ impl KdTree {
         if p.is_nan() {
             return;
         }
-        let q = p.to_array();
         let floor2 = strict_bound(floor.max(0.0) * floor.max(0.0));
-        for &slot in slots {
-            let d2 = dist2(items[slot as usize].position().to_array(), q);
-            let r = reach.radius[slot as usize];
-            if d2 < r * r || d2 < floor2 {
-                f(slot, d2);
-            }
-        }
+        reaching_in_leaf(reach, items, slots.iter().copied(), p.to_array(), floor2, &mut f);
     }
 }
 
@@ -839,7 +815,7 @@ impl KdTree {
 fn reaching_in_leaf<T: KdPoint>(
     reach: &Reach,
     items: &[T],
-    slots: std::ops::Range<u32>,
+    slots: impl IntoIterator<Item = u32>,
     q: [f32; 3],
     floor2: f32,
     f: &mut impl FnMut(u32, f32),

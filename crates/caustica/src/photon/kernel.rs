@@ -63,6 +63,10 @@ pub(super) fn kernel_radii(
     per_leaf.concat()
 }
 
+/// A relative margin far above f32 rounding that keeps every coverage and band test on the safe
+/// side.
+const MARGIN: f32 = 1e-4;
+
 /// Buffers one thread reuses from leaf to leaf.
 #[derive(Default)]
 struct LeafScratch {
@@ -155,8 +159,6 @@ fn leaf_radii(
     let half = (hi - lo).length() * 0.5;
     let max_radius = max2.sqrt();
     let wanted = (r0.sqrt() + 2.0 * half).min(max_radius);
-    // A relative margin far above f32 rounding keeps every test below on the safe side.
-    const MARGIN: f32 = 1e-4;
     let reach = (wanted + half) * (1.0 + MARGIN);
     scratch.candidates.clear();
     tree.for_each_within(photons, centre, reach * reach, |slot, _| {
@@ -201,7 +203,6 @@ fn band_kth(
     min_normal_cosine: f32,
     scratch: &mut LeafScratch,
 ) -> Option<f32> {
-    const MARGIN: f32 = 1e-4;
     let outer = (r + e) * (1.0 + MARGIN);
     if outer.is_nan() || outer >= covered || k == 0 {
         return None;
@@ -260,7 +261,6 @@ fn covered_kth(
     min_normal_cosine: f32,
     scratch: &mut LeafScratch,
 ) -> Option<f32> {
-    const MARGIN: f32 = 1e-4;
     let max_radius = max2.sqrt();
     let (code, normal) = (photon.normal_code(), photon.normal());
     scratch.dist2.clear();
