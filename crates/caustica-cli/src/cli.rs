@@ -253,9 +253,9 @@ pub struct ProgressiveOptions {
     pub model: Option<String>,
     /// Integrator: whitted (course model), or path, ppm, gi, lt, vcm (physical model: what a
     /// pbrt-v4 scene names; vcm for a pbrt or glTF file that names none, as it shows the
-    /// caustics of point, spot and sun lights; ppm for a .ray or .obj file with --model physical). lt is light tracing: mirrors, glass and
-    /// lights seen by the camera are black. vcm is vertex connection and merging: all of them,
-    /// weighted against each other.
+    /// caustics of point, spot and sun lights; ppm for a .ray or .obj file with --model
+    /// physical). lt is light tracing: mirrors, glass and lights seen by the camera are black.
+    /// vcm is vertex connection and merging: all of them, weighted against each other.
     #[arg(long, value_parser = ["whitted", "path", "ppm", "gi", "lt", "vcm"])]
     pub integrator: Option<String>,
     /// Passes to render: N (passes 0..N) or A..B (passes A to B−1 of a run split across
