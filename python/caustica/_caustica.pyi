@@ -99,6 +99,9 @@ class Scene:
         """Remarks made while reading and building."""
     def size(self, width: int = 512, height: int | None = None) -> tuple[int, int]:
         """(width, height) of a render `width` pixels wide."""
+    def camera_fit(self, width: int = 512, height: int | None = None) -> str | None:
+        """How a render of this size fits the camera when their aspects differ (cropped or
+        extended by the format's rule, never stretched); None when they agree."""
 
 SceneLike = Scene | PathLike | None
 

@@ -107,6 +107,15 @@ impl PyScene {
         image_size(self.loaded.scene.camera(), width, height)
     }
 
+    /// What a render at this size does when its aspect differs from the camera's (the picture
+    /// cropped or extended by the format's rule, never stretched), in words; `None` when it
+    /// does not differ.
+    #[pyo3(signature = (width=512, height=None))]
+    fn camera_fit(&self, width: usize, height: Option<usize>) -> Option<String> {
+        let (width, height) = image_size(self.loaded.scene.camera(), width, height);
+        self.loaded.scene.camera().fit_note(width, height)
+    }
+
     fn __repr__(&self) -> String {
         format!("caustica.Scene({:?})", self.loaded.name)
     }

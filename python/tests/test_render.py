@@ -174,6 +174,20 @@ def test_a_gltf_file_renders_as_the_command_line(tmp_path, options, suffix):
         assert np.array_equal(ours, caustica.render(other, **options))
 
 
+def test_a_square_image_of_a_wide_camera_is_cropped_and_said_so(tmp_path):
+    """An image of another aspect than the camera's is cropped by the format's rule, not
+    stretched; Python says so as the command line's --json does, and renders its pixels."""
+    path = gltf_quad_under_a_light(tmp_path / "floor.gltf")
+    scene = caustica.Scene(path)
+    note = scene.camera_fit(32, 32)
+    assert note is not None and "cropped at the sides" in note
+    assert scene.camera_fit(48, 32) is None, "the camera's own 3:2"
+    options = dict(width=32, height=32, passes=1)
+    report = json.loads(cli("render", path, "-o", tmp_path / "fit.png", "--json", *cli_args(options)).stdout)
+    assert report["camera_fit"] == note
+    assert np.array_equal(caustica.render(scene, **options), cli_image(tmp_path, path, options))
+
+
 def test_the_thread_count_does_not_change_the_image(scenes):
     options = dict(width=32, model="physical", passes=2, photons=3000)
     one = caustica.render(scenes / "glass_sphere.ray", threads=1, **options)

@@ -176,7 +176,8 @@ pub struct RenderArgs {
     /// Image width in pixels [default: 512, or a pbrt-v4 scene's Film resolution].
     #[arg(long)]
     pub width: Option<usize>,
-    /// Image height in pixels (default: width / the camera's aspect ratio).
+    /// Image height in pixels (default: width / the camera's aspect ratio; another aspect crops
+    /// or extends the picture by the format's rule, never stretches it).
     #[arg(long)]
     pub height: Option<usize>,
     /// N×N stratified, jittered samples per pixel.
@@ -348,7 +349,8 @@ pub struct PhotonArgs {
     /// Image width in pixels.
     #[arg(long, default_value_t = 512)]
     pub width: usize,
-    /// Image height in pixels (default: width / the camera's aspect ratio).
+    /// Image height in pixels (default: width / the camera's aspect ratio; another aspect crops
+    /// or extends the picture by the format's rule, never stretches it).
     #[arg(long)]
     pub height: Option<usize>,
     /// Worker threads (default: all cores).

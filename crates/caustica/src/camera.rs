@@ -1,7 +1,7 @@
 //! The camera: a pinhole whose image plane is spanned by `u` and `v` (the course's camera, §4;
 //! every scene format describes one of these, see [`CameraDesc`]).
 
-use crate::description::CameraDesc;
+use crate::description::{CameraDesc, FovAxis};
 use crate::math::{Ray, Vec3};
 
 /// A pinhole camera.
@@ -17,6 +17,8 @@ pub struct Camera {
     pub v: Vec3,
     /// Width / height.
     pub aspect_ratio: f32,
+    /// Which span keeps its field of view in an image of another aspect ([`Camera::fitted`]).
+    pub fov_axis: FovAxis,
 }
 
 impl Default for Camera {
@@ -33,6 +35,7 @@ impl Camera {
         if let Some(right) = desc.right {
             camera.u = right * desc.height * desc.aspect_ratio;
         }
+        camera.fov_axis = desc.fov_axis;
         camera
     }
 
@@ -45,7 +48,69 @@ impl Camera {
             u: x * h * aspect_ratio,
             v: up * h,
             aspect_ratio,
+            fov_axis: FovAxis::Vertical,
         }
+    }
+
+    /// The camera for a `width` × `height` image: itself when the image has its aspect (to the
+    /// pixel), else widened or narrowed along one axis by the format's rule ([`FovAxis`]), so
+    /// the picture is cropped or extended, never stretched.
+    pub fn fitted(&self, width: usize, height: usize) -> Camera {
+        if self.fits(width, height) {
+            return self.clone();
+        }
+        let aspect = width as f32 / height as f32;
+        let (du, dv) = (self.u.length(), self.v.length());
+        let (su, sv) = match self.fov_axis {
+            FovAxis::Vertical => (dv * aspect, dv),
+            FovAxis::Shorter => {
+                let s = du.min(dv);
+                if aspect >= 1.0 {
+                    (s * aspect, s)
+                } else {
+                    (s, s / aspect)
+                }
+            }
+        };
+        let scaled = |axis: Vec3, from: f32, to: f32| if from > 0.0 { axis * (to / from) } else { axis };
+        Camera {
+            u: scaled(self.u, du, su),
+            v: scaled(self.v, dv, sv),
+            aspect_ratio: aspect,
+            ..self.clone()
+        }
+    }
+
+    /// Whether a `width` × `height` image has this camera's aspect, to the pixel.
+    fn fits(&self, width: usize, height: usize) -> bool {
+        let rounded = |a: usize, aspect: f32| ((a as f32 * aspect).round() as usize).max(1);
+        height == self.height_for_width(width) || width == rounded(height, self.aspect_ratio)
+    }
+
+    /// What [`Camera::fitted`] does for a `width` × `height` image, in words; `None` when the
+    /// image has the camera's aspect.
+    pub fn fit_note(&self, width: usize, height: usize) -> Option<String> {
+        if self.fits(width, height) {
+            return None;
+        }
+        let fitted = self.fitted(width, height);
+        let kept = match self.fov_axis {
+            FovAxis::Vertical => "the vertical field of view is kept (the format's rule)",
+            FovAxis::Shorter => "the field of view spans the shorter side (pbrt's rule)",
+        };
+        let wider = fitted.aspect_ratio > self.aspect_ratio;
+        let (side, change) = match (self.fov_axis, wider) {
+            (FovAxis::Vertical, true) => ("sides", "extended"),
+            (FovAxis::Vertical, false) => ("sides", "cropped"),
+            (FovAxis::Shorter, _) if fitted.u.length() > self.u.length() * 1.0001 => ("sides", "extended"),
+            (FovAxis::Shorter, _) if fitted.u.length() < self.u.length() * 0.9999 => ("sides", "cropped"),
+            (FovAxis::Shorter, _) if fitted.v.length() > self.v.length() * 1.0001 => ("top and bottom", "extended"),
+            (FovAxis::Shorter, _) => ("top and bottom", "cropped"),
+        };
+        Some(format!(
+            "the image is {width}×{height} (aspect {:.3}) and the camera's frame {:.3}: {kept}, so the picture is {change} at the {side}, not stretched",
+            fitted.aspect_ratio, self.aspect_ratio
+        ))
     }
 
     /// The primary ray through normalised screen point (sx, sy) ∈ [0, 1]², sy = 0 at the bottom;

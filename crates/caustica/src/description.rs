@@ -5,6 +5,8 @@
 //! Materials are already resolved: each object holds the finished material it renders with.
 
 use crate::error::Span;
+pub use crate::texture::ImageSource;
+use crate::texture::{Encoding, Sampler, Wrap};
 use glam::{Mat4, Vec2, Vec3};
 use std::path::PathBuf;
 
@@ -82,8 +84,21 @@ pub struct CameraDesc {
     /// The image plane's rightward direction per unit, when it is not `up × −view` (a
     /// left-handed camera such as pbrt's); `None` for the usual right-handed one.
     pub right: Option<Vec3>,
+    /// Which span keeps its field of view when the image's aspect differs from `aspect_ratio`.
+    pub fov_axis: FovAxis,
     /// Where the camera is described.
     pub span: Span,
+}
+
+/// The axis whose field of view a format fixes: an image of another aspect than the camera's
+/// widens or narrows along the other one, so nothing is stretched.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FovAxis {
+    /// The vertical span (glTF's `yfov`, the course's `fov`, OBJ's framing).
+    #[default]
+    Vertical,
+    /// The shorter of the two spans (pbrt's `fov`).
+    Shorter,
 }
 
 /// A light.
@@ -228,13 +243,46 @@ pub enum Param {
         /// Cells per unit of u and v.
         scale: Vec2,
     },
-    /// `map("file")`: the path resolved against the scene file's directory.
-    Texture {
-        /// Resolved path of the image file.
-        path: PathBuf,
-        /// Where `map(...)` is written, for error reporting when the file cannot be read.
-        span: Span,
-    },
+    /// An image map (`map("file")`, pbrt's `imagemap`, glTF's and OBJ's textures).
+    Texture(Box<ImageMap>),
+}
+
+/// An image map: its image, how the image's values are decoded and how it is sampled.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImageMap {
+    /// The image.
+    pub source: ImageSource,
+    /// How integer texels become linear values.
+    pub encoding: Encoding,
+    /// Transform, wrap, filter and factor.
+    pub sampler: Sampler,
+    /// Where the map is written, for messages when the image cannot be read.
+    pub span: Span,
+}
+
+impl ImageMap {
+    /// A map of the course's `.ray` kind: `path` read as stored, clamped, bilinear.
+    pub fn course(path: PathBuf, span: Span) -> ImageMap {
+        ImageMap {
+            source: ImageSource::File(path),
+            encoding: Encoding::Linear,
+            sampler: Sampler::default(),
+            span,
+        }
+    }
+
+    /// A colour map of a physical format (glTF, pbrt, OBJ): sRGB-decoded, repeating, bilinear.
+    pub fn colour(source: ImageSource, span: Span) -> ImageMap {
+        ImageMap {
+            source,
+            encoding: Encoding::Srgb,
+            sampler: Sampler {
+                wrap: [Wrap::Repeat; 2],
+                ..Sampler::default()
+            },
+            span,
+        }
+    }
 }
 
 impl Param {

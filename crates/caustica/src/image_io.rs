@@ -3,39 +3,92 @@
 
 use crate::error::{Error, Result};
 use crate::math::Vec3;
-use crate::texture::Texture;
+use crate::texture::{Encoding, Image, ImageSource, Sampler, Texture};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
 
 /// Largest texture accepted, in pixels (8192 × 4096): a small compressed file can declare a huge
 /// image, and each pixel costs 24 bytes once converted.
 const MAX_TEXTURE_PIXELS: u64 = 1 << 25;
 
-/// Loads a texture: PNG, JPEG, BMP, PPM/PGM/PBM or TGA, recognised by content whatever the
+/// Loads a texture as the course's `.ray` maps are read: values as stored, clamped, bilinear.
+/// PNG, JPEG, BMP, PPM/PGM/PBM or TGA (and EXR, HDR), recognised by content whatever the
 /// extension says (TGA, which has no signature, by its extension); 8 or 16 bits per channel,
 /// alpha ignored.
 pub fn load_texture(path: &Path) -> Result<Texture> {
+    let image = load_image(&ImageSource::File(path.to_path_buf()), Encoding::Linear)?;
+    Ok(Texture::sampled(Arc::new(image), Sampler::default()))
+}
+
+/// Decodes an image from a file or from bytes held in a scene file into linear values:
+/// integer images through `encoding`, float images (EXR, HDR) as stored.
+pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
     let image_error = |message: String| Error::Image {
-        path: path.to_path_buf(),
+        path: match source {
+            ImageSource::File(path) => path.clone(),
+            ImageSource::Memory { name, .. } => PathBuf::from(name),
+        },
         message,
     };
-    let reader = || -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>> {
-        image::ImageReader::open(path)
-            .and_then(|r| r.with_guessed_format())
-            .map_err(|e| image_error(e.to_string()))
+    let decoded = match source {
+        ImageSource::File(path) => {
+            let reader = || -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>> {
+                image::ImageReader::open(path)
+                    .and_then(|r| r.with_guessed_format())
+                    .map_err(|e| image_error(e.to_string()))
+            };
+            check_size(reader()?.into_dimensions().map_err(|e| image_error(e.to_string()))?).map_err(image_error)?;
+            reader()?.decode()
+        }
+        ImageSource::Memory { bytes, .. } => {
+            let reader = || {
+                image::ImageReader::new(std::io::Cursor::new(&bytes[..]))
+                    .with_guessed_format()
+                    .map_err(|e| image_error(e.to_string()))
+            };
+            check_size(reader()?.into_dimensions().map_err(|e| image_error(e.to_string()))?).map_err(image_error)?;
+            reader()?.decode()
+        }
     };
-    // The header's size is checked before anything is decoded.
-    let (w, h) = reader()?.into_dimensions().map_err(|e| image_error(e.to_string()))?;
+    let img = decoded.map_err(|e| image_error(e.to_string()))?;
+    let (w, h) = (img.width() as usize, img.height() as usize);
+    let texels: Vec<Vec3> = match img.color() {
+        image::ColorType::Rgb32F | image::ColorType::Rgba32F => {
+            img.to_rgb32f().pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect()
+        }
+        // 8-bit images (most textures) decode through a table: no power per texel.
+        image::ColorType::L8 | image::ColorType::La8 | image::ColorType::Rgb8 | image::ColorType::Rgba8 => {
+            let table: Vec<f32> = (0..=255u8).map(|v| encoding.to_linear(f32::from(v) / 255.0)).collect();
+            let at = |v: u8| table[usize::from(v)];
+            img.to_rgb8()
+                .pixels()
+                .map(|p| Vec3::new(at(p[0]), at(p[1]), at(p[2])))
+                .collect()
+        }
+        _ => img
+            .to_rgb32f()
+            .pixels()
+            .map(|p| {
+                Vec3::new(
+                    encoding.to_linear(p[0]),
+                    encoding.to_linear(p[1]),
+                    encoding.to_linear(p[2]),
+                )
+            })
+            .collect(),
+    };
+    Image::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()))
+}
+
+/// Refuses an image whose header declares more than [`MAX_TEXTURE_PIXELS`], before decoding.
+fn check_size((w, h): (u32, u32)) -> std::result::Result<(), String> {
     if u64::from(w) * u64::from(h) > MAX_TEXTURE_PIXELS {
-        return Err(image_error(format!(
+        return Err(format!(
             "the image is {w}×{h}, too large: at most {MAX_TEXTURE_PIXELS} pixels are accepted"
-        )));
+        ));
     }
-    let img = reader()?.decode().map_err(|e| image_error(e.to_string()))?;
-    let rgb = img.to_rgb32f();
-    let (w, h) = (rgb.width() as usize, rgb.height() as usize);
-    let texels = rgb.pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect();
-    Texture::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()))
+    Ok(())
 }
 
 /// The formats caustica writes, chosen by the output file's extension.

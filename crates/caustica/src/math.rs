@@ -2,7 +2,7 @@
 //!
 //! caustica computes in `f32` (glam's `Vec3`); positions, directions and normals share that type.
 
-pub use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
+pub use glam::{Affine2, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 
 /// A ray `origin + t · dir`; `dir` need not be unit length unless a caller says so.
 #[derive(Clone, Copy, Debug, PartialEq)]

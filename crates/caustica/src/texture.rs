@@ -1,55 +1,214 @@
-//! Image textures: bilinear lookup with (0, 0) at the bottom-left corner (§6.3).
+//! Image textures: an image of linear RGB texels and how a material samples it — a transform
+//! of the texture coordinates, the wrap of each axis, the filter and a factor. (0, 0) is the
+//! image's bottom-left corner (§6.3); readers whose formats put v downwards flip it.
 
-use crate::math::{Vec2, Vec3};
+use crate::math::{Affine2, Vec2, Vec3};
+use std::sync::Arc;
 
-/// An RGB image in [0, 1] per channel, rows stored top to bottom as in the file.
+/// Where an image's bytes are.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ImageSource {
+    /// A file, its path resolved against the scene file's folder.
+    File(std::path::PathBuf),
+    /// Bytes held in the scene file (a GLB's binary chunk, a data URI), named for messages
+    /// as `file#images[i]`.
+    Memory {
+        /// The name messages use.
+        name: String,
+        /// The encoded image (PNG, JPEG, …).
+        bytes: std::sync::Arc<[u8]>,
+    },
+}
+
+impl ImageSource {
+    /// The file's path, or the name of bytes in the scene file.
+    pub fn name(&self) -> String {
+        match self {
+            ImageSource::File(path) => path.display().to_string(),
+            ImageSource::Memory { name, .. } => name.clone(),
+        }
+    }
+}
+
+/// An RGB image of linear values, rows stored top to bottom as in the file.
 #[derive(Clone, Debug)]
-pub struct Texture {
+pub struct Image {
     width: usize,
     height: usize,
     texels: Vec<Vec3>,
 }
 
+impl Image {
+    /// An image from rows stored top to bottom; `None` if the size does not match.
+    pub fn new(width: usize, height: usize, texels: Vec<Vec3>) -> Option<Image> {
+        (width > 0 && height > 0 && texels.len() == width * height).then_some(Image { width, height, texels })
+    }
+}
+
+/// How an integer image's stored values become linear light (float images are linear).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Encoding {
+    /// As stored, over the largest value (data maps, and the course's `.ray` maps).
+    Linear,
+    /// The sRGB curve (colour maps of glTF, pbrt and OBJ).
+    Srgb,
+    /// A power law: stored value to the power G (pbrt's `"gamma G"`).
+    Gamma(f32),
+}
+
+impl Encoding {
+    /// The linear value of a stored value in [0, 1].
+    #[inline]
+    pub fn to_linear(self, stored: f32) -> f32 {
+        match self {
+            Encoding::Linear => stored,
+            Encoding::Srgb if stored <= 0.04045 => stored / 12.92,
+            Encoding::Srgb => ((stored + 0.055) / 1.055).powf(2.4),
+            Encoding::Gamma(g) => stored.max(0.0).powf(g),
+        }
+    }
+}
+
+/// What a texture coordinate outside 0..1 reads, per axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Wrap {
+    /// The edge texel (the course's `.ray` maps).
+    #[default]
+    Clamp,
+    /// The image tiles (glTF's REPEAT, pbrt's and OBJ's default).
+    Repeat,
+    /// The image tiles, every other copy mirrored (glTF's MIRRORED_REPEAT).
+    Mirror,
+    /// Black outside (pbrt's `black`).
+    Black,
+}
+
+impl Wrap {
+    /// The texel index `i` reads on an axis of `n` texels; `None`: black.
+    #[inline]
+    fn index(self, i: i64, n: usize) -> Option<usize> {
+        let n = n as i64;
+        Some(match self {
+            Wrap::Clamp => i.clamp(0, n - 1),
+            Wrap::Repeat => i.rem_euclid(n),
+            Wrap::Mirror => {
+                let k = i.rem_euclid(2 * n);
+                if k < n {
+                    k
+                } else {
+                    2 * n - 1 - k
+                }
+            }
+            Wrap::Black if (0..n).contains(&i) => i,
+            Wrap::Black => return None,
+        } as usize)
+    }
+}
+
+/// How a texture is read from its image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sampler {
+    /// Wrap of u and of v.
+    pub wrap: [Wrap; 2],
+    /// Nearest texel instead of bilinear filtering.
+    pub nearest: bool,
+    /// From the hit's texture coordinates to the image's (both with v upwards).
+    pub transform: Affine2,
+    /// Multiplies every texel (a glTF factor, pbrt's `scale`).
+    pub scale: Vec3,
+}
+
+impl Default for Sampler {
+    /// The course's maps: clamped, bilinear, as stored.
+    fn default() -> Self {
+        Sampler {
+            wrap: [Wrap::Clamp; 2],
+            nearest: false,
+            transform: Affine2::IDENTITY,
+            scale: Vec3::ONE,
+        }
+    }
+}
+
+/// An image as a material samples it.
+#[derive(Clone, Debug)]
+pub struct Texture {
+    image: Arc<Image>,
+    sampler: Sampler,
+}
+
 impl Texture {
-    /// A texture from rows stored top to bottom; `None` if the size does not match.
+    /// A texture from rows stored top to bottom, sampled as the course's maps are; `None` if
+    /// the size does not match.
     pub fn new(width: usize, height: usize, texels: Vec<Vec3>) -> Option<Texture> {
-        (width > 0 && height > 0 && texels.len() == width * height).then_some(Texture { width, height, texels })
+        Image::new(width, height, texels).map(|image| Texture::sampled(Arc::new(image), Sampler::default()))
+    }
+
+    /// `image` read through `sampler`.
+    pub fn sampled(image: Arc<Image>, sampler: Sampler) -> Texture {
+        Texture { image, sampler }
     }
 
     /// Width in texels.
     pub fn width(&self) -> usize {
-        self.width
+        self.image.width
     }
 
     /// Height in texels.
     pub fn height(&self) -> usize {
-        self.height
+        self.image.height
     }
 
-    /// The texel in column `x`, row `y` (rows from the top).
+    /// The stored texel in column `x`, row `y` (rows from the top), without the sampler.
     #[inline]
     pub fn texel(&self, x: usize, y: usize) -> Vec3 {
-        self.texels[y * self.width + x]
+        self.image.texels[y * self.image.width + x]
     }
 
-    /// Bilinearly filtered colour at `uv`, u to the right and v upwards, clamped at the edges.
+    /// The texel at column `x`, row `y` counted upwards from the bottom, wrapped.
+    #[inline]
+    fn wrapped(&self, x: i64, y_up: i64) -> Vec3 {
+        let (w, h) = (self.image.width, self.image.height);
+        match (self.sampler.wrap[0].index(x, w), self.sampler.wrap[1].index(y_up, h)) {
+            (Some(x), Some(y)) => self.image.texels[(h - 1 - y) * w + x],
+            _ => Vec3::ZERO,
+        }
+    }
+
+    /// The colour at `uv`, u to the right and v upwards: transformed, wrapped, filtered and
+    /// scaled by the sampler.
     pub fn lookup(&self, uv: Vec2) -> Vec3 {
-        let x = (uv.x.clamp(0.0, 1.0) * self.width as f32 - 0.5).clamp(0.0, (self.width - 1) as f32);
-        let y_up = (uv.y.clamp(0.0, 1.0) * self.height as f32 - 0.5).clamp(0.0, (self.height - 1) as f32);
-        let y = (self.height - 1) as f32 - y_up;
-        let (x0, y0) = (x.floor() as usize, y.floor() as usize);
-        let (x1, y1) = ((x0 + 1).min(self.width - 1), (y0 + 1).min(self.height - 1));
-        let (fx, fy) = (x - x0 as f32, y - y0 as f32);
-        let at = |xx: usize, yy: usize| self.texels[yy * self.width + xx];
-        let top = at(x0, y0).lerp(at(x1, y0), fx);
-        let bottom = at(x0, y1).lerp(at(x1, y1), fx);
-        top.lerp(bottom, fy)
+        let s = &self.sampler;
+        let uv = s.transform.transform_point2(uv);
+        let (w, h) = (self.image.width as f32, self.image.height as f32);
+        // Past ±2^40 texels a coordinate is noise: kept finite so the index stays exact.
+        let limit = 1.0e12;
+        let (x, y) = ((uv.x * w).clamp(-limit, limit), (uv.y * h).clamp(-limit, limit));
+        if !(x.is_finite() && y.is_finite()) {
+            return Vec3::ZERO;
+        }
+        let colour = if s.nearest {
+            self.wrapped(x.floor() as i64, y.floor() as i64)
+        } else {
+            let (x, y) = (x - 0.5, y - 0.5);
+            let (x0, y0) = (x.floor(), y.floor());
+            let (fx, fy) = (x - x0, y - y0);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            let bottom = self.wrapped(x0, y0).lerp(self.wrapped(x0 + 1, y0), fx);
+            let top = self.wrapped(x0, y0 + 1).lerp(self.wrapped(x0 + 1, y0 + 1), fx);
+            bottom.lerp(top, fy)
+        };
+        colour * s.scale
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn image(w: usize, h: usize, texels: Vec<Vec3>) -> Arc<Image> {
+        Arc::new(Image::new(w, h, texels).unwrap())
+    }
 
     #[test]
     fn origin_is_bottom_left_and_filter_is_bilinear() {
@@ -63,5 +222,64 @@ mod tests {
         assert!((mid - Vec3::new(0.5, 0.0, 0.5)).length() < 1e-6);
         assert_eq!(t.lookup(Vec2::new(-3.0, 7.0)), red, "clamped outside [0, 1]");
         assert!(Texture::new(2, 2, vec![red]).is_none());
+    }
+
+    /// One row of four texels 0, 1, 2, 3 read at texel centres beyond the image's edges.
+    #[test]
+    fn each_wrap_reads_the_texel_its_rule_names() {
+        let row = image(4, 1, (0..4).map(|i| Vec3::splat(i as f32)).collect());
+        let at = |wrap: Wrap, texel: f32| {
+            let sampler = Sampler {
+                wrap: [wrap, Wrap::Clamp],
+                nearest: true,
+                ..Sampler::default()
+            };
+            Texture::sampled(row.clone(), sampler)
+                .lookup(Vec2::new((texel + 0.5) / 4.0, 0.5))
+                .x
+        };
+        for (texel, clamp, repeat, mirror, black) in [
+            (-1.0, 0.0, 3.0, 0.0, 0.0),
+            (-5.0, 0.0, 3.0, 3.0, 0.0),
+            (2.0, 2.0, 2.0, 2.0, 2.0),
+            (4.0, 3.0, 0.0, 3.0, 0.0),
+            (6.0, 3.0, 2.0, 1.0, 0.0),
+            (9.0, 3.0, 1.0, 1.0, 0.0),
+        ] {
+            assert_eq!(at(Wrap::Clamp, texel), clamp, "clamp at {texel}");
+            assert_eq!(at(Wrap::Repeat, texel), repeat, "repeat at {texel}");
+            assert_eq!(at(Wrap::Mirror, texel), mirror, "mirror at {texel}");
+            assert_eq!(at(Wrap::Black, texel), black, "black at {texel}");
+        }
+    }
+
+    /// Bilinear filtering across a repeating edge blends the last texel with the first.
+    #[test]
+    fn a_repeating_edge_filters_across_the_seam() {
+        let row = image(2, 1, vec![Vec3::ZERO, Vec3::ONE]);
+        let sampler = Sampler {
+            wrap: [Wrap::Repeat; 2],
+            ..Sampler::default()
+        };
+        let t = Texture::sampled(row, sampler);
+        assert!((t.lookup(Vec2::new(0.0, 0.5)).x - 0.5).abs() < 1e-6);
+        assert!((t.lookup(Vec2::new(2.0, 0.5)).x - 0.5).abs() < 1e-6);
+        assert!((t.lookup(Vec2::new(0.75, 0.5)).x - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn the_transform_and_scale_apply_before_and_after_the_lookup() {
+        // Left half black, right half white; the transform mirrors u.
+        let row = image(2, 1, vec![Vec3::ZERO, Vec3::ONE]);
+        let sampler = Sampler {
+            nearest: true,
+            transform: Affine2::from_cols(Vec2::new(-1.0, 0.0), Vec2::Y, Vec2::new(1.0, 0.0)),
+            scale: Vec3::new(0.5, 0.25, 2.0),
+            ..Sampler::default()
+        };
+        let t = Texture::sampled(row, sampler);
+        assert_eq!(t.lookup(Vec2::new(0.1, 0.5)), Vec3::new(0.5, 0.25, 2.0));
+        assert_eq!(t.lookup(Vec2::new(0.9, 0.5)), Vec3::ZERO);
+        assert_eq!(t.lookup(Vec2::new(f32::NAN, 0.5)), Vec3::ZERO);
     }
 }

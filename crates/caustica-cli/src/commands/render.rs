@@ -176,6 +176,11 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     }
     let mut session = RenderSession::new(scene, config.render_options(loaded.scene_id.clone())?)?;
     let (width, height) = session.size();
+    // An image of another aspect than the camera's is cropped or extended, and said so.
+    let camera_fit = scene.camera().fit_note(width, height);
+    if let Some(note) = camera_fit.as_ref().filter(|_| !quiet) {
+        eprintln!("note: {note}");
+    }
     let exposure = options.exposure;
     let tone_map = match options.tone_map.as_deref() {
         Some("reinhard") => ToneMap::Reinhard { exposure },
@@ -289,6 +294,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "integrator_why": integrator_why,
                 "model": "physical",
                 "width": width,
+                "camera_fit": camera_fit,
                 "height": height,
                 "passes": passes_done,
                 "pass_ranges": ranges.join(","),
@@ -313,6 +319,7 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
                 "integrator": "whitted",
                 "model": "course",
                 "width": width,
+                "camera_fit": camera_fit,
                 "height": height,
                 "samples_per_pixel": aa * aa,
                 "photons_stored": photon_stats.as_ref().map_or(0, |s| s.stored),

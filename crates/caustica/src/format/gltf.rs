@@ -9,12 +9,14 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
+    CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial,
+    SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{Error, ParseError, Result, Span};
 use crate::progress::Progress;
+use crate::texture::Wrap;
 use ::gltf::json;
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Affine2, Mat4, Quat, Vec2, Vec3};
 use json::validation::{Checked, Validate};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -759,7 +761,7 @@ impl Reader<'_, '_> {
             .unwrap_or(0.0) as f32;
         let base = match &pbr.base_color_texture {
             Some(info) => self.texture(
-                info.index.value(),
+                info,
                 &format!("{path}.pbrMetallicRoughness.baseColorTexture"),
                 base_factor,
             ),
@@ -780,13 +782,10 @@ impl Reader<'_, '_> {
             );
         }
         let emissive = Vec3::from(m.emissive_factor.0).max(Vec3::ZERO) * emissive_strength.max(0.0);
-        if m.emissive_texture.is_some() {
-            self.warn_once(
-                "emissivetexture",
-                &format!("{path}.emissiveTexture"),
-                "emissive textures are not read: the factor is used",
-            );
-        }
+        let emissive_param = match &m.emissive_texture {
+            Some(info) if emissive != Vec3::ZERO => self.texture(info, &format!("{path}.emissiveTexture"), emissive),
+            _ => Param::Constant(emissive),
+        };
         if emissive != Vec3::ZERO && !m.double_sided {
             self.warn_once("onesided", &path, "caustica's emissive surfaces emit from both faces");
         }
@@ -801,7 +800,7 @@ impl Reader<'_, '_> {
             );
         }
         let mut desc = MaterialDesc {
-            emissive: Param::Constant(emissive),
+            emissive: emissive_param,
             name: m.name.clone(),
             ..MaterialDesc::default()
         };
@@ -894,36 +893,128 @@ impl Reader<'_, '_> {
         Ok(desc)
     }
 
-    /// A base-colour texture: image files are read; embedded images are not (a warning).
-    fn texture(&mut self, texture: usize, path: &str, factor: Vec3) -> Param {
-        let image = self.root.textures[texture].source.value();
-        let Some(uri) = self.root.images[image].uri.clone() else {
-            self.warn_once(
-                "embeddedimage",
-                path,
-                "images inside the file are not read: the base colour factor is used",
-            );
+    /// A colour texture (`info` at JSON path `path`) times `factor`, sRGB-decoded: its image
+    /// from a file, a data URI or a buffer view (a GLB's binary chunk), with the texture's
+    /// sampler and `KHR_texture_transform`. An image that cannot be used (KTX2, WebP, a
+    /// missing file) is a warning, and the factor stands in for the texture.
+    fn texture(&mut self, info: &json::texture::Info, path: &str, factor: Vec3) -> Param {
+        let transform = info.extensions.as_ref().and_then(|e| e.texture_transform.as_ref());
+        let tex_coord = transform.and_then(|t| t.tex_coord).unwrap_or(info.tex_coord);
+        let Some(texture) = self.root.textures.get(info.index.value()) else {
             return Param::Constant(factor);
         };
-        if uri.starts_with("data:") {
-            self.warn_once(
-                "embeddedimage",
-                path,
-                "images inside the file are not read: the base colour factor is used",
-            );
+        let image = texture.source.value();
+        let Some(source) = self.image_source(image, path) else {
             return Param::Constant(factor);
-        }
-        if factor != Vec3::ONE {
+        };
+        if tex_coord != 0 {
             self.warn_once(
-                "texturefactor",
+                "texcoord",
                 path,
-                "a base colour factor times a texture: the texture alone is used",
+                format!("texture coordinate set {tex_coord} is not read: TEXCOORD_0 is used"),
             );
         }
-        Param::Texture {
-            path: self.dir.join(percent_decode(&uri)),
-            span: locate(&self.files.main().text, &format!("images[{image}].uri")),
+        let mut map = ImageMap::colour(source, locate(&self.files.main().text, path));
+        map.sampler.scale = factor;
+        if let Some(sampler) = texture.sampler.and_then(|i| self.root.samplers.get(i.value())) {
+            use json::texture::{MagFilter, WrappingMode};
+            let wrap = |mode: &Checked<WrappingMode>| match mode {
+                Checked::Valid(WrappingMode::ClampToEdge) => Wrap::Clamp,
+                Checked::Valid(WrappingMode::MirroredRepeat) => Wrap::Mirror,
+                _ => Wrap::Repeat,
+            };
+            map.sampler.wrap = [wrap(&sampler.wrap_s), wrap(&sampler.wrap_t)];
+            map.sampler.nearest = matches!(sampler.mag_filter, Some(Checked::Valid(MagFilter::Nearest)));
         }
+        // glTF's v runs down the image and the reader flipped it (v ↦ 1 − v): the transform,
+        // written for glTF's coordinates, is conjugated by that flip.
+        if let Some(t) = transform {
+            let (offset, scale, rotation) = (Vec2::from(t.offset.0), Vec2::from(t.scale.0), t.rotation.0);
+            let (sin, cos) = rotation.sin_cos();
+            // T · R · S, R = [[cos, sin], [−sin, cos]] (the extension's definition).
+            let gltf = Affine2::from_cols(Vec2::new(cos, -sin) * scale.x, Vec2::new(sin, cos) * scale.y, offset);
+            let flip = Affine2::from_cols(Vec2::X, -Vec2::Y, Vec2::Y);
+            map.sampler.transform = flip * gltf * flip;
+        }
+        Param::Texture(Box::new(map))
+    }
+
+    /// Where image `image`'s bytes are, or `None` with a warning naming `path` when the image
+    /// cannot be read (a format caustica does not decode, a missing file or buffer).
+    fn image_source(&mut self, image: usize, path: &str) -> Option<ImageSource> {
+        let entry = self.root.images.get(image)?;
+        let mime = entry.mime_type.as_ref().map(|m| m.0.to_ascii_lowercase());
+        let uri = entry.uri.clone();
+        let name = format!("{}#images[{image}]", self.files.main().path.display());
+        let ext = uri
+            .as_deref()
+            .and_then(|u| u.rsplit('.').next())
+            .map(str::to_ascii_lowercase);
+        let unread = match (mime.as_deref(), ext.as_deref()) {
+            (Some("image/ktx2"), _) | (_, Some("ktx2")) => Some("KTX2"),
+            (Some("image/webp"), _) | (_, Some("webp")) => Some("WebP"),
+            _ => None,
+        };
+        if let Some(kind) = unread {
+            let what = uri.clone().unwrap_or(name);
+            self.warn(
+                path,
+                format!("{kind} images are not read (`{what}`): the factor is used instead"),
+            );
+            return None;
+        }
+        match (uri, entry.buffer_view) {
+            (Some(uri), _) if uri.starts_with("data:") => match self.load_uri(&uri, &format!("images[{image}].uri")) {
+                Ok(bytes) => Some(ImageSource::Memory {
+                    name,
+                    bytes: bytes.into(),
+                }),
+                Err(e) => {
+                    self.warn(path, format!("{}: the factor is used instead", e.message));
+                    None
+                }
+            },
+            (Some(uri), _) => {
+                let file = self.dir.join(percent_decode(&uri));
+                if !file.is_file() {
+                    self.warn(
+                        &format!("images[{image}].uri"),
+                        format!("the image `{}` is missing: the factor is used instead", file.display()),
+                    );
+                    return None;
+                }
+                Some(ImageSource::File(file))
+            }
+            (None, Some(view)) => match self.view_bytes(view.value()) {
+                Some(bytes) => Some(ImageSource::Memory {
+                    name,
+                    bytes: bytes.into(),
+                }),
+                None => {
+                    self.warn(
+                        &format!("images[{image}].bufferView"),
+                        "the image's buffer view lies outside its buffer: the factor is used instead",
+                    );
+                    None
+                }
+            },
+            (None, None) => {
+                self.warn(
+                    &format!("images[{image}]"),
+                    "the image has neither a uri nor a buffer view",
+                );
+                None
+            }
+        }
+    }
+
+    /// The bytes of buffer view `view`, if they lie inside a loaded buffer.
+    fn view_bytes(&self, view: usize) -> Option<Vec<u8>> {
+        let v = self.root.buffer_views.get(view)?;
+        let buffer = self.buffers.get(v.buffer.value())?.as_ref()?;
+        let start = v.byte_offset.map_or(0, |o| o.0) as usize;
+        let end = start.checked_add(v.byte_length.0 as usize)?;
+        buffer.get(start..end).map(<[u8]>::to_vec)
     }
 
     fn camera(&mut self, index: usize, world: Mat4, node_path: &str) {
@@ -956,6 +1047,7 @@ impl Reader<'_, '_> {
             height: 2.0 * (yfov * 0.5).tan(),
             aspect_ratio: aspect,
             right: Some(right),
+            fov_axis: FovAxis::Vertical,
             span: locate(&self.files.main().text, &format!("cameras[{index}]")),
         });
     }

@@ -7,7 +7,8 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    CameraDesc, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
+    CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial,
+    SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{Error, ParseError, Result, Span};
 use crate::progress::Progress;
@@ -538,7 +539,18 @@ pub fn parse_mtl(
                         head.1.clone(),
                     ));
                 }
-                entry.map_kd = Some((dir.join(file.0), file.1.clone()));
+                let path = dir.join(file.0);
+                if path.is_file() {
+                    entry.map_kd = Some((path, file.1.clone()));
+                } else {
+                    warnings.push((
+                        format!(
+                            "the texture `{}` is missing: the diffuse colour Kd is used",
+                            path.display()
+                        ),
+                        file.1.clone(),
+                    ));
+                }
             }
             other => {
                 ignored.entry(other.to_string()).or_insert_with(|| head.1.clone());
@@ -588,10 +600,10 @@ impl MtlEntry {
             m.specular = Param::grey(0.0);
         }
         if let Some((path, span)) = &self.map_kd {
-            m.diffuse = Param::Texture {
-                path: path.clone(),
-                span: span.clone(),
-            };
+            m.diffuse = Param::Texture(Box::new(ImageMap::colour(
+                ImageSource::File(path.clone()),
+                span.clone(),
+            )));
         }
         if matches!(illum, 3 | 5 | 8) {
             m.reflective = Param::Constant(ks);
@@ -647,6 +659,7 @@ pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, aspect_ratio
         height: 2.0 * (fov_degrees.to_radians() * 0.5).tan(),
         aspect_ratio,
         right: None,
+        fov_axis: FovAxis::Vertical,
         span: 0..0,
     }
 }

@@ -20,12 +20,13 @@ use self::lexer::{Kind, Lexer, Token};
 use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
-    CameraDesc, IntegratorHint, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial, SceneDescription,
-    ShapeDesc, TrimeshDesc,
+    CameraDesc, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, ObjectDesc, Param,
+    PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use crate::texture::{Encoding, Wrap};
+use glam::{Affine2, Mat3, Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -789,6 +790,7 @@ impl<'f> Reader<'f> {
             height: (window[3] - window[2]) * t,
             aspect_ratio: (window[1] - window[0]) / (window[3] - window[2]),
             right: Some(right),
+            fov_axis: FovAxis::Shorter,
             span,
         });
         Ok(())
@@ -1061,29 +1063,65 @@ impl<'f> Reader<'f> {
                 let Some((file, span)) = params.string("filename")? else {
                     return Err(ParseError::new("an imagemap needs `string filename`", class.span));
                 };
-                for (what, default) in [
-                    ("uscale", 1.0),
-                    ("vscale", 1.0),
-                    ("udelta", 0.0),
-                    ("vdelta", 0.0),
-                    ("scale", 1.0),
-                ] {
-                    if params.float(what)?.is_some_and(|v| v != default) {
-                        let s = params.span_of(what).unwrap_or(span.clone());
-                        self.warn(format!("`{what}` of an image texture is not applied"), s);
-                    }
+                let image = self.dir.join(file);
+                if !image.is_file() {
+                    self.warn(
+                        format!("the image `{}` is missing: the texture reads mid grey", image.display()),
+                        span.clone(),
+                    );
+                    self.textures.insert(name.text, TextureValue::Param(Param::grey(0.5)));
+                    return Ok(());
                 }
+                let mut map = ImageMap::colour(ImageSource::File(image), span.clone());
+                // pbrt's UV mapping: (su·u + du, sv·v + dv).
+                let (su, sv) = (params.float_or("uscale", 1.0)?, params.float_or("vscale", 1.0)?);
+                let (du, dv) = (params.float_or("udelta", 0.0)?, params.float_or("vdelta", 0.0)?);
+                map.sampler.transform =
+                    Affine2::from_scale_angle_translation(Vec2::new(su, sv), 0.0, Vec2::new(du, dv));
+                map.sampler.scale = Vec3::splat(params.float_or("scale", 1.0)?);
                 if params.bool_or("invert", false)? {
                     self.warn("`invert` of an image texture is not applied", class.span.clone());
                 }
-                let _ = params.string("filter");
-                let _ = params.string("wrap");
-                let _ = params.string("encoding");
+                if let Some((filter, s)) = params.string("filter")? {
+                    match filter.as_str() {
+                        "point" => map.sampler.nearest = true,
+                        "bilinear" | "trilinear" | "ewa" | "EWA" => {}
+                        other => self.warn(format!("unknown filter \"{other}\": bilinear is used"), s),
+                    }
+                }
+                if let Some((wrap, s)) = params.string("wrap")? {
+                    map.sampler.wrap = [match wrap.as_str() {
+                        "repeat" => Wrap::Repeat,
+                        "black" => Wrap::Black,
+                        "clamp" => Wrap::Clamp,
+                        other => {
+                            let what = if other == "octahedralsphere" {
+                                "is not read"
+                            } else {
+                                "is unknown"
+                            };
+                            self.warn(format!("wrap \"{other}\" {what}: repeat is used"), s);
+                            Wrap::Repeat
+                        }
+                    }; 2];
+                }
+                if let Some((encoding, s)) = params.string("encoding")? {
+                    map.encoding = match encoding.as_str() {
+                        "sRGB" => Encoding::Srgb,
+                        "linear" => Encoding::Linear,
+                        g => match g.strip_prefix("gamma ").map(|v| v.trim().parse::<f32>()) {
+                            Some(Ok(g)) if g > 0.0 && g.is_finite() => Encoding::Gamma(g),
+                            _ => {
+                                return Err(ParseError::new(
+                                    format!("`encoding` is \"sRGB\", \"linear\" or \"gamma G\", not \"{g}\""),
+                                    s,
+                                ))
+                            }
+                        },
+                    };
+                }
                 let _ = params.float("maxanisotropy");
-                TextureValue::Param(Param::Texture {
-                    path: self.dir.join(file),
-                    span,
-                })
+                TextureValue::Param(Param::Texture(Box::new(map)))
             }
             "checkerboard" => {
                 let (a, b) = if float {

@@ -85,6 +85,8 @@ pub struct GiMaps {
 /// The integrator over a whole image.
 pub struct Gi<'a> {
     scene: &'a Scene,
+    /// The scene's camera fitted to the image ([`Camera::fitted`]).
+    camera: crate::camera::Camera,
     settings: GiSettings,
     width: usize,
     height: usize,
@@ -100,12 +102,14 @@ pub struct Gi<'a> {
 impl<'a> Gi<'a> {
     /// A renderer for `scene` at `width`×`height`.
     pub fn new(scene: &'a Scene, settings: GiSettings, width: usize, height: usize, seed: u64) -> Gi<'a> {
+        let camera = scene.camera().fitted(width, height);
         Gi {
             scene,
             width,
             height,
             seed,
-            pixel_angle: pixel_angle(scene.camera(), height),
+            pixel_angle: pixel_angle(&camera, height),
+            camera,
             mis: bsdf_can_reach_light(scene),
             spectral: settings_spectral(&settings.spectral, scene),
             settings,
@@ -283,7 +287,7 @@ impl Progressive for Gi<'_> {
         if control.cancelled() {
             return None;
         }
-        let camera = self.scene.camera();
+        let camera = &self.camera;
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             wl.to_rgb(self.radiance(&maps, camera.generate_ray(sx, sy), &wl, rng))
         })

@@ -53,6 +53,8 @@ const ROUND: u64 = 64;
 
 /// Where on the film a point is seen, and how much importance the eye gives it.
 pub struct Sensor {
+    /// The camera fitted to the film ([`Camera::fitted`]).
+    camera: Camera,
     eye: Vec3,
     /// Unit normal of the image plane (towards the scene).
     normal: Vec3,
@@ -77,8 +79,9 @@ pub struct SensorSample {
 }
 
 impl Sensor {
-    /// The sensor of `camera` with a film of `width`×`height` pixels.
+    /// The sensor of `camera` with a film of `width`×`height` pixels (the camera fitted to it).
     pub fn new(camera: &Camera, width: usize, height: usize) -> Sensor {
+        let camera = camera.fitted(width, height);
         let cross = camera.u.cross(camera.v);
         let area = cross.length();
         let normal = if area > 0.0 { cross / area } else { camera.look };
@@ -91,6 +94,7 @@ impl Sensor {
         };
         Sensor {
             eye: camera.eye,
+            camera,
             normal,
             scale,
             width,
@@ -109,7 +113,7 @@ impl Sensor {
         }
     }
 
-    /// Where `p` lands on the film of `camera` (`None`: outside the view or behind the eye).
+    /// Where `p` lands on the film (`None`: outside the view or behind the eye).
     ///
     /// A pixel's value is the mean radiance over its square of screen coordinates (sx, sy),
     /// of area 1/(W·H). Screen point (sx, sy) lies on the image plane at
@@ -117,7 +121,8 @@ impl Sensor {
     /// dω = cos θ dA / ℓ² with ℓ = d / cos θ (d: the plane's distance, θ: the angle to its
     /// normal). So the pixel is ∫ W·H·d² / (|u × v| cos³θ) · L dω over its directions, and
     /// that factor is the importance We (docs/radiometry.md).
-    pub fn sample(&self, camera: &Camera, p: Vec3) -> Option<SensorSample> {
+    pub fn sample(&self, p: Vec3) -> Option<SensorSample> {
+        let camera = &self.camera;
         if self.scale <= 0.0 {
             return None;
         }
@@ -225,7 +230,7 @@ impl<'a> LightTracer<'a> {
     /// adjoint BSDF needs Veach's correction |wo·ns| |ωe·ng| / (|wo·ng| |ωe·ns|), so the cosine
     /// becomes |ωe·ng| |wo·ns| / |wo·ng|.
     fn connect(&self, hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3, power: Spectrum) -> Option<(usize, Spectrum)> {
-        let s = self.sensor.sample(self.scene.camera(), hit.point)?;
+        let s = self.sensor.sample(hit.point)?;
         let f = bsdf.eval(wo, s.to_eye);
         if f == Spectrum::ZERO {
             return None;

@@ -111,6 +111,8 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengt
 /// The path tracer over a whole image, one sample per pixel per pass.
 pub struct PathTracer<'a> {
     scene: &'a Scene,
+    /// The scene's camera fitted to the image ([`Camera::fitted`]).
+    camera: crate::camera::Camera,
     settings: PathSettings,
     width: usize,
     height: usize,
@@ -122,6 +124,7 @@ impl<'a> PathTracer<'a> {
     pub fn new(scene: &'a Scene, settings: PathSettings, width: usize, height: usize, seed: u64) -> PathTracer<'a> {
         PathTracer {
             scene,
+            camera: scene.camera().fitted(width, height),
             settings,
             width,
             height,
@@ -132,7 +135,7 @@ impl<'a> PathTracer<'a> {
 
 impl super::Progressive for PathTracer<'_> {
     fn render_pass(&self, pass: u64, control: crate::progress::Control) -> Option<Vec<Vec3>> {
-        let camera = self.scene.camera();
+        let camera = &self.camera;
         let spectral = super::ppm::settings_spectral(&self.settings.spectral, self.scene);
         super::tiles::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             // Each sample its own wavelengths: no photons need to agree with it.

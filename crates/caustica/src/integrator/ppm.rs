@@ -97,6 +97,8 @@ pub(crate) fn settings_spectral(asked: &Option<bool>, scene: &Scene) -> bool {
 /// The progressive photon mapper over a whole image.
 pub struct Ppm<'a> {
     scene: &'a Scene,
+    /// The scene's camera fitted to the image ([`Camera::fitted`]).
+    camera: crate::camera::Camera,
     settings: PpmSettings,
     width: usize,
     height: usize,
@@ -113,9 +115,11 @@ pub struct Ppm<'a> {
 impl<'a> Ppm<'a> {
     /// A renderer for `scene` at `width`×`height`.
     pub fn new(scene: &'a Scene, settings: PpmSettings, width: usize, height: usize, seed: u64) -> Ppm<'a> {
-        let pixel_angle = pixel_angle(scene.camera(), height);
+        let camera = scene.camera().fitted(width, height);
+        let pixel_angle = pixel_angle(&camera, height);
         Ppm {
             scene,
+            camera,
             width,
             height,
             seed,
@@ -179,7 +183,7 @@ impl Progressive for Ppm<'_> {
             return None;
         }
         let factor = radius_factor(pass, self.settings.alpha);
-        let camera = self.scene.camera();
+        let camera = &self.camera;
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             wl.to_rgb(self.radiance(&map, camera.generate_ray(sx, sy), factor, &wl, rng))
         })

@@ -306,6 +306,8 @@ struct CameraVertex<'h> {
 /// The renderer over a whole image.
 pub struct Vcm<'a> {
     scene: &'a Scene,
+    /// The scene's camera fitted to the image ([`Camera::fitted`]).
+    camera: crate::camera::Camera,
     settings: VcmSettings,
     width: usize,
     height: usize,
@@ -403,17 +405,18 @@ const PILOT_TO_PASS_COST: f64 = 2.1;
 impl<'a> Vcm<'a> {
     /// A renderer for `scene` at `width`×`height`.
     pub fn new(scene: &'a Scene, settings: VcmSettings, width: usize, height: usize, seed: u64) -> Vcm<'a> {
-        let camera = scene.camera();
+        let camera = scene.camera().fitted(width, height);
         let radius = match settings.initial_radius {
             InitialRadius::World(r) => r,
             InitialRadius::Pixels(px) => {
                 let distance = (scene.lights().scene_sphere().0 - camera.eye).length().max(1e-6);
-                px * super::radius::pixel_angle(camera, height) * distance
+                px * super::radius::pixel_angle(&camera, height) * distance
             }
         };
         Vcm {
             scene,
-            sensor: Sensor::new(camera, width, height),
+            sensor: Sensor::new(&camera, width, height),
+            camera,
             emitters: Emitters::new(
                 scene.lights(),
                 if settings.aim {
@@ -605,7 +608,7 @@ impl<'a> Vcm<'a> {
     /// same random numbers, so the camera strategies' part is the same and the light's differs.
     fn balance_pixel(&self, pixel: usize, pilot: &BalanceHalves, wl: &Wavelengths) -> (PixelSpread, CameraWork) {
         let (w, h) = (self.width, self.height);
-        let camera = self.scene.camera();
+        let camera = &self.camera;
         let scale = pilot.scale;
         let mut rng = Rng::new(self.seed ^ BALANCE_SEED ^ 1, pixel as u64);
         let (x, y) = (pixel % w, pixel / w);
@@ -654,7 +657,7 @@ impl<'a> Vcm<'a> {
             if focus.is_empty() {
                 return vec![false; w * h];
             }
-            let camera = self.scene.camera();
+            let camera = &self.camera;
             let centre: Vec<bool> = (0..w * h)
                 .into_par_iter()
                 .map(|pixel| {
@@ -812,7 +815,7 @@ impl<'a> Vcm<'a> {
         if v.length == 1 || v.length + 1 > self.max_length {
             return;
         }
-        let Some(s) = self.sensor.sample(self.scene.camera(), v.hit.point) else {
+        let Some(s) = self.sensor.sample(v.hit.point) else {
             return;
         };
         let value = bsdf.eval(v.wo, s.to_eye);
@@ -1425,7 +1428,7 @@ impl Vcm<'_> {
             f,
             radius,
         );
-        let camera = self.scene.camera();
+        let camera = &self.camera;
         let (w, h) = (self.width, self.height);
         let focus_pixels = self.focus_pixels();
         let (mut film, complete) = shade_tiles(w, h, control, false, |x, y| {

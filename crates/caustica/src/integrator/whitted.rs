@@ -253,7 +253,7 @@ pub fn render(
     image: &super::ImageSettings,
     control: crate::progress::Control,
 ) -> (crate::film::Film, bool) {
-    let camera = scene.camera();
+    let camera = &scene.camera().fitted(image.width, image.height);
     let reuse = settings.reuse_caustic_estimates;
     // A pixel's width at unit distance along a camera path.
     let pixel_angle = super::radius::pixel_angle(camera, image.height);

@@ -22,7 +22,7 @@ pub fn photon_color(flags: u8) -> Vec3 {
 /// Draws the photons the camera can see as one-pixel points on black.
 pub fn draw_photons(scene: &Scene, photons: &[Photon], width: usize, height: usize) -> Film {
     let mut film = Film::new(width, height);
-    let camera = scene.camera();
+    let camera = scene.camera().fitted(width, height);
     for photon in photons {
         let Some((sx, sy)) = camera.project(photon.position) else {
             continue;

@@ -18,7 +18,6 @@ use crate::math::{Aabb, Mat3, Vec3};
 use crate::progress::{NoProgress, Progress};
 use crate::texture::Texture;
 use std::collections::HashMap;
-use std::path::PathBuf;
 
 /// Options for building a scene.
 #[derive(Clone, Debug, Default)]
@@ -243,7 +242,8 @@ struct Builder {
     materials: Vec<Material>,
     material_ids: HashMap<MaterialKey, u32>,
     textures: Vec<Texture>,
-    texture_ids: HashMap<PathBuf, u32>,
+    texture_ids: HashMap<String, u32>,
+    images: HashMap<String, std::sync::Arc<crate::texture::Image>>,
     shapes: Vec<Shape>,
     shape_materials: Vec<u32>,
     meshes: Vec<Mesh>,
@@ -474,24 +474,33 @@ impl Builder {
                 self.textures.push(checkerboard(*even, *odd, *scale));
                 Ok(Channel::Texture(id))
             }
-            Param::Texture { path, span } => {
-                if let Some(&id) = self.texture_ids.get(path) {
+            Param::Texture(map) => {
+                let source = map.source.name();
+                // One texture per image and sampler, one decoded image per file and encoding.
+                let key = format!("{source}\u{0}{:?}\u{0}{:?}", map.encoding, map.sampler);
+                if let Some(&id) = self.texture_ids.get(&key) {
                     return Ok(Channel::Texture(id));
                 }
-                let texture = image_io::load_texture(path).map_err(|e| {
-                    let reason = match e {
-                        Error::Image { message, .. } => message,
-                        other => other.to_string(),
-                    };
-                    ParseError::new(
-                        format!("cannot read the texture `{}`: {reason}", path.display()),
-                        span.clone(),
-                    )
-                    .with_help("texture paths are resolved against the scene file's folder; PNG, JPEG, BMP, PPM and TGA are read")
-                })?;
+                let image_key = format!("{source}\u{0}{:?}", map.encoding);
+                let image = match self.images.get(&image_key) {
+                    Some(image) => image.clone(),
+                    None => {
+                        let image = image_io::load_image(&map.source, map.encoding).map_err(|e| {
+                            let reason = match e {
+                                Error::Image { message, .. } => message,
+                                other => other.to_string(),
+                            };
+                            ParseError::new(format!("cannot read the texture `{source}`: {reason}"), map.span.clone())
+                                .with_help("texture paths are resolved against the scene file's folder; PNG, JPEG, BMP, PPM, TGA, EXR and HDR are read")
+                        })?;
+                        let image = std::sync::Arc::new(image);
+                        self.images.insert(image_key, image.clone());
+                        image
+                    }
+                };
                 let id = self.textures.len() as u32;
-                self.textures.push(texture);
-                self.texture_ids.insert(path.clone(), id);
+                self.textures.push(Texture::sampled(image, map.sampler));
+                self.texture_ids.insert(key, id);
                 Ok(Channel::Texture(id))
             }
         }

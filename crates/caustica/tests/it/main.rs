@@ -8,6 +8,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod camera_fit;
 mod caustic_scenes;
 mod caustics;
 mod closed_forms;
@@ -23,5 +24,6 @@ mod photon_budget;
 mod physical;
 mod shadow_acne;
 mod spectral;
+mod textures;
 mod vcm;
 mod whitted;

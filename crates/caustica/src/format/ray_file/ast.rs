@@ -6,7 +6,7 @@
 //! current-default inheritance of dialect T and the named materials of both dialects are applied,
 //! so each object holds the finished material it will render with.
 
-use crate::description::{CameraDesc, SceneDescription};
+use crate::description::{CameraDesc, FovAxis, SceneDescription};
 pub use crate::description::{LightDesc, MaterialDesc, ObjectDesc, Param, ShapeDesc, TrimeshDesc};
 use crate::error::ParseError;
 pub use crate::error::Span;
@@ -212,6 +212,7 @@ impl RayCamera {
             height: h,
             aspect_ratio: aspect,
             right: None,
+            fov_axis: FovAxis::Vertical,
             span: self.span.clone(),
         }
     }

@@ -640,10 +640,10 @@ impl<'a> Reader<'a> {
             Kind::Str => &self.text[s.start + 1..s.end - 1],
             _ => self.word(s),
         };
-        Param::Texture {
-            path: self.scene_dir.join(name),
+        Param::Texture(Box::new(crate::description::ImageMap::course(
+            self.scene_dir.join(name),
             span,
-        }
+        )))
     }
 
     /// A transform chain ending in a primitive, walked iteratively.

@@ -100,7 +100,10 @@ fn hkust_texture_is_the_diffuse_map() {
     let scene = read(body);
     assert_eq!(scene.dialect, Dialect::Hkust, "`texture = \"…\"` marks an HKUST file");
     match &scene.objects[0].material.diffuse {
-        Param::Texture { path, .. } => assert_eq!(path, &PathBuf::from("scenes/earth.bmp")),
+        Param::Texture(map) => assert_eq!(
+            map.source,
+            crate::description::ImageSource::File(PathBuf::from("scenes/earth.bmp"))
+        ),
         other => panic!("{other:?}"),
     }
     let plain = read_as(body, Some(Dialect::Dictionary)).unwrap();

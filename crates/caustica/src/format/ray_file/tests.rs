@@ -279,9 +279,10 @@ fn materials_inherit_from_the_current_default() {
     assert_eq!(m[2].specular, Param::Constant(Vec3::Y));
     assert_eq!(m[2].index, Param::grey(1.5));
     match &m[2].transmissive {
-        Param::Texture { path, span } => {
-            assert_eq!(path, &PathBuf::from("scenes/glass.png"));
-            assert_eq!(span.end - span.start, "map(\"glass.png\")".len());
+        Param::Texture(map) => {
+            let course = crate::description::ImageMap::course(PathBuf::from("scenes/glass.png"), map.span.clone());
+            assert_eq!(**map, course, "read as stored, clamped, bilinear");
+            assert_eq!(map.span.end - map.span.start, "map(\"glass.png\")".len());
         }
         other => panic!("{other:?}"),
     }
@@ -627,7 +628,9 @@ fn dialect_o_reads_its_own_rules() {
     let inline = &scene.objects[1].material;
     assert_eq!(inline.reflective, Param::Constant(Vec3::Z));
     assert_eq!(inline.specular, Param::grey(0.0));
-    assert!(matches!(&inline.diffuse, Param::Texture { path, .. } if path == &PathBuf::from("scenes/brick.bmp")));
+    assert!(
+        matches!(&inline.diffuse, Param::Texture(map) if map.source == crate::description::ImageSource::File(PathBuf::from("scenes/brick.bmp")))
+    );
     let ShapeDesc::Trimesh(mesh) = &scene.objects[2].shape else {
         panic!("mesh")
     };

@@ -1003,10 +1003,10 @@ impl<'a> Parser<'a> {
         self.cur.expect(Tok::LParen, "after `map`")?;
         let (file, _) = self.identifier("(the image file) in `map(…)`")?;
         self.cur.expect(Tok::RParen, "to close `map(…)`")?;
-        Ok(Param::Texture {
-            path: self.scene_dir.join(file),
-            span: start..self.cur.prev_end(),
-        })
+        Ok(Param::Texture(Box::new(crate::description::ImageMap::course(
+            self.scene_dir.join(file),
+            start..self.cur.prev_end(),
+        ))))
     }
 
     fn push_object(&mut self, shape: ShapeDesc, material: MaterialDesc, span: Span) {

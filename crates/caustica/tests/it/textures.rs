@@ -1,0 +1,396 @@
+//! Image textures as each format means them, checked against the formats' own definitions:
+//! the sRGB curve for 8-bit colour maps, glTF's sampler and `KHR_texture_transform` formulas,
+//! pbrt-v4's `imagemap` parameters, OBJ's `map_Kd`; images in files, data URIs and a GLB's
+//! binary chunk rendering the same pixels; a missing image a warning, not a refusal.
+
+use crate::common::control;
+use crate::formats::base64;
+use caustica::integrator::{RenderConfig, RenderSession};
+use caustica::loader::{load, LoadSettings};
+use caustica::material::Channel;
+use caustica::math::{Vec2, Vec3};
+use caustica::scene::Scene;
+use std::path::{Path, PathBuf};
+
+/// The sRGB transfer function of an 8-bit value (IEC 61966-2-1), written out here.
+fn srgb(v: u8) -> f32 {
+    let c = f64::from(v) / 255.0;
+    (if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }) as f32
+}
+
+fn folder(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("caustica-textures-{}-{test}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A PNG of `w`×`h` RGB texels, rows from the top.
+fn png(w: u32, h: u32, texels: &[[u8; 3]]) -> Vec<u8> {
+    let image = image::RgbImage::from_fn(w, h, |x, y| image::Rgb(texels[(y * w + x) as usize]));
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    bytes.into_inner()
+}
+
+/// The diffuse colour of the scene's only textured material at `uv` (v upwards).
+fn diffuse_at(scene: &Scene, uv: Vec2) -> Vec3 {
+    let material = scene
+        .materials()
+        .iter()
+        .find(|m| matches!(m.diffuse, Channel::Texture(_)))
+        .expect("a textured material");
+    material.eval(scene.textures(), uv).diffuse
+}
+
+fn near(a: Vec3, b: Vec3, tolerance: f32) -> bool {
+    (a - b).abs().max_element() <= tolerance
+}
+
+/// How a glTF file holds its image.
+#[derive(Clone, Copy, PartialEq)]
+enum Holder {
+    File,
+    DataUri,
+    Glb,
+}
+
+/// A unit quad in z = 0 (u along x, glTF's v down along −y) with one textured material, its
+/// image held as `holder` says; `material` and `sampler` are JSON written into the file.
+fn quad_gltf(dir: &Path, image: &[u8], holder: Holder, material: &str, sampler: &str) -> PathBuf {
+    let positions: [f32; 12] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0];
+    let uvs: [f32; 8] = [0.0, 1.0, 1.0, 1.0, 1.0, 0.0, 0.0, 0.0];
+    let indices: [u16; 6] = [0, 1, 2, 0, 2, 3];
+    let mut buffer: Vec<u8> = positions.iter().chain(&uvs).flat_map(|v| v.to_le_bytes()).collect();
+    buffer.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    let mut views = vec![
+        r#"{"buffer":0,"byteOffset":0,"byteLength":48}"#.to_string(),
+        r#"{"buffer":0,"byteOffset":48,"byteLength":32}"#.to_string(),
+        r#"{"buffer":0,"byteOffset":80,"byteLength":12}"#.to_string(),
+    ];
+    let image_json = match holder {
+        Holder::File => {
+            std::fs::write(dir.join("texels.png"), image).unwrap();
+            r#"{"uri":"texels.png"}"#.to_string()
+        }
+        Holder::DataUri => format!(r#"{{"uri":"data:image/png;base64,{}"}}"#, base64(image)),
+        Holder::Glb => {
+            buffer.resize(buffer.len().next_multiple_of(4), 0);
+            views.push(format!(
+                r#"{{"buffer":0,"byteOffset":{},"byteLength":{}}}"#,
+                buffer.len(),
+                image.len()
+            ));
+            buffer.extend(image);
+            r#"{"bufferView":3,"mimeType":"image/png"}"#.to_string()
+        }
+    };
+    buffer.resize(buffer.len().next_multiple_of(4), 0);
+    let buffer_json = match holder {
+        Holder::Glb => format!(r#"{{"byteLength":{}}}"#, buffer.len()),
+        _ => format!(
+            r#"{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}"#,
+            buffer.len(),
+            base64(&buffer)
+        ),
+    };
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],
+"nodes":[{{"mesh":0}},{{"camera":0,"translation":[0.5,0.5,2]}}],
+"cameras":[{{"type":"perspective","perspective":{{"yfov":0.4,"aspectRatio":1,"znear":0.1}}}}],
+"materials":[{material}],
+"textures":[{{"source":0,"sampler":0}}],"samplers":[{sampler}],"images":[{image_json}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"TEXCOORD_0":1}},"indices":2,"material":0}}]}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":4,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+{{"bufferView":1,"componentType":5126,"count":4,"type":"VEC2"}},
+{{"bufferView":2,"componentType":5123,"count":6,"type":"SCALAR"}}],
+"bufferViews":[{}],"buffers":[{buffer_json}]}}"#,
+        views.join(",")
+    );
+    if holder != Holder::Glb {
+        let path = dir.join("quad.gltf");
+        std::fs::write(&path, json).unwrap();
+        return path;
+    }
+    let mut json = json.into_bytes();
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend(((12 + 8 + json.len() + 8 + buffer.len()) as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((buffer.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&buffer);
+    let path = dir.join("quad.glb");
+    std::fs::write(&path, glb).unwrap();
+    path
+}
+
+/// A diffuse material (no metal, no specular layer) whose base colour is texture 0 times
+/// `factor`.
+fn diffuse_material(factor: &str, texture_info: &str) -> String {
+    format!(
+        r#"{{"pbrMetallicRoughness":{{"baseColorFactor":{factor},"metallicFactor":0,"baseColorTexture":{texture_info}}},
+"extensions":{{"KHR_materials_specular":{{"specularFactor":0}}}}}}"#
+    )
+}
+
+const LINEAR_REPEAT: &str = r#"{"magFilter":9729,"wrapS":10497,"wrapT":10497}"#;
+
+/// A uniform 8-bit base-colour texture reads the sRGB decoding of its value times the factor;
+/// the same file with its image in a file, a data URI and a GLB's binary chunk renders the
+/// same pixels, and a diffuse quad under the default sky of radiance 1 shows that albedo.
+#[test]
+fn a_uniform_colour_texture_is_srgb_decoded_and_times_its_factor_wherever_the_image_is() {
+    let dir = folder("uniform");
+    let texel = [128u8, 64, 200];
+    let image = png(2, 2, &[texel; 4]);
+    let material = diffuse_material("[0.5,1,1,1]", r#"{"index":0}"#);
+    let want = Vec3::new(0.5 * srgb(128), srgb(64), srgb(200));
+    let mut films = Vec::new();
+    for holder in [Holder::File, Holder::DataUri, Holder::Glb] {
+        let scene = load(
+            &quad_gltf(&dir, &image, holder, &material, LINEAR_REPEAT),
+            &LoadSettings::default(),
+        )
+        .unwrap();
+        for uv in [Vec2::new(0.3, 0.7), Vec2::new(-2.6, 5.1)] {
+            let got = diffuse_at(&scene, uv);
+            assert!(near(got, want, 1e-6), "{got} vs {want}");
+        }
+        let config = RenderConfig {
+            integrator: Some("path".parse().unwrap()),
+            width: 16,
+            height: Some(16),
+            passes: Some("64".into()),
+            seed: 3,
+            ..RenderConfig::default()
+        };
+        let mut session = RenderSession::new(&scene, config.render_options("test").unwrap()).unwrap();
+        assert!(
+            session
+                .run(&config.plan().unwrap(), control(), |_| Ok(()))
+                .unwrap()
+                .complete
+        );
+        films.push(session.image());
+    }
+    assert!(
+        films.windows(2).all(|f| f[0].pixels == f[1].pixels),
+        "the three holders render alike"
+    );
+    // The quad fills the view's middle; a Lambertian plane under a uniform sky of radiance 1
+    // reflects its albedo.
+    let got = films[0].region_mean((6, 10), (6, 10));
+    assert!(
+        near(got, want, 0.03 * want.max_element()),
+        "rendered {got}, albedo {want}"
+    );
+}
+
+/// glTF's sampler (nearest, REPEAT on s, MIRRORED_REPEAT on t) and `KHR_texture_transform`
+/// (offset, rotation, scale) against the spec's formulas, texel by texel, at texture
+/// coordinates inside and far outside 0..1.
+#[test]
+fn gltf_sampler_and_texture_transform_follow_the_spec() {
+    let dir = folder("transform");
+    let texels: Vec<[u8; 3]> = (0..16u8).map(|i| [i * 16 + 8, 255 - i * 16, 40]).collect();
+    let image = png(4, 4, &texels);
+    let (offset, rotation, scale) = ([0.25f32, -0.5f32], 0.3f32, [2.0f32, 3.0f32]);
+    let info = format!(
+        r#"{{"index":0,"extensions":{{"KHR_texture_transform":{{"offset":[{},{}],"rotation":{rotation},"scale":[{},{}]}}}}}}"#,
+        offset[0], offset[1], scale[0], scale[1]
+    );
+    let material = diffuse_material("[1,1,1,1]", &info);
+    let sampler = r#"{"magFilter":9728,"minFilter":9728,"wrapS":10497,"wrapT":33648}"#;
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, &material, sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    let (sin, cos) = rotation.sin_cos();
+    let mut checked = 0;
+    for i in 0..23 {
+        for j in 0..19 {
+            // glTF's texture coordinates, v down.
+            let (u, v) = (-1.7 + i as f32 * 0.173, -2.3 + j as f32 * 0.261);
+            // The spec: T · R · S with R = [[cos, sin], [−sin, cos]].
+            let s = cos * scale[0] * u + sin * scale[1] * v + offset[0];
+            let t = -sin * scale[0] * u + cos * scale[1] * v + offset[1];
+            let repeat = s - s.floor();
+            let m = t.rem_euclid(2.0);
+            let mirror = if m <= 1.0 { m } else { 2.0 - m };
+            let (x, y) = (repeat * 4.0, mirror * 4.0);
+            if [x, y].iter().any(|c| (c - c.round()).abs() < 1e-3) {
+                continue; // on a texel edge: either neighbour is right
+            }
+            let texel = texels[(y.floor() as usize).min(3) * 4 + (x.floor() as usize).min(3)];
+            let want = Vec3::new(srgb(texel[0]), srgb(texel[1]), srgb(texel[2]));
+            let got = diffuse_at(&scene, Vec2::new(u, 1.0 - v));
+            assert!(near(got, want, 1e-6), "at ({u}, {v}): {got} vs texel {texel:?}");
+            checked += 1;
+        }
+    }
+    assert!(checked > 300, "{checked} points checked");
+}
+
+/// Each glTF wrap mode on its own, bilinear: CLAMP_TO_EDGE reads the edge texel beyond the
+/// image, the others tile.
+#[test]
+fn gltf_clamp_to_edge_holds_the_edge_texel() {
+    let dir = folder("clamp");
+    let image = png(2, 1, &[[0, 0, 0], [255, 255, 255]]);
+    let material = diffuse_material("[1,1,1,1]", r#"{"index":0}"#);
+    let sampler = r#"{"magFilter":9729,"wrapS":33071,"wrapT":33071}"#;
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, &material, sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    assert_eq!(diffuse_at(&scene, Vec2::new(3.4, 0.5)), Vec3::ONE);
+    assert_eq!(diffuse_at(&scene, Vec2::new(-3.4, 0.5)), Vec3::ZERO);
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, &material, LINEAR_REPEAT),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    // Repeating, u = 3 lies on the seam between the white last texel and the black first one.
+    assert!(near(diffuse_at(&scene, Vec2::new(3.0, 0.5)), Vec3::splat(0.5), 1e-6));
+}
+
+/// A missing image and a KTX2 image are warnings naming them; the factor stands in.
+#[test]
+fn an_image_that_cannot_be_read_is_a_warning_and_the_factor_stands_in() {
+    let dir = folder("missing");
+    let image = png(1, 1, &[[10, 20, 30]]);
+    let path = quad_gltf(
+        &dir,
+        &image,
+        Holder::File,
+        &diffuse_material("[0.2,0.4,0.6,1]", r#"{"index":0}"#),
+        LINEAR_REPEAT,
+    );
+    std::fs::remove_file(dir.join("texels.png")).unwrap();
+    let scene = load(&path, &LoadSettings::default()).unwrap();
+    assert!(
+        scene
+            .warnings()
+            .iter()
+            .any(|w| w.contains("texels.png") && w.contains("missing")),
+        "{:?}",
+        scene.warnings()
+    );
+    assert!(scene
+        .materials()
+        .iter()
+        .any(|m| m.diffuse == Channel::Constant(Vec3::new(0.2, 0.4, 0.6))));
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("texels.png", "texels.ktx2");
+    std::fs::write(&path, text).unwrap();
+    let scene = load(&path, &LoadSettings::default()).unwrap();
+    assert!(scene
+        .warnings()
+        .iter()
+        .any(|w| w.contains("KTX2") && w.contains("texels.ktx2")));
+}
+
+/// pbrt-v4's `imagemap`: 8-bit images are sRGB unless `encoding` says "linear" or "gamma G";
+/// `uscale`/`udelta` map u, `scale` multiplies, `wrap "black"` is black outside, `filter
+/// "point"` reads the nearest texel.
+#[test]
+fn pbrt_imagemap_encodings_mapping_and_wrap() {
+    let dir = folder("pbrt");
+    std::fs::write(dir.join("ramp.png"), png(2, 1, &[[100, 100, 100], [200, 200, 200]])).unwrap();
+    let scene_with = |texture: &str| {
+        let text = format!(
+            r#"LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+WorldBegin
+LightSource "point" "rgb I" [1 1 1] "point3 from" [0 0 2]
+Texture "t" "spectrum" "imagemap" "string filename" "ramp.png" "string filter" "point" {texture}
+Material "diffuse" "texture reflectance" "t"
+Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 1 1 0 0 1 0] "point2 uv" [0 0 1 0 1 1 0 1] "integer indices" [0 1 2 0 2 3]
+"#
+        );
+        std::fs::write(dir.join("scene.pbrt"), text).unwrap();
+        load(&dir.join("scene.pbrt"), &LoadSettings::default())
+    };
+    let scene_with = |texture: &str| scene_with(texture).unwrap();
+    let (left, right) = (Vec2::new(0.25, 0.5), Vec2::new(0.75, 0.5));
+    let s = scene_with("");
+    assert!(near(diffuse_at(&s, left), Vec3::splat(srgb(100)), 1e-6));
+    assert!(near(diffuse_at(&s, right), Vec3::splat(srgb(200)), 1e-6));
+    let s = scene_with(r#""string encoding" "linear""#);
+    assert!(near(diffuse_at(&s, left), Vec3::splat(100.0 / 255.0), 1e-6));
+    let s = scene_with(r#""string encoding" "gamma 2.2""#);
+    assert!(near(
+        diffuse_at(&s, right),
+        Vec3::splat((200.0f32 / 255.0).powf(2.2)),
+        1e-5
+    ));
+    // u ↦ 2u + 0.5: u = 0.1 reads 0.7 (the right texel), u = 0.3 reads 1.1, past the edge.
+    let s = scene_with(r#""float uscale" 2 "float udelta" 0.5 "string wrap" "black" "float scale" 0.5"#);
+    assert!(near(
+        diffuse_at(&s, Vec2::new(0.1, 0.5)),
+        Vec3::splat(0.5 * srgb(200)),
+        1e-6
+    ));
+    assert_eq!(diffuse_at(&s, Vec2::new(0.3, 0.5)), Vec3::ZERO);
+    let s = scene_with(r#""float uscale" 2 "float udelta" 0.5"#);
+    assert!(
+        near(diffuse_at(&s, Vec2::new(0.3, 0.5)), Vec3::splat(srgb(100)), 1e-6),
+        "repeats by default"
+    );
+}
+
+/// OBJ's `map_Kd` is an sRGB colour map that repeats.
+#[test]
+fn obj_map_kd_is_srgb_and_repeats() {
+    let dir = folder("obj");
+    std::fs::write(dir.join("wood.png"), png(1, 1, &[[30, 90, 150]])).unwrap();
+    std::fs::write(dir.join("m.mtl"), "newmtl wood\nKd 1 1 1\nmap_Kd wood.png\n").unwrap();
+    std::fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl wood\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let s = load(&dir.join("m.obj"), &LoadSettings::default()).unwrap();
+    let want = Vec3::new(srgb(30), srgb(90), srgb(150));
+    assert!(near(diffuse_at(&s, Vec2::new(4.2, -1.3)), want, 1e-6));
+}
+
+/// An emissive texture times `emissiveFactor` (and `KHR_materials_emissive_strength`): black
+/// texels do not glow.
+#[test]
+fn an_emissive_texture_glows_only_where_its_texels_do() {
+    let dir = folder("emissive");
+    let image = png(2, 1, &[[0, 0, 0], [255, 128, 255]]);
+    let material = r#"{"pbrMetallicRoughness":{"baseColorFactor":[0,0,0,1],"metallicFactor":0},
+"emissiveFactor":[1,0.5,1],"emissiveTexture":{"index":0},
+"extensions":{"KHR_materials_emissive_strength":{"emissiveStrength":4}}}"#;
+    let sampler = r#"{"magFilter":9728,"wrapS":10497,"wrapT":10497}"#;
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, material, sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    let m = scene
+        .materials()
+        .iter()
+        .find(|m| matches!(m.emissive, Channel::Texture(_)))
+        .expect("a textured emission");
+    assert_eq!(m.eval(scene.textures(), Vec2::new(0.25, 0.5)).emissive, Vec3::ZERO);
+    let want = Vec3::new(4.0, 2.0 * srgb(128), 4.0);
+    assert!(near(
+        m.eval(scene.textures(), Vec2::new(0.75, 0.5)).emissive,
+        want,
+        1e-5
+    ));
+}
