@@ -7,7 +7,7 @@
 use crate::error::Span;
 pub use crate::texture::ImageSource;
 use crate::texture::{Encoding, Sampler, Wrap};
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use std::path::PathBuf;
 
 /// A whole scene.
@@ -320,6 +320,11 @@ pub struct MaterialDesc {
     /// physical reading (docs/radiometry.md). The course fields always hold the closest course
     /// reading.
     pub physical: Option<PhysicalMaterial>,
+    /// A normal map bending the shading normal of meshes with texture coordinates.
+    pub normal_map: Option<NormalMap>,
+    /// glTF's metallic-roughness texture: where it is given, the physical reading at each point
+    /// follows it instead of `physical`.
+    pub metallic_roughness: Option<MetallicRoughness>,
 }
 
 /// A physically based material beyond the course fields' reading, generic over how a colour is
@@ -418,8 +423,51 @@ impl Default for MaterialDesc {
             abbe: None,
             name: None,
             physical: None,
+            normal_map: None,
+            metallic_roughness: None,
         }
     }
+}
+
+/// glTF's metallic-roughness model with its texture, generic over how a colour is given: at
+/// each point metalness is the texture's blue times `metallic`, roughness its green times
+/// `roughness` (GGX α = roughness²); a point at least half metal is a conductor of the base
+/// colour's reflectance, the rest the base colour under a clear coat of index `coat` (or bare
+/// Lambert without one).
+#[derive(Clone, Debug, PartialEq)]
+pub struct MetallicRoughness<P = Param> {
+    /// The base colour.
+    pub base: P,
+    /// The texture (linear).
+    pub texture: P,
+    /// `metallicFactor`.
+    pub metallic: f32,
+    /// `roughnessFactor`.
+    pub roughness: f32,
+    /// The dielectric's coat index (`None`: no specular layer).
+    pub coat: Option<f32>,
+}
+
+impl MetallicRoughness<Param> {
+    /// The same with each colour mapped by `f`.
+    pub fn try_map<Q, E>(&self, mut f: impl FnMut(&Param) -> Result<Q, E>) -> Result<MetallicRoughness<Q>, E> {
+        Ok(MetallicRoughness {
+            base: f(&self.base)?,
+            texture: f(&self.texture)?,
+            metallic: self.metallic,
+            roughness: self.roughness,
+            coat: self.coat,
+        })
+    }
+}
+
+/// A tangent-space normal map: its image (linear), and the scale of its x and y.
+#[derive(Clone, Debug, PartialEq)]
+pub struct NormalMap {
+    /// The image; texels map [0, 1] to normal components in [−1, 1].
+    pub map: ImageMap,
+    /// Multiplies the normal's x and y (glTF's `normalTexture.scale`).
+    pub scale: f32,
 }
 
 /// A primitive placed in the world.
@@ -540,4 +588,7 @@ pub struct TrimeshDesc {
     pub materials: Option<Vec<MaterialDesc>>,
     /// Per-vertex texture coordinates (UW `texture_uv`), same length as `points`.
     pub uvs: Option<Vec<Vec2>>,
+    /// Per-vertex tangents (glTF's `TANGENT`: the direction of increasing u, and in w the
+    /// bitangent's sign), same length as `points`; generated where a normal map needs them.
+    pub tangents: Option<Vec<Vec4>>,
 }

@@ -13,6 +13,7 @@ pub mod roots;
 pub mod shape;
 pub mod sphere;
 pub mod square;
+pub mod tangents;
 pub mod torus;
 pub mod triangle;
 pub mod triangle_packet;

@@ -72,6 +72,11 @@ pub struct Material {
     /// The physical model's reading when it is not the course fields' own (a metal, a coated
     /// or translucent surface, thin glass).
     pub physical: Option<PhysicalMaterial<Channel>>,
+    /// A tangent-space normal map on meshes with texture coordinates: the texture and the
+    /// scale of the normal's x and y.
+    pub normal_map: Option<(u32, f32)>,
+    /// glTF's metallic-roughness texture, which decides the physical reading point by point.
+    pub metallic_roughness: Option<crate::description::MetallicRoughness<Channel>>,
 }
 
 /// A material's constant colours as fitted smooth spectra (for spectral transport); `None`
@@ -247,6 +252,18 @@ impl Material {
         ]
         .iter()
         .any(|c| matches!(c, Channel::Texture(_)))
+            || self.normal_map.is_some()
+            || self.metallic_roughness.is_some()
+            || self.physical.as_ref().is_some_and(|p| {
+                p.try_map(|c| {
+                    if matches!(c, Channel::Texture(_)) {
+                        Err(())
+                    } else {
+                        Ok(())
+                    }
+                })
+                .is_err()
+            })
     }
 
     /// Whether the material can turn a photon specularly (mirror or glass): what makes caustics.
@@ -262,6 +279,26 @@ impl Material {
     /// The physical reading's values at texture coordinates `uv`, if it has its own.
     #[inline]
     pub fn physical_at(&self, textures: &[Texture], uv: Vec2) -> Option<PhysicalMaterial<Vec3>> {
+        if let Some(mr) = &self.metallic_roughness {
+            let texel = mr.texture.eval(textures, uv);
+            let base = mr.base.eval(textures, uv);
+            let roughness = (texel.y * mr.roughness).clamp(0.0, 1.0);
+            let alpha = roughness * roughness;
+            return if texel.z * mr.metallic >= 0.5 {
+                Some(PhysicalMaterial::Conductor {
+                    eta: Vec3::ONE,
+                    k: Vec3::ZERO,
+                    reflectance: Some(base),
+                    roughness: alpha,
+                })
+            } else {
+                mr.coat.map(|eta| PhysicalMaterial::CoatedDiffuse {
+                    reflectance: base,
+                    eta,
+                    roughness: alpha,
+                })
+            };
+        }
         let physical = self.physical.as_ref()?;
         physical.try_map(|c| Ok::<Vec3, ()>(c.eval(textures, uv))).ok()
     }

@@ -259,3 +259,31 @@ mod tests {
         assert!(Aabb::EMPTY.is_empty());
     }
 }
+
+/// Whether a transform cannot place a shape: not finite, or its linear part flattens space (its
+/// columns nearly coplanar). Scale-free, so a node scaled by 0.0001 still places its mesh.
+pub fn is_degenerate_transform(m: &Mat4) -> bool {
+    let linear = Mat3::from_mat4(*m);
+    let det = linear.determinant();
+    let size = linear.x_axis.length() * linear.y_axis.length() * linear.z_axis.length();
+    !(det.is_finite() && size.is_finite() && m.is_finite()) || det.abs() <= 1e-6 * size || size == 0.0
+}
+
+#[cfg(test)]
+mod transform_tests {
+    use super::*;
+
+    #[test]
+    fn tiny_scales_place_shapes_and_flat_or_broken_transforms_do_not() {
+        assert!(!is_degenerate_transform(&Mat4::from_scale(Vec3::splat(1e-4))));
+        assert!(!is_degenerate_transform(&Mat4::from_scale(Vec3::new(1e-5, 3e3, 1.0))));
+        assert!(is_degenerate_transform(&Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0))));
+        assert!(is_degenerate_transform(&Mat4::from_scale(Vec3::new(
+            1.0,
+            f32::NAN,
+            1.0
+        ))));
+        let flat = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::new(1.0, 1.0, 0.0, 0.0), Vec4::W);
+        assert!(is_degenerate_transform(&flat));
+    }
+}

@@ -27,6 +27,8 @@ pub struct Mesh {
     pub normals: Option<Vec<Vec3>>,
     /// Per-vertex texture coordinates.
     pub uvs: Option<Vec<Vec2>>,
+    /// Per-vertex world-space tangents (w: the bitangent's sign) where a normal map needs them.
+    pub tangents: Option<Vec<crate::math::Vec4>>,
     /// Per-vertex material ids.
     pub vertex_materials: Option<Vec<u32>>,
     /// The mesh's material id.
@@ -606,6 +608,22 @@ impl Scene {
                 weights: w,
             },
             None => MaterialRef::One(mesh.material),
+        };
+        let shading_normal = match (&mesh.tangents, self.materials[mesh.material as usize].normal_map) {
+            (Some(t), Some((texture, scale))) => {
+                let tangent = t[i0] * w[0] + t[i1] * w[1] + t[i2] * w[2];
+                let sign = if t[i0].w < 0.0 { -1.0 } else { 1.0 };
+                let texel = self.textures[texture as usize].lookup(uv);
+                crate::geometry::tangents::bend(
+                    shading_normal,
+                    geometric_normal,
+                    tangent.truncate(),
+                    sign,
+                    texel,
+                    scale,
+                )
+            }
+            _ => shading_normal,
         };
         SurfaceHit {
             t: hit.t,

@@ -9,14 +9,14 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial,
-    SceneDescription, ShapeDesc, TrimeshDesc,
+    CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, MetallicRoughness, NormalMap, ObjectDesc,
+    Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{Error, ParseError, Result, Span};
 use crate::progress::Progress;
-use crate::texture::Wrap;
+use crate::texture::{Encoding, Wrap};
 use ::gltf::json;
-use glam::{Affine2, Mat4, Quat, Vec2, Vec3};
+use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
 use json::validation::{Checked, Validate};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -658,11 +658,13 @@ impl Reader<'_, '_> {
             let mut position = None;
             let mut normal = None;
             let mut uv = None;
+            let mut tangent = None;
             for (semantic, accessor) in &primitive.attributes {
                 match semantic {
                     Checked::Valid(json::mesh::Semantic::Positions) => position = Some(accessor.value()),
                     Checked::Valid(json::mesh::Semantic::Normals) => normal = Some(accessor.value()),
                     Checked::Valid(json::mesh::Semantic::TexCoords(0)) => uv = Some(accessor.value()),
+                    Checked::Valid(json::mesh::Semantic::Tangents) => tangent = Some(accessor.value()),
                     _ => {}
                 }
             }
@@ -684,6 +686,16 @@ impl Reader<'_, '_> {
                     let (v, _) = self.accessor_data(a, 2, &format!("{path}.attributes[\"TEXCOORD_0\"]"))?;
                     // glTF's v runs down the image; caustica's up.
                     (v.len() == 2 * n).then(|| v.chunks(2).map(|c| Vec2::new(c[0], 1.0 - c[1])).collect())
+                }
+                None => None,
+            };
+            // Read for normal maps; a tangent that is not finite and unit-ish is regenerated.
+            let tangents: Option<Vec<Vec4>> = match tangent {
+                Some(a) => {
+                    let (v, _) = self.accessor_data(a, 4, &format!("{path}.attributes[\"TANGENT\"]"))?;
+                    let ts: Vec<Vec4> = v.chunks(4).map(Vec4::from_slice).collect();
+                    let usable = |t: &Vec4| t.is_finite() && t.truncate().length_squared() > 1e-6;
+                    (ts.len() == n && ts.iter().all(usable)).then_some(ts)
                 }
                 None => None,
             };
@@ -722,6 +734,7 @@ impl Reader<'_, '_> {
                     normals,
                     materials: None,
                     uvs,
+                    tangents,
                 })),
                 world_from_object: world,
                 material,
@@ -767,20 +780,38 @@ impl Reader<'_, '_> {
             ),
             None => Param::Constant(base_factor),
         };
-        if pbr.metallic_roughness_texture.is_some() {
-            self.warn_once(
-                "mrtexture",
-                &format!("{path}.pbrMetallicRoughness.metallicRoughnessTexture"),
-                "metallic-roughness textures are not read: the factors are used",
-            );
-        }
-        if m.normal_texture.is_some() {
-            self.warn_once(
-                "normaltexture",
-                &format!("{path}.normalTexture"),
-                "normal maps are not applied",
-            );
-        }
+        // Linear data: blue is metalness, green roughness. Glass keeps its factors.
+        let mr_texture = match &pbr.metallic_roughness_texture {
+            Some(info) if transmission < 0.5 => {
+                let mrpath = format!("{path}.pbrMetallicRoughness.metallicRoughnessTexture");
+                let transform = info.extensions.as_ref().and_then(|e| e.texture_transform.as_ref());
+                self.image_map(info.index.value(), info.tex_coord, transform, &mrpath)
+                    .map(|mut map| {
+                        map.encoding = Encoding::Linear;
+                        Param::Texture(Box::new(map))
+                    })
+            }
+            Some(_) => {
+                self.warn_once(
+                    "mrtexture",
+                    &format!("{path}.pbrMetallicRoughness.metallicRoughnessTexture"),
+                    "the metallic-roughness texture of a transmissive material is not read: the factors are used",
+                );
+                None
+            }
+            None => None,
+        };
+        let normal_map = match &m.normal_texture {
+            Some(n) => {
+                let npath = format!("{path}.normalTexture");
+                self.image_map(n.index.value(), n.tex_coord, None, &npath)
+                    .map(|mut map| {
+                        map.encoding = Encoding::Linear;
+                        NormalMap { map, scale: n.scale }
+                    })
+            }
+            None => None,
+        };
         let emissive = Vec3::from(m.emissive_factor.0).max(Vec3::ZERO) * emissive_strength.max(0.0);
         let emissive_param = match &m.emissive_texture {
             Some(info) if emissive != Vec3::ZERO => self.texture(info, &format!("{path}.emissiveTexture"), emissive),
@@ -801,9 +832,21 @@ impl Reader<'_, '_> {
         }
         let mut desc = MaterialDesc {
             emissive: emissive_param,
+            normal_map,
             name: m.name.clone(),
             ..MaterialDesc::default()
         };
+        if let Some(texture) = mr_texture {
+            desc.diffuse = base.clone();
+            desc.metallic_roughness = Some(MetallicRoughness {
+                base,
+                texture,
+                metallic,
+                roughness,
+                coat: (specular > 0.0).then_some(ior),
+            });
+            return Ok(desc);
+        }
         if metallic > 0.0 && metallic < 1.0 || transmission > 0.0 && transmission < 1.0 {
             self.warn_once(
                 "fractional",
@@ -899,14 +942,26 @@ impl Reader<'_, '_> {
     /// missing file) is a warning, and the factor stands in for the texture.
     fn texture(&mut self, info: &json::texture::Info, path: &str, factor: Vec3) -> Param {
         let transform = info.extensions.as_ref().and_then(|e| e.texture_transform.as_ref());
-        let tex_coord = transform.and_then(|t| t.tex_coord).unwrap_or(info.tex_coord);
-        let Some(texture) = self.root.textures.get(info.index.value()) else {
+        let Some(mut map) = self.image_map(info.index.value(), info.tex_coord, transform, path) else {
             return Param::Constant(factor);
         };
+        map.sampler.scale = factor;
+        Param::Texture(Box::new(map))
+    }
+
+    /// Texture `index` as an sRGB colour map with its sampler and transform; `None` (with a
+    /// warning) when its image cannot be used.
+    fn image_map(
+        &mut self,
+        index: usize,
+        tex_coord: u32,
+        transform: Option<&json::extensions::texture::TextureTransform>,
+        path: &str,
+    ) -> Option<ImageMap> {
+        let tex_coord = transform.and_then(|t| t.tex_coord).unwrap_or(tex_coord);
+        let texture = self.root.textures.get(index)?;
         let image = texture.source.value();
-        let Some(source) = self.image_source(image, path) else {
-            return Param::Constant(factor);
-        };
+        let source = self.image_source(image, path)?;
         if tex_coord != 0 {
             self.warn_once(
                 "texcoord",
@@ -915,7 +970,6 @@ impl Reader<'_, '_> {
             );
         }
         let mut map = ImageMap::colour(source, locate(&self.files.main().text, path));
-        map.sampler.scale = factor;
         if let Some(sampler) = texture.sampler.and_then(|i| self.root.samplers.get(i.value())) {
             use json::texture::{MagFilter, WrappingMode};
             let wrap = |mode: &Checked<WrappingMode>| match mode {
@@ -936,7 +990,7 @@ impl Reader<'_, '_> {
             let flip = Affine2::from_cols(Vec2::X, -Vec2::Y, Vec2::Y);
             map.sampler.transform = flip * gltf * flip;
         }
-        Param::Texture(Box::new(map))
+        Some(map)
     }
 
     /// Where image `image`'s bytes are, or `None` with a warning naming `path` when the image

@@ -420,6 +420,7 @@ impl ObjMesh {
             normals,
             materials: None,
             uvs,
+            tangents: None,
         })
     }
 }

@@ -1438,6 +1438,7 @@ impl<'f> Reader<'f> {
                     normals: ply.normals.filter(|v| v.len() == n),
                     materials: None,
                     uvs: ply.uvs.filter(|v| v.len() == n),
+                    tangents: None,
                 };
                 if !mesh.triangles.is_empty() {
                     shapes.push((ShapeDesc::Trimesh(Box::new(mesh)), ctm));
@@ -1586,6 +1587,7 @@ impl<'f> Reader<'f> {
             normals,
             materials: None,
             uvs,
+            tangents: None,
         }))
     }
 }

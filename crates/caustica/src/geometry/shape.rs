@@ -80,8 +80,7 @@ pub struct ShapeHit {
 impl Shape {
     /// Places `kind` by `world_from_object`; `None` if the matrix cannot be inverted.
     pub fn new(kind: ShapeKind, world_from_object: Mat4) -> Option<Shape> {
-        let det = world_from_object.determinant();
-        if !det.is_finite() || det.abs() < 1e-12 {
+        if crate::math::is_degenerate_transform(&world_from_object) {
             return None;
         }
         let object_from_world = world_from_object.inverse();

@@ -368,8 +368,7 @@ impl Builder {
         warnings: &mut Vec<String>,
     ) -> Result<(), ParseError> {
         let m = object.world_from_object;
-        let det = m.determinant();
-        if !det.is_finite() || det.abs() < 1e-12 {
+        if crate::math::is_degenerate_transform(&m) {
             return Err(singular(&object.span));
         }
         let normal_to_world = Mat3::from_mat4(m.inverse()).transpose();
@@ -410,9 +409,20 @@ impl Builder {
                 "dropped {dropped} degenerate triangle(s) of a mesh after its transform"
             ));
         }
+        let tangents = match (&self.materials[material as usize].normal_map, &desc.uvs) {
+            (Some(_), Some(uvs)) => Some(match &desc.tangents {
+                Some(ts) => ts
+                    .iter()
+                    .map(|t| (m.transform_vector3(t.truncate()).normalize_or_zero()).extend(t.w.signum()))
+                    .collect(),
+                None => crate::geometry::tangents::generate(&points, &indices, uvs, normals.as_deref()),
+            }),
+            _ => None,
+        };
         self.meshes.push(Mesh {
             indices,
             normals,
+            tangents,
             uvs: desc.uvs.clone(),
             vertex_materials,
             material,
@@ -436,6 +446,17 @@ impl Builder {
                 Some(p) => Some(p.try_map(|param| self.channel(param))?),
                 None => None,
             },
+            metallic_roughness: match &desc.metallic_roughness {
+                Some(mr) => Some(mr.try_map(|param| self.channel(param))?),
+                None => None,
+            },
+            normal_map: match &desc.normal_map {
+                Some(n) => match self.channel(&Param::Texture(Box::new(n.map.clone())))? {
+                    Channel::Texture(id) => Some((id, n.scale)),
+                    Channel::Constant(_) => None,
+                },
+                None => None,
+            },
         };
         let key = MaterialKey(
             [
@@ -454,7 +475,14 @@ impl Builder {
                 Channel::Texture(i) => [1, *i, 0, 0],
             })
             .chain([material.abbe.map_or(0, f32::to_bits)])
-            .chain(format!("{:?}", material.physical).bytes().map(u32::from))
+            .chain(
+                format!(
+                    "{:?} {:?} {:?}",
+                    material.physical, material.normal_map, material.metallic_roughness
+                )
+                .bytes()
+                .map(u32::from),
+            )
             .collect(),
         );
         if let Some(&id) = self.material_ids.get(&key) {

@@ -394,3 +394,118 @@ fn an_emissive_texture_glows_only_where_its_texels_do() {
         1e-5
     ));
 }
+
+/// A constant tangent-space normal map tilts a Lambertian quad's normal: under a directional
+/// light of irradiance E from angle φ the quad's radiance is albedo/π · E · max(0, n·l), with
+/// n the decoded texel (x and y times `scale`), normalised in the frame whose tangent follows u
+/// (along +x here) — the spec's exact answer, which a tangent the wrong way round would miss.
+#[test]
+fn a_constant_normal_map_tilts_the_shading_by_its_decoded_normal() {
+    let dir = folder("normal");
+    let texel = [209u8, 128, 225];
+    let image = png(1, 1, &[texel]);
+    let scale = 0.5f32;
+    let material = format!(
+        r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0}},
+"normalTexture":{{"index":0,"scale":{scale}}},
+"extensions":{{"KHR_materials_specular":{{"specularFactor":0}}}}}}"#
+    );
+    let path = quad_gltf(&dir, &image, Holder::File, &material, LINEAR_REPEAT);
+    let (sin, cos) = 0.6f32.sin_cos();
+    let (hs, hc) = 0.3f32.sin_cos();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let text = text
+        .replacen(
+            r#"{"asset":{"version":"2.0"},"#,
+            r#"{"asset":{"version":"2.0"},"extensionsUsed":["KHR_lights_punctual"],"extensions":{"KHR_lights_punctual":{"lights":[{"type":"directional","intensity":1366}]}},"#,
+            1,
+        )
+        .replacen(r#""nodes":[0,1]"#, r#""nodes":[0,1,2]"#, 1)
+        .replacen(
+            r#""translation":[0.5,0.5,2]}]"#,
+            &format!(
+                r#""translation":[0.5,0.5,2]}},{{"rotation":[0,{hs},0,{hc}],"extensions":{{"KHR_lights_punctual":{{"light":0}}}}}}]"#
+            ),
+            1,
+        );
+    std::fs::write(&path, text).unwrap();
+    let scene = load(&path, &LoadSettings::default()).unwrap();
+    assert_eq!(scene.lights().len(), 1, "{:?}", scene.warnings());
+    let m = Vec3::new(texel[0] as f32, texel[1] as f32, texel[2] as f32) / 255.0 * 2.0 - Vec3::ONE;
+    let n = Vec3::new(m.x * scale, m.y * scale, m.z).normalize();
+    // The light travels along (−sin φ, 0, −cos φ): towards it is (sin φ, 0, cos φ).
+    let want = 0.5 / std::f32::consts::PI * 2.0 * n.dot(Vec3::new(sin, 0.0, cos));
+    let flat = 0.5 / std::f32::consts::PI * 2.0 * cos;
+    let config = RenderConfig {
+        integrator: Some("path".parse().unwrap()),
+        width: 16,
+        height: Some(16),
+        passes: Some("4".into()),
+        ..RenderConfig::default()
+    };
+    let mut session = RenderSession::new(&scene, config.render_options("test").unwrap()).unwrap();
+    assert!(
+        session
+            .run(&config.plan().unwrap(), control(), |_| Ok(()))
+            .unwrap()
+            .complete
+    );
+    let got = session.image().region_mean((5, 11), (5, 11));
+    assert!((want - flat).abs() > 0.05 * flat, "the map tilts enough to tell");
+    assert!(
+        near(got, Vec3::splat(want), 0.01 * want),
+        "rendered {got}, expected {want} (flat: {flat})"
+    );
+}
+
+/// glTF's metallic-roughness texture, linear: blue times `metallicFactor` is metalness, green
+/// times `roughnessFactor` roughness (GGX α its square); a metal point reflects the base colour,
+/// a dielectric point is the base colour under the coat of the ior.
+#[test]
+fn a_metallic_roughness_texture_decides_metal_and_roughness_point_by_point() {
+    use caustica::description::PhysicalMaterial;
+    let dir = folder("metal");
+    let image = png(2, 1, &[[0, 64, 255], [0, 200, 0]]);
+    let material = r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.9,0.6,0.2,1],"metallicFactor":1,"roughnessFactor":0.8,
+"metallicRoughnessTexture":{"index":0}}}"#;
+    let sampler = r#"{"magFilter":9728,"wrapS":10497,"wrapT":10497}"#;
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, material, sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        scene.warnings().iter().all(|w| !w.contains("metallic")),
+        "{:?}",
+        scene.warnings()
+    );
+    let m = scene
+        .materials()
+        .iter()
+        .find(|m| m.metallic_roughness.is_some())
+        .unwrap();
+    let base = Vec3::new(0.9, 0.6, 0.2);
+    let alpha = |g: u8| (g as f32 / 255.0 * 0.8).powi(2);
+    match m.physical_at(scene.textures(), Vec2::new(0.25, 0.5)) {
+        Some(PhysicalMaterial::Conductor {
+            reflectance: Some(r),
+            roughness,
+            ..
+        }) => {
+            assert_eq!(r, base);
+            assert!((roughness - alpha(64)).abs() < 1e-6, "{roughness}");
+        }
+        other => panic!("a metal point: {other:?}"),
+    }
+    match m.physical_at(scene.textures(), Vec2::new(0.75, 0.5)) {
+        Some(PhysicalMaterial::CoatedDiffuse {
+            reflectance,
+            eta,
+            roughness,
+        }) => {
+            assert_eq!((reflectance, eta), (base, 1.5));
+            assert!((roughness - alpha(200)).abs() < 1e-6, "{roughness}");
+        }
+        other => panic!("a dielectric point: {other:?}"),
+    }
+}

@@ -137,6 +137,7 @@ impl RayScene {
                     normals: ply.normals.filter(|v| v.len() == n),
                     materials: None,
                     uvs: ply.uvs.filter(|v| v.len() == n),
+                    tangents: None,
                 };
                 vec![ObjectDesc {
                     shape: ShapeDesc::Trimesh(Box::new(desc)),

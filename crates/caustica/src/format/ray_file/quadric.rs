@@ -261,6 +261,7 @@ impl Builder<'_> {
             normals: Some(normals),
             materials: None,
             uvs: None,
+            tangents: None,
         })
     }
 }

@@ -109,6 +109,7 @@ pub(crate) fn finish(
         normals,
         materials: input.materials.map(|(m, _)| m),
         uvs: input.uvs.map(|(u, _)| u),
+        tangents: None,
     }))
 }
 
