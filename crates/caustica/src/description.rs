@@ -325,6 +325,19 @@ pub struct MaterialDesc {
     /// glTF's metallic-roughness texture: where it is given, the physical reading at each point
     /// follows it instead of `physical`.
     pub metallic_roughness: Option<MetallicRoughness>,
+    /// Coverage of a mesh's surface (its x channel): where it is below the cutoff, or with no
+    /// cutoff at random in proportion, rays and photons pass through.
+    pub alpha: Option<Alpha>,
+}
+
+/// How much of a surface is there: glTF's `alphaMode` MASK (a cutoff) and BLEND (none: a ray
+/// passes with the chance 1 − coverage).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Alpha<P = Param> {
+    /// Coverage in [0, 1], in the x channel.
+    pub coverage: P,
+    /// MASK's `alphaCutoff`; `None` for BLEND.
+    pub cutoff: Option<f32>,
 }
 
 /// A physically based material beyond the course fields' reading, generic over how a colour is
@@ -425,6 +438,7 @@ impl Default for MaterialDesc {
             physical: None,
             normal_map: None,
             metallic_roughness: None,
+            alpha: None,
         }
     }
 }

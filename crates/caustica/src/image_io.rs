@@ -54,6 +54,7 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
     let img = decoded.map_err(|e| image_error(e.to_string()))?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     let texels: Vec<Vec3> = match img.color() {
+        _ if encoding == Encoding::Coverage => img.to_rgba32f().pixels().map(|p| Vec3::splat(p[3])).collect(),
         image::ColorType::Rgb32F | image::ColorType::Rgba32F => {
             img.to_rgb32f().pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect()
         }

@@ -77,6 +77,8 @@ pub struct Material {
     pub normal_map: Option<(u32, f32)>,
     /// glTF's metallic-roughness texture, which decides the physical reading point by point.
     pub metallic_roughness: Option<crate::description::MetallicRoughness<Channel>>,
+    /// Coverage of a mesh's surface ([`crate::description::Alpha`]).
+    pub alpha: Option<crate::description::Alpha<Channel>>,
 }
 
 /// A material's constant colours as fitted smooth spectra (for spectral transport); `None`
@@ -254,6 +256,7 @@ impl Material {
         .any(|c| matches!(c, Channel::Texture(_)))
             || self.normal_map.is_some()
             || self.metallic_roughness.is_some()
+            || self.alpha.is_some()
             || self.physical.as_ref().is_some_and(|p| {
                 p.try_map(|c| {
                     if matches!(c, Channel::Texture(_)) {

@@ -114,6 +114,8 @@ pub struct Scene {
     shape_bvh: Bvh,
     /// Hierarchy over the triangles, tested four at a time (primitive id `shapes.len() + i`).
     triangle_bvh: TriangleBvh,
+    /// Whether some mesh has cut-outs (a material with coverage): only then are hits tested.
+    cutouts: bool,
 }
 
 /// What a scene is assembled from (the builder's output).
@@ -230,7 +232,12 @@ impl Scene {
             hints,
             shape_bvh,
             triangle_bvh,
+            cutouts: false,
         };
+        scene.cutouts = scene
+            .meshes
+            .iter()
+            .any(|m| scene.materials[m.material as usize].alpha.is_some());
         scene.lights = LightSet::new(&scene, lights);
         scene
     }
@@ -405,7 +412,9 @@ impl Scene {
                 && self.shapes[prim as usize]
                     .intersect_object_normal(&ray, t_max)
                     .is_some()
-        }) || self.triangle_bvh.each_hit(&ray, t_max, |h| n_shapes + h.prim != own);
+        }) || self
+            .triangle_bvh
+            .each_hit(&ray, t_max, |h| n_shapes + h.prim != own && !self.is_hole(&ray, &h));
         !blocked
     }
 
@@ -419,13 +428,63 @@ impl Scene {
         self.shapes.len() + self.triangles.len()
     }
 
+    /// Whether a triangle hit falls in a cut-out of its mesh, where rays pass through: the
+    /// material's coverage there is below its cutoff or, without one, below a number drawn from
+    /// the ray and the triangle (the same each time the same ray meets it).
+    #[inline]
+    fn is_hole(&self, ray: &Ray, h: &TriangleBvhHit) -> bool {
+        if !self.cutouts {
+            return false;
+        }
+        let tri_ref = self.triangle_refs[h.prim as usize];
+        let mesh = &self.meshes[tri_ref.mesh as usize];
+        let Some(alpha) = &self.materials[mesh.material as usize].alpha else {
+            return false;
+        };
+        let uv = match &mesh.uvs {
+            Some(uvs) => {
+                let [i0, i1, i2] = mesh.indices[tri_ref.index as usize].map(|i| i as usize);
+                uvs[i0] * (1.0 - h.u - h.v) + uvs[i1] * h.u + uvs[i2] * h.v
+            }
+            None => Vec2::new(h.u, h.v),
+        };
+        let coverage = alpha.coverage.eval(&self.textures, uv).x;
+        match alpha.cutoff {
+            Some(cutoff) => coverage < cutoff,
+            None => {
+                let bits = [ray.origin.to_array(), ray.dir.to_array()]
+                    .iter()
+                    .flatten()
+                    .fold(u64::from(h.prim), |acc, c| {
+                        crate::sampling::mix64(acc ^ u64::from(c.to_bits()))
+                    });
+                ((bits >> 40) as f32 / (1u64 << 24) as f32) >= coverage
+            }
+        }
+    }
+
+    /// The nearest triangle hit in `(0, t_max)` that is not in a cut-out.
+    #[inline]
+    fn closest_triangle(&self, ray: &Ray, t_max: f32) -> Option<TriangleBvhHit> {
+        let hit = self.triangle_bvh.closest_hit(ray, t_max)?;
+        if !self.is_hole(ray, &hit) {
+            return Some(hit);
+        }
+        // Rare: every hit along the ray, the nearest solid one kept.
+        let mut best: Option<TriangleBvhHit> = None;
+        self.triangle_bvh.each_hit(ray, t_max, |h| {
+            if best.is_none_or(|b| h.t < b.t) && !self.is_hole(ray, &h) {
+                best = Some(h);
+            }
+            false
+        });
+        best
+    }
+
     /// The closest hit in `(0, t_max)`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Intersection> {
-        let mut best = self
-            .triangle_bvh
-            .closest_hit(ray, t_max)
-            .map(|h| self.triangle_intersection(h));
+        let mut best = self.closest_triangle(ray, t_max).map(|h| self.triangle_intersection(h));
         let t_max = best.map_or(t_max, |h| h.t);
         self.shape_bvh.closest_hit(ray, t_max, |prim, t_max| {
             let hit = self.intersect_shape(prim, ray, t_max)?;
@@ -440,9 +499,9 @@ impl Scene {
     pub fn any_hit(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&Intersection) -> bool) -> bool {
         self.shape_bvh.any_hit(ray, t_max, |prim, t_max| {
             self.intersect_shape(prim, ray, t_max).is_some_and(|h| visit(&h))
-        }) || self
-            .triangle_bvh
-            .each_hit(ray, t_max, |h| visit(&self.triangle_intersection(h)))
+        }) || self.triangle_bvh.each_hit(ray, t_max, |h| {
+            !self.is_hole(ray, &h) && visit(&self.triangle_intersection(h))
+        })
     }
 
     /// A triangle hit as an intersection.
@@ -480,12 +539,13 @@ impl Scene {
             self.intersect_shape(prim, ray, t_max)
         } else {
             let hit = self.triangles[(prim - n_shapes) as usize].intersect(ray, t_max)?;
-            Some(self.triangle_intersection(TriangleBvhHit {
+            let hit = TriangleBvhHit {
                 t: hit.t,
                 prim: prim - n_shapes,
                 u: hit.u,
                 v: hit.v,
-            }))
+            };
+            (!self.is_hole(ray, &hit)).then(|| self.triangle_intersection(hit))
         }
     }
 

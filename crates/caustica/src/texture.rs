@@ -54,6 +54,9 @@ pub enum Encoding {
     Srgb,
     /// A power law: stored value to the power G (pbrt's `"gamma G"`).
     Gamma(f32),
+    /// Not the colour but the alpha channel, as coverage in all three channels (1 where the
+    /// image has no alpha).
+    Coverage,
 }
 
 impl Encoding {
@@ -61,7 +64,7 @@ impl Encoding {
     #[inline]
     pub fn to_linear(self, stored: f32) -> f32 {
         match self {
-            Encoding::Linear => stored,
+            Encoding::Linear | Encoding::Coverage => stored,
             Encoding::Srgb if stored <= 0.04045 => stored / 12.92,
             Encoding::Srgb => ((stored + 0.055) / 1.055).powf(2.4),
             Encoding::Gamma(g) => stored.max(0.0).powf(g),

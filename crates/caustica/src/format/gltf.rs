@@ -9,8 +9,8 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, MetallicRoughness, NormalMap, ObjectDesc,
-    Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
+    Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, MetallicRoughness, NormalMap,
+    ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{Error, ParseError, Result, Span};
 use crate::progress::Progress;
@@ -443,17 +443,26 @@ impl Reader<'_, '_> {
             self.warn("cameras", "the scene has no camera: one is placed to frame it from +z");
             self.desc.camera = Some(super::obj::frame(&self.desc.objects));
         }
-        let emits = self.desc.objects.iter().any(|o| match &o.material.emissive {
+        // Uniform emission lights a scene; an emissive texture (a screen, a dial, a sign) decorates
+        // a model its viewer lights.
+        let lit_by_emission = self.desc.objects.iter().any(|o| match &o.material.emissive {
             Param::Constant(c) => c.max_element() > 0.0,
-            _ => true,
+            _ => false,
         });
-        if self.desc.lights.is_empty() && !emits && !self.desc.objects.is_empty() {
+        let decorated = self
+            .desc
+            .objects
+            .iter()
+            .any(|o| matches!(o.material.emissive, Param::Texture(_)));
+        if self.desc.lights.is_empty() && !lit_by_emission && !self.desc.objects.is_empty() {
             // Many files leave lighting to the viewer; a viewer's neutral default.
             // A remark on the whole file: no place in it (an empty span at 0).
-            self.desc.warnings.push((
-                "the scene has no lights: a uniform white sky of radiance 1 lights it".into(),
-                0..0,
-            ));
+            let message = if decorated {
+                "the scene has no lights but emissive textures: a uniform white sky of radiance 1 lights it"
+            } else {
+                "the scene has no lights: a uniform white sky of radiance 1 lights it"
+            };
+            self.desc.warnings.push((message.into(), 0..0));
             self.desc.lights.push(LightDesc::Environment {
                 color: Vec3::ONE,
                 map: None,
@@ -820,19 +829,29 @@ impl Reader<'_, '_> {
         if emissive != Vec3::ZERO && !m.double_sided {
             self.warn_once("onesided", &path, "caustica's emissive surfaces emit from both faces");
         }
-        if matches!(
-            m.alpha_mode,
-            Checked::Valid(json::material::AlphaMode::Blend | json::material::AlphaMode::Mask)
-        ) {
-            self.warn_once(
-                "alpha",
-                &format!("{path}.alphaMode"),
-                "alpha blending and masking are not applied: surfaces are opaque",
-            );
-        }
+        // Coverage: the base colour's alpha times its texture's alpha channel.
+        let cutoff = match m.alpha_mode {
+            Checked::Valid(json::material::AlphaMode::Mask) => Some(Some(m.alpha_cutoff.map_or(0.5, |c| c.0))),
+            Checked::Valid(json::material::AlphaMode::Blend) => Some(None),
+            _ => None,
+        };
+        let cut_outs = cutoff.map(|cutoff| {
+            let factor = pbr.base_color_factor.0[3].clamp(0.0, 1.0);
+            let coverage = match &base {
+                Param::Texture(map) => {
+                    let mut map = (**map).clone();
+                    map.encoding = Encoding::Coverage;
+                    map.sampler.scale = Vec3::splat(factor);
+                    Param::Texture(Box::new(map))
+                }
+                _ => Param::grey(factor),
+            };
+            Alpha { coverage, cutoff }
+        });
         let mut desc = MaterialDesc {
             emissive: emissive_param,
             normal_map,
+            alpha: cut_outs,
             name: m.name.clone(),
             ..MaterialDesc::default()
         };

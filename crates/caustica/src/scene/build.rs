@@ -446,6 +446,13 @@ impl Builder {
                 Some(p) => Some(p.try_map(|param| self.channel(param))?),
                 None => None,
             },
+            alpha: match &desc.alpha {
+                Some(a) => Some(crate::description::Alpha {
+                    coverage: self.channel(&a.coverage)?,
+                    cutoff: a.cutoff,
+                }),
+                None => None,
+            },
             metallic_roughness: match &desc.metallic_roughness {
                 Some(mr) => Some(mr.try_map(|param| self.channel(param))?),
                 None => None,
@@ -477,8 +484,8 @@ impl Builder {
             .chain([material.abbe.map_or(0, f32::to_bits)])
             .chain(
                 format!(
-                    "{:?} {:?} {:?}",
-                    material.physical, material.normal_map, material.metallic_roughness
+                    "{:?} {:?} {:?} {:?}",
+                    material.physical, material.normal_map, material.metallic_roughness, material.alpha
                 )
                 .bytes()
                 .map(u32::from),

@@ -509,3 +509,74 @@ fn a_metallic_roughness_texture_decides_metal_and_roughness_point_by_point() {
         other => panic!("a dielectric point: {other:?}"),
     }
 }
+
+/// glTF's `alphaMode`: MASK cuts holes where the base colour's alpha times its factor is below
+/// `alphaCutoff` — for camera rays, shadow rays and every other query alike — and BLEND lets a
+/// ray through with the chance 1 − coverage.
+#[test]
+fn alpha_masks_are_holes_for_every_ray_and_blend_passes_in_proportion() {
+    let dir = folder("alpha");
+    let rgba = image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba([200, 100, 50, if x == 0 { 60 } else { 255 }]));
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    rgba.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    let image = bytes.into_inner();
+    let sampler = r#"{"magFilter":9728,"wrapS":33071,"wrapT":33071}"#;
+    let material = |mode: &str| {
+        format!(
+            r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,0.8],"metallicFactor":0,"baseColorTexture":{{"index":0}}}},{mode}}}"#
+        )
+    };
+    // Rays straight down −z through the quad's left (u = 0.25) and right (u = 0.75) halves.
+    let down = |x: f32| caustica::math::Ray::new(Vec3::new(x, 0.5, 1.0), -Vec3::Z);
+    // Left coverage 0.8 · 60/255 = 0.19 is below the cutoff 0.5; right 0.8 is above.
+    let mask = load(
+        &quad_gltf(&dir, &image, Holder::File, &material(r#""alphaMode":"MASK""#), sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        mask.intersect(&down(0.25), f32::INFINITY).is_none(),
+        "a hole for camera rays"
+    );
+    assert!(mask.intersect(&down(0.75), f32::INFINITY).is_some());
+    let (above, below) = (Vec3::new(0.25, 0.5, 1.0), Vec3::new(0.25, 0.5, -1.0));
+    assert!(
+        mask.segment_clear(above, Vec3::Z, below, -Vec3::Z),
+        "a hole for shadow rays"
+    );
+    assert!(!mask.segment_clear(above + Vec3::X * 0.5, Vec3::Z, below + Vec3::X * 0.5, -Vec3::Z));
+    // A cutoff of 0.1 keeps the left half.
+    let low = load(
+        &quad_gltf(
+            &dir,
+            &image,
+            Holder::File,
+            &material(r#""alphaMode":"MASK","alphaCutoff":0.1"#),
+            sampler,
+        ),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    assert!(low.intersect(&down(0.25), f32::INFINITY).is_some());
+    // BLEND: of many rays through the left half, 1 − 0.19 pass.
+    let blend = load(
+        &quad_gltf(&dir, &image, Holder::File, &material(r#""alphaMode":"BLEND""#), sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    let n = 20_000;
+    let passed = (0..n)
+        .filter(|i| {
+            let (x, y) = (
+                0.02 + 0.46 * (*i % 200) as f32 / 200.0,
+                0.02 + 0.96 * (*i / 200) as f32 / 100.0,
+            );
+            blend
+                .intersect(&caustica::math::Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z), f32::INFINITY)
+                .is_none()
+        })
+        .count() as f32
+        / n as f32;
+    let want = 1.0 - 0.8 * 60.0 / 255.0;
+    assert!((passed - want).abs() < 0.02, "{passed} passed, {want} expected");
+}
