@@ -773,6 +773,37 @@ impl Reader<'_, '_> {
             .clamp(0.0, 1.0);
         let ior = ext.ior.as_ref().map_or(1.5, |i| i.ior.0);
         let ior = if ior >= 1.0 { ior } else { 1.5 };
+        // Textures of extensions read by their factors alone: said, never silently dropped.
+        let unread = [
+            (
+                ext.transmission
+                    .as_ref()
+                    .is_some_and(|t| t.transmission_texture.is_some()),
+                "KHR_materials_transmission.transmissionTexture",
+                "the transmission texture is not read",
+            ),
+            (
+                ext.volume.as_ref().is_some_and(|v| v.thickness_texture.is_some()),
+                "KHR_materials_volume.thicknessTexture",
+                "the thickness texture is not read",
+            ),
+            (
+                ext.specular
+                    .as_ref()
+                    .is_some_and(|v| v.specular_texture.is_some() || v.specular_color_texture.is_some()),
+                "KHR_materials_specular",
+                "specular textures are not read",
+            ),
+        ];
+        for (given, at, what) in unread {
+            if given {
+                self.warn_once(
+                    at,
+                    &format!("{path}.extensions.{at}"),
+                    format!("{what}: the factor is used"),
+                );
+            }
+        }
         let specular = ext.specular.as_ref().map_or(1.0, |s| s.specular_factor.0);
         let emissive_strength = ext.emissive_strength.as_ref().map_or(1.0, |e| e.emissive_strength.0);
         let dispersion = ext
