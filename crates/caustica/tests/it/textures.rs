@@ -50,6 +50,26 @@ fn near(a: Vec3, b: Vec3, tolerance: f32) -> bool {
     (a - b).abs().max_element() <= tolerance
 }
 
+/// A 16² path-traced image of `passes` passes.
+fn path_traced(scene: &Scene, passes: u64) -> caustica::film::Film {
+    let config = RenderConfig {
+        integrator: Some("path".parse().unwrap()),
+        width: 16,
+        height: Some(16),
+        passes: Some(passes.to_string()),
+        seed: 3,
+        ..RenderConfig::default()
+    };
+    let mut session = RenderSession::new(scene, config.render_options("test").unwrap()).unwrap();
+    assert!(
+        session
+            .run(&config.plan().unwrap(), control(), |_| Ok(()))
+            .unwrap()
+            .complete
+    );
+    session.image()
+}
+
 /// How a glTF file holds its image.
 #[derive(Clone, Copy, PartialEq)]
 enum Holder {
@@ -164,22 +184,7 @@ fn a_uniform_colour_texture_is_srgb_decoded_and_times_its_factor_wherever_the_im
             let got = diffuse_at(&scene, uv);
             assert!(near(got, want, 1e-6), "{got} vs {want}");
         }
-        let config = RenderConfig {
-            integrator: Some("path".parse().unwrap()),
-            width: 16,
-            height: Some(16),
-            passes: Some("64".into()),
-            seed: 3,
-            ..RenderConfig::default()
-        };
-        let mut session = RenderSession::new(&scene, config.render_options("test").unwrap()).unwrap();
-        assert!(
-            session
-                .run(&config.plan().unwrap(), control(), |_| Ok(()))
-                .unwrap()
-                .complete
-        );
-        films.push(session.image());
+        films.push(path_traced(&scene, 64));
     }
     assert!(
         films.windows(2).all(|f| f[0].pixels == f[1].pixels),
@@ -436,21 +441,7 @@ fn a_constant_normal_map_tilts_the_shading_by_its_decoded_normal() {
     // The light travels along (−sin φ, 0, −cos φ): towards it is (sin φ, 0, cos φ).
     let want = 0.5 / std::f32::consts::PI * 2.0 * n.dot(Vec3::new(sin, 0.0, cos));
     let flat = 0.5 / std::f32::consts::PI * 2.0 * cos;
-    let config = RenderConfig {
-        integrator: Some("path".parse().unwrap()),
-        width: 16,
-        height: Some(16),
-        passes: Some("4".into()),
-        ..RenderConfig::default()
-    };
-    let mut session = RenderSession::new(&scene, config.render_options("test").unwrap()).unwrap();
-    assert!(
-        session
-            .run(&config.plan().unwrap(), control(), |_| Ok(()))
-            .unwrap()
-            .complete
-    );
-    let got = session.image().region_mean((5, 11), (5, 11));
+    let got = path_traced(&scene, 4).region_mean((5, 11), (5, 11));
     assert!((want - flat).abs() > 0.05 * flat, "the map tilts enough to tell");
     assert!(
         near(got, Vec3::splat(want), 0.01 * want),
