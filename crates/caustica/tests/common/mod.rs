@@ -16,6 +16,15 @@ pub fn scene(text: &str) -> Scene {
 
 static NEVER: AtomicBool = AtomicBool::new(false);
 
+/// `scene` rendered to the end with `config`, as the command line renders it.
+pub fn render_with(scene: &Scene, config: &caustica::integrator::RenderConfig) -> Film {
+    let options = config.render_options("test").unwrap();
+    let mut session = caustica::integrator::RenderSession::new(scene, options).unwrap();
+    let summary = session.run(&config.plan().unwrap(), control(), |_| Ok(())).unwrap();
+    assert!(summary.complete);
+    session.image()
+}
+
 /// A control that reports nowhere and is never cancelled.
 pub fn control() -> Control<'static> {
     Control {

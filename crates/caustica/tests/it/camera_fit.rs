@@ -2,10 +2,10 @@
 //! never stretched: a sphere stays round, a square stays square, at the size its field of view
 //! gives.
 
-use crate::common::{control, scene};
+use crate::common::{render_with, scene};
 use crate::formats::base64;
 use caustica::film::Film;
-use caustica::integrator::{RenderConfig, RenderSession};
+use caustica::integrator::RenderConfig;
 use caustica::loader::{load, LoadSettings};
 use caustica::scene::Scene;
 use std::path::PathBuf;
@@ -19,14 +19,7 @@ fn render(scene: &Scene, integrator: Option<&str>, width: usize, height: usize) 
         passes: integrator.map(|_| "1".to_string()),
         ..RenderConfig::default()
     };
-    let mut session = RenderSession::new(scene, config.render_options("test").unwrap()).unwrap();
-    assert!(
-        session
-            .run(&config.plan().unwrap(), control(), |_| Ok(()))
-            .unwrap()
-            .complete
-    );
-    session.image()
+    render_with(scene, &config)
 }
 
 /// The lit object's extent in pixels: (columns, rows) holding any pixel brighter than 0.1.

@@ -4,9 +4,9 @@
 //! image (a caustic). `path` has no way to the light through the mirror (a point light seen in
 //! a mirror is a delta lobe on a delta light), so it sits that one out.
 
-use crate::common::{control, rel, scene};
+use crate::common::{rel, render_with, scene};
 use caustica::film::Film;
-use caustica::integrator::{RenderConfig, RenderSession};
+use caustica::integrator::RenderConfig;
 use caustica::math::Vec3;
 use caustica::scene::Scene;
 use std::f32::consts::PI;
@@ -24,10 +24,7 @@ fn render(scene: &Scene, integrator: &str, passes: u64, photons: usize) -> Film 
         seed: 5,
         ..RenderConfig::default()
     };
-    let mut session = RenderSession::new(scene, config.render_options("test").unwrap()).unwrap();
-    let summary = session.run(&config.plan().unwrap(), control(), |_| Ok(())).unwrap();
-    assert!(summary.complete);
-    session.image()
+    render_with(scene, &config)
 }
 
 /// A white Lambertian sphere in a constant sky of radiance L reflects exactly L.

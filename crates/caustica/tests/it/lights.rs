@@ -1,10 +1,10 @@
 //! Spot lights, suns and the environment against closed forms, in every physical integrator.
 
-use crate::common::{control, rel, scene};
+use crate::common::{rel, render_with, scene};
 use caustica::description::LightDesc;
 use caustica::film::Film;
 use caustica::format::ray_file::{self, ParseOptions};
-use caustica::integrator::{RenderConfig, RenderSession};
+use caustica::integrator::RenderConfig;
 use caustica::light::{spot_solid_angle, Light};
 use caustica::math::Vec3;
 use caustica::sampling::Rng;
@@ -24,10 +24,7 @@ fn render(scene: &Scene, integrator: &str, width: usize, passes: u64, photons: u
         seed: 3,
         ..RenderConfig::default()
     };
-    let mut session = RenderSession::new(scene, config.render_options("test").unwrap()).unwrap();
-    let summary = session.run(&config.plan().unwrap(), control(), |_| Ok(())).unwrap();
-    assert!(summary.complete);
-    session.image()
+    render_with(scene, &config)
 }
 
 fn region(film: &Film, rows: (usize, usize), cols: (usize, usize)) -> Vec3 {

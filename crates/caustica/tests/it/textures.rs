@@ -3,9 +3,9 @@
 //! pbrt-v4's `imagemap` parameters, OBJ's `map_Kd`; images in files, data URIs and a GLB's
 //! binary chunk rendering the same pixels; a missing image a warning, not a refusal.
 
-use crate::common::control;
+use crate::common::render_with;
 use crate::formats::base64;
-use caustica::integrator::{RenderConfig, RenderSession};
+use caustica::integrator::RenderConfig;
 use caustica::loader::{load, LoadSettings};
 use caustica::material::Channel;
 use caustica::math::{Vec2, Vec3};
@@ -60,14 +60,7 @@ fn path_traced(scene: &Scene, passes: u64) -> caustica::film::Film {
         seed: 3,
         ..RenderConfig::default()
     };
-    let mut session = RenderSession::new(scene, config.render_options("test").unwrap()).unwrap();
-    assert!(
-        session
-            .run(&config.plan().unwrap(), control(), |_| Ok(()))
-            .unwrap()
-            .complete
-    );
-    session.image()
+    render_with(scene, &config)
 }
 
 /// How a glTF file holds its image.
