@@ -37,6 +37,21 @@ pub struct Mesh {
     pub bounds: Aabb,
 }
 
+impl Mesh {
+    /// Texture coordinates at barycentrics (`b1`, `b2`) of triangle `index`: interpolated, or
+    /// the barycentrics themselves when the mesh has none.
+    #[inline]
+    pub fn uv_at(&self, index: u32, b1: f32, b2: f32) -> Vec2 {
+        match &self.uvs {
+            Some(uvs) => {
+                let [i0, i1, i2] = self.indices[index as usize].map(|i| i as usize);
+                uvs[i0] * (1.0 - b1 - b2) + uvs[i1] * b1 + uvs[i2] * b2
+            }
+            None => Vec2::new(b1, b2),
+        }
+    }
+}
+
 /// Which object a triangle belongs to.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TriangleRef {
@@ -441,14 +456,10 @@ impl Scene {
         let Some(alpha) = &self.materials[mesh.material as usize].alpha else {
             return false;
         };
-        let uv = match &mesh.uvs {
-            Some(uvs) => {
-                let [i0, i1, i2] = mesh.indices[tri_ref.index as usize].map(|i| i as usize);
-                uvs[i0] * (1.0 - h.u - h.v) + uvs[i1] * h.u + uvs[i2] * h.v
-            }
-            None => Vec2::new(h.u, h.v),
-        };
-        let coverage = alpha.coverage.eval(&self.textures, uv).x;
+        let coverage = alpha
+            .coverage
+            .eval(&self.textures, mesh.uv_at(tri_ref.index, h.u, h.v))
+            .x;
         match alpha.cutoff {
             Some(cutoff) => coverage < cutoff,
             None => {
@@ -643,9 +654,7 @@ impl Scene {
         let [i0, i1, i2] = mesh.indices[tri_ref.index as usize].map(|i| i as usize);
         let (b1, b2) = (hit.normal_or_bary.x, hit.normal_or_bary.y);
         let w = [1.0 - b1 - b2, b1, b2];
-        let uv = mesh.uvs.as_ref().map_or(Vec2::new(b1, b2), |uvs| {
-            uvs[i0] * w[0] + uvs[i1] * w[1] + uvs[i2] * w[2]
-        });
+        let uv = mesh.uv_at(tri_ref.index, b1, b2);
         let mut geometric_normal = self.triangles[tri_index].geometric_normal();
         let shading_normal = match &mesh.normals {
             Some(n) => {
