@@ -744,10 +744,13 @@ impl Scene {
         if occluders.overflowed {
             return !self.any_hit(&ray, len, |_| true);
         }
-        !occluders
-            .prims()
-            .iter()
-            .any(|&prim| self.intersect_prim(prim, &ray, len).is_some())
+        let n_shapes = self.shapes.len() as u32;
+        let end = ray.at(len);
+        // A segment inside a shape's interior (photons on a floor inside a ring) needs no test.
+        !occluders.prims().iter().any(|&prim| {
+            !(prim < n_shapes && self.shapes[prim as usize].interior_holds(ray.origin, end))
+                && self.intersect_prim(prim, &ray, len).is_some()
+        })
     }
 
     /// Whether the straight segment between two surface points is free of geometry; each end is

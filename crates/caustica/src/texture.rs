@@ -88,7 +88,7 @@ pub enum Wrap {
 
 impl Wrap {
     /// The texel index `i` reads on an axis of `n` texels; `None`: black.
-    #[inline]
+    #[inline(always)]
     fn index(self, i: i64, n: usize) -> Option<usize> {
         let n = n as i64;
         Some(match self {
@@ -168,12 +168,12 @@ impl Texture {
         self.image.texels[y * self.image.width + x]
     }
 
-    /// The texel at column `x`, row `y` counted upwards from the bottom, wrapped.
-    #[inline]
-    fn wrapped(&self, x: i64, y_up: i64) -> Vec3 {
-        let (w, h) = (self.image.width, self.image.height);
-        match (self.sampler.wrap[0].index(x, w), self.sampler.wrap[1].index(y_up, h)) {
-            (Some(x), Some(y)) => self.image.texels[(h - 1 - y) * w + x],
+    /// The texel at wrapped column `x` and row `y_up` counted upwards from the bottom; black
+    /// where either wrapped to nothing.
+    #[inline(always)]
+    fn at(&self, x: Option<usize>, y_up: Option<usize>) -> Vec3 {
+        match (x, y_up) {
+            (Some(x), Some(y)) => self.image.texels[(self.image.height - 1 - y) * self.image.width + x],
             _ => Vec3::ZERO,
         }
     }
@@ -183,25 +183,43 @@ impl Texture {
     pub fn lookup(&self, uv: Vec2) -> Vec3 {
         let s = &self.sampler;
         let uv = s.transform.transform_point2(uv);
-        let (w, h) = (self.image.width as f32, self.image.height as f32);
+        let (w, h) = (self.image.width, self.image.height);
         // Past ±2^40 texels a coordinate is noise: kept finite so the index stays exact.
         let limit = 1.0e12;
-        let (x, y) = ((uv.x * w).clamp(-limit, limit), (uv.y * h).clamp(-limit, limit));
+        let (x, y) = (
+            (uv.x * w as f32).clamp(-limit, limit),
+            (uv.y * h as f32).clamp(-limit, limit),
+        );
         if !(x.is_finite() && y.is_finite()) {
             return Vec3::ZERO;
         }
+        let [wrap_x, wrap_y] = s.wrap;
         let colour = if s.nearest {
-            self.wrapped(x.floor() as i64, y.floor() as i64)
+            self.at(wrap_x.index(floor(x), w), wrap_y.index(floor(y), h))
         } else {
             let (x, y) = (x - 0.5, y - 0.5);
-            let (x0, y0) = (x.floor(), y.floor());
-            let (fx, fy) = (x - x0, y - y0);
-            let (x0, y0) = (x0 as i64, y0 as i64);
-            let bottom = self.wrapped(x0, y0).lerp(self.wrapped(x0 + 1, y0), fx);
-            let top = self.wrapped(x0, y0 + 1).lerp(self.wrapped(x0 + 1, y0 + 1), fx);
+            let (x0, y0) = (floor(x), floor(y));
+            let (fx, fy) = (x - x0 as f32, y - y0 as f32);
+            // Each axis wrapped once for the two texels it reads.
+            let (xa, xb) = (wrap_x.index(x0, w), wrap_x.index(x0 + 1, w));
+            let (ya, yb) = (wrap_y.index(y0, h), wrap_y.index(y0 + 1, h));
+            let bottom = self.at(xa, ya).lerp(self.at(xb, ya), fx);
+            let top = self.at(xa, yb).lerp(self.at(xb, yb), fx);
             bottom.lerp(top, fy)
         };
         colour * s.scale
+    }
+}
+
+/// `x.floor()` as an integer, for |x| ≤ 2^40 (exact: the conversion truncates toward zero, and
+/// an f32 that large is whole). Without SSE4.1 `f32::floor` is a call into libm.
+#[inline(always)]
+fn floor(x: f32) -> i64 {
+    let i = x as i64;
+    if (i as f32) > x {
+        i - 1
+    } else {
+        i
     }
 }
 
@@ -225,6 +243,20 @@ mod tests {
         assert!((mid - Vec3::new(0.5, 0.0, 0.5)).length() < 1e-6);
         assert_eq!(t.lookup(Vec2::new(-3.0, 7.0)), red, "clamped outside [0, 1]");
         assert!(Texture::new(2, 2, vec![red]).is_none());
+    }
+
+    /// The integer floor agrees with `f32::floor` on negatives, halves, whole numbers, values
+    /// just below whole numbers and the largest coordinates a lookup keeps.
+    #[test]
+    fn integer_floor_is_the_float_floor() {
+        let mut values = vec![0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 1e12, -1e12, 16_777_217.0, -8_388_609.5];
+        for i in -2000..2000 {
+            let x = i as f32 * 0.37;
+            values.extend([x, x.floor(), x.next_down(), x.next_up()]);
+        }
+        for x in values {
+            assert_eq!(floor(x), x.floor() as i64, "{x}");
+        }
     }
 
     /// One row of four texels 0, 1, 2, 3 read at texel centres beyond the image's edges.

@@ -82,6 +82,16 @@ impl Cone {
             .min(disc(self.height, self.top_radius))
     }
 
+    /// Whether `p` lies inside the solid by more than `1 − inside` of its radius there: within
+    /// the cone ρ < r0 + s z (a convex set the side never enters), and between the caps when
+    /// there are caps.
+    pub fn interior_holds(&self, p: Vec3, inside: f32) -> bool {
+        let rho2 = p.x * p.x + p.y * p.y;
+        let radius = (self.bottom_radius + self.slope() * p.z) * inside;
+        let between_caps = !self.capped || (p.z > self.height * (1.0 - inside) && p.z < self.height * inside);
+        radius > 0.0 && rho2 < radius * radius && between_caps
+    }
+
     fn slope(&self) -> f32 {
         (self.top_radius - self.bottom_radius) / self.height
     }

@@ -156,6 +156,25 @@ impl Shape {
         d * (1.0 - 1e-4) - 1e-6 * (1.0 + p.abs().max_element()) <= r * self.object_stretch
     }
 
+    /// Whether the straight segment between world points `a` and `b` certainly misses the
+    /// surface: both ends lie inside the solid's convex interior (sphere, box, cone), which the
+    /// surface never enters. False when unsure, and for shapes without one.
+    #[inline]
+    pub fn interior_holds(&self, a: Vec3, b: Vec3) -> bool {
+        // Well inside: a relative margin far above the transform's rounding.
+        const INSIDE: f32 = 1.0 - 1e-4;
+        let inside = |p: Vec3| {
+            let q = self.object_from_world.transform_point3(p);
+            match &self.kind {
+                ShapeKind::Sphere => q.length_squared() < INSIDE * INSIDE,
+                ShapeKind::Box => q.abs().max_element() < 0.5 * INSIDE,
+                ShapeKind::Cone(cone) => cone.interior_holds(q, INSIDE),
+                _ => false,
+            }
+        };
+        inside(a) && inside(b)
+    }
+
     /// Nearest hit in `(0, t_max)` along the world ray.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
@@ -680,6 +699,62 @@ mod tests {
             }
         }
         assert!(pruned > 500, "the bound prunes: {pruned}");
+    }
+
+    /// A segment `interior_holds` says misses the surface does miss it (cast along it, both
+    /// ways); segments that cross the surface are never held; and the test does hold most
+    /// segments between points deep inside.
+    #[test]
+    fn held_segments_miss_the_surface() {
+        let kinds = [
+            ShapeKind::Sphere,
+            ShapeKind::Box,
+            ShapeKind::cylinder(false),
+            ShapeKind::cylinder(true),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 1.0, true, false)),
+            ShapeKind::Cone(Cone::new(2.0, 3.0, 3.0, false, true)),
+            ShapeKind::Cone(Cone::new(2.0, 0.5, 2.0, false, false)),
+        ];
+        let transforms = [
+            Mat4::IDENTITY,
+            Mat4::from_scale(Vec3::new(20.0, 20.0, 0.5)),
+            Mat4::from_axis_angle(Vec3::new(1.0, 1.0, 0.0).normalize(), 0.785)
+                * Mat4::from_translation(Vec3::new(0.5, -1.0, 2.0))
+                * Mat4::from_scale(Vec3::new(3.0, 0.2, 1.5)),
+        ];
+        let mut rng = crate::sampling::Rng::new(11, 0);
+        for kind in kinds {
+            for m in transforms {
+                let s = Shape::new(kind.clone(), m).unwrap();
+                let (lo, hi) = (s.bounds.min, s.bounds.max);
+                let (mut held, mut deep) = (0, 0);
+                for _ in 0..4000 {
+                    let at = |u: Vec3| lo + (hi - lo) * u;
+                    let a = at(Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()));
+                    let b = at(Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()));
+                    let len = a.distance(b);
+                    let crosses = s.intersect(&Ray::new(a, (b - a) / len), len).is_some()
+                        || s.intersect(&Ray::new(b, (a - b) / len), len).is_some();
+                    let holds = s.interior_holds(a, b);
+                    assert!(!(holds && crosses), "{kind:?} {m:?}: held {a} → {b} crosses");
+                    held += holds as u32;
+                    // Both ends well inside (their object-space points scaled toward the axis).
+                    let shrink = |p: Vec3| {
+                        let q = s.object_from_world.transform_point3(p);
+                        let centre = match &kind {
+                            ShapeKind::Cone(c) => Vec3::new(0.0, 0.0, q.z.clamp(0.1 * c.height, 0.9 * c.height)),
+                            _ => Vec3::ZERO,
+                        };
+                        s.world_from_object.transform_point3(centre + (q - centre) * 0.05)
+                    };
+                    if s.interior_holds(shrink(a), shrink(b)) {
+                        deep += 1;
+                    }
+                }
+                assert!(held > 0, "{kind:?} {m:?}: some random segments lie inside");
+                assert!(deep > 3000, "{kind:?} {m:?}: {deep} of 4000 deep segments held");
+            }
+        }
     }
 
     /// Surface points found by casting rays lie inside the bounding sphere.

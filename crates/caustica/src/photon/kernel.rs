@@ -28,8 +28,8 @@ use std::f32::consts::PI;
 /// surface faces within `min_normal_cosine` of its own, or `max_radius` when there are fewer
 /// than k that near.
 ///
-/// Computed a leaf at a time: the first photon of a leaf is searched in the tree, and its
-/// radius bounds its leaf-mates' (the triangle inequality), so one ball query around the leaf
+/// Computed a leaf at a time: the photon nearest the leaf's centre is searched in the tree, and
+/// its radius bounds its leaf-mates' (the triangle inequality), so one ball query around the leaf
 /// gathers every candidate its photons need. Each result is the tree's own to the bit: a photon
 /// whose k-th neighbour the gathered ball does not surely hold is searched in the tree.
 pub(super) fn kernel_radii(
@@ -140,26 +140,32 @@ fn leaf_radii(
             out,
         )
     };
-    let mut radii = Vec::with_capacity(range.len());
     let leaf = &photons[range];
-    let Some(first) = leaf.first() else {
-        return radii;
-    };
-    let r0 = tree_search(first, &mut scratch.neighbors);
-    radii.push(r0);
     let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
     let finite = leaf.iter().all(|p| p.position.is_finite());
-    if leaf.len() == 1 || !finite || !(lo.cmple(hi).all()) || k == 0 {
-        radii.extend(leaf[1..].iter().map(|p| tree_search(p, &mut scratch.neighbors)));
-        return radii;
+    if leaf.len() <= 1 || !finite || !(lo.cmple(hi).all()) || k == 0 {
+        return leaf.iter().map(|p| tree_search(p, &mut scratch.neighbors)).collect();
     }
-    // Every photon of the leaf lies within `half` of `centre`, so its k-th neighbour lies within
-    // r0 + 2 half of it (the first photon's k among them), and within `reach` of the centre.
+    // The photon nearest the leaf's centre is searched in the tree: its radius bounds its
+    // leaf-mates' (each within it ± their distance) most tightly, so the ball around the leaf
+    // that surely holds every photon's k-th neighbour is the smallest.
     let centre = (lo + hi) * 0.5;
-    let half = (hi - lo).length() * 0.5;
+    let first = (0..leaf.len())
+        .min_by(|&a, &b| {
+            leaf[a]
+                .position
+                .distance_squared(centre)
+                .total_cmp(&leaf[b].position.distance_squared(centre))
+        })
+        .unwrap_or(0);
+    let r0 = tree_search(&leaf[first], &mut scratch.neighbors).sqrt();
     let max_radius = max2.sqrt();
-    let wanted = (r0.sqrt() + 2.0 * half).min(max_radius);
-    let reach = (wanted + half) * (1.0 + MARGIN);
+    let x0 = leaf[first].position;
+    let reach = leaf
+        .iter()
+        .map(|p| (p.position - centre).length() + (r0 + p.position.distance(x0)).min(max_radius))
+        .fold(0.0f32, f32::max)
+        * (1.0 + 3.0 * MARGIN);
     scratch.candidates.clear();
     tree.for_each_within(photons, centre, reach * reach, |slot, _| {
         let q = &photons[slot as usize];
@@ -168,46 +174,56 @@ fn leaf_radii(
             .push((q.position, q.normal_code(), normals[slot as usize]));
     });
     scratch.lay_out();
-    let mut r_done = vec![r0.sqrt()];
-    for (i, photon) in leaf.iter().enumerate().skip(1) {
+    let mut done: Vec<Option<f32>> = vec![None; leaf.len()];
+    done[first] = Some(r0);
+    let mut radii = vec![0.0; leaf.len()];
+    radii[first] = r0 * r0;
+    for (i, photon) in leaf.iter().enumerate() {
+        if i == first {
+            continue;
+        }
         // The ball around this photon that the gathered candidates surely cover.
         let covered = reach - (photon.position - centre).length() - MARGIN * reach;
-        // The nearest leaf-mate done on the same surface (the same normal code, so the same
-        // photons count for both) bounds this one's radius to its own ± their distance.
-        let mate = (0..i)
-            .filter(|&j| leaf[j].normal_code() == photon.normal_code())
-            .map(|j| (leaf[j].position.distance(photon.position), r_done[j]))
-            .min_by(|a, b| a.0.total_cmp(&b.0));
-        let r2 = mate
-            .and_then(|(e, r)| band_kth(photon, r, e, covered, k, max2, min_normal_cosine, scratch))
+        // Each leaf-mate done on the same surface (the same normal code, so the same photons
+        // count for both) bounds this one's radius to its own ± their distance: the band is
+        // where all those bounds meet.
+        let band = (0..leaf.len())
+            .filter_map(|j| {
+                let r = done[j]?;
+                (leaf[j].normal_code() == photon.normal_code()).then(|| {
+                    let e = leaf[j].position.distance(photon.position);
+                    (r - e, r + e)
+                })
+            })
+            .reduce(|(a, b), (c, d)| (a.max(c), b.min(d)));
+        let r2 = band
+            .and_then(|(inner, outer)| band_kth(photon, (inner, outer), covered, k, max2, min_normal_cosine, scratch))
             .or_else(|| covered_kth(photon, covered, k, max2, min_normal_cosine, scratch));
         let r2 = r2.unwrap_or_else(|| tree_search(photon, &mut scratch.neighbors));
-        r_done.push(r2.sqrt());
-        radii.push(r2);
+        done[i] = Some(r2.sqrt());
+        radii[i] = r2;
     }
     radii
 }
 
 /// The k-th squared distance from `photon` among the gathered candidates on its surface, when
-/// it lies within `e` of `r`: those nearer than r − e are counted and only those between
-/// r − e and r + e ranked. `None` when the band does not hold the k-th, or reaches past what
-/// the candidates cover.
+/// it lies between `inner` and `outer`: those nearer are counted and only those between ranked.
+/// `None` when the band does not hold the k-th, or reaches past what the candidates cover.
 #[allow(clippy::too_many_arguments)]
 fn band_kth(
     photon: &Photon,
-    r: f32,
-    e: f32,
+    (inner, outer): (f32, f32),
     covered: f32,
     k: usize,
     max2: f32,
     min_normal_cosine: f32,
     scratch: &mut LeafScratch,
 ) -> Option<f32> {
-    let outer = (r + e) * (1.0 + MARGIN);
+    let outer = outer * (1.0 + MARGIN);
     if outer.is_nan() || outer >= covered || k == 0 {
         return None;
     }
-    let inner = (r - e) * (1.0 - MARGIN);
+    let inner = inner * (1.0 - MARGIN);
     let inner2 = if inner > 0.0 { inner * inner } else { -1.0 };
     let outer2 = (outer * outer).min(max2);
     scratch.mark_same(photon.normal_code(), photon.normal(), min_normal_cosine);
@@ -215,7 +231,8 @@ fn band_kth(
     let (inner2, outer2) = (Vec4::splat(inner2), Vec4::splat(outer2));
     let band = &mut scratch.dist2;
     band.clear();
-    band.resize(scratch.same.len(), 0.0);
+    // Room for a whole chunk past the last in-band candidate: every lane is written.
+    band.resize(scratch.same.len() + LANES, 0.0);
     let (mut nearer, mut in_band) = (0usize, 0usize);
     let [xs, ys, zs] = &scratch.lanes;
     let lanes = xs
@@ -233,12 +250,12 @@ fn band_kth(
         let d2 = dx * dx + dy * dy + dz * dz;
         let same = Vec4::from_slice(same).cmpeq(Vec4::ONE);
         nearer += ONES[(same & d2.cmplt(inner2)).bitmask() as usize] as usize;
-        let mut inside = (same & d2.cmpge(inner2) & d2.cmple(outer2)).bitmask();
-        // Few candidates fall in the band: only those are written.
-        while inside != 0 {
-            band[in_band] = d2[inside.trailing_zeros() as usize];
-            in_band += 1;
-            inside &= inside - 1;
+        let inside = (same & d2.cmpge(inner2) & d2.cmple(outer2)).bitmask();
+        // Every lane is written and the end moves past those in the band: no branch on which
+        // (a branch per lane mispredicted at about every other chunk).
+        for lane in 0..LANES {
+            band[in_band] = d2[lane];
+            in_band += ((inside >> lane) & 1) as usize;
         }
     }
     if nearer >= k || nearer + in_band < k {
