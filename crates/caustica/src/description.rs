@@ -606,3 +606,65 @@ pub struct TrimeshDesc {
     /// bitangent's sign), same length as `points`; generated where a normal map needs them.
     pub tangents: Option<Vec<Vec4>>,
 }
+
+/// Vertex attributes that are not finite (a NaN normal in an exporter's PLY or glTF) repaired
+/// in place, with a warning for each kind counting them: a normal is recomputed from the
+/// triangles around its vertex (area-weighted), a texture coordinate read as (0, 0). Triangles
+/// on vertices whose positions are not finite are left for the reader or the scene build to drop.
+pub fn repair_vertex_attributes(
+    points: &[Vec3],
+    triangles: &[[u32; 3]],
+    normals: &mut Option<Vec<Vec3>>,
+    uvs: &mut Option<Vec<Vec2>>,
+) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let lost = points.iter().filter(|p| !p.is_finite()).count();
+    if lost > 0 {
+        warnings.push(format!(
+            "{lost} of {} vertex positions are not finite: the triangles using them are left out",
+            points.len()
+        ));
+    }
+    if let Some(ns) = normals.as_mut() {
+        let broken: Vec<bool> = ns.iter().map(|n| !n.is_finite()).collect();
+        let count = broken.iter().filter(|&&b| b).count();
+        if count > 0 {
+            for n in ns.iter_mut().filter(|n| !n.is_finite()) {
+                *n = Vec3::ZERO;
+            }
+            for tri in triangles {
+                let [a, b, c] = tri.map(|i| points.get(i as usize).copied().unwrap_or(Vec3::NAN));
+                // Twice the area along the face normal: larger faces weigh more.
+                let face = (b - a).cross(c - a);
+                if !face.is_finite() {
+                    continue;
+                }
+                for &i in tri {
+                    if broken.get(i as usize) == Some(&true) {
+                        ns[i as usize] += face;
+                    }
+                }
+            }
+            for (n, _) in ns.iter_mut().zip(&broken).filter(|(_, &b)| b) {
+                *n = n.normalize_or_zero();
+            }
+            warnings.push(format!(
+                "{count} of {} vertex normals are not finite: recomputed from the faces around them",
+                ns.len()
+            ));
+        }
+    }
+    if let Some(uvs) = uvs.as_mut() {
+        let count = uvs.iter().filter(|uv| !uv.is_finite()).count();
+        if count > 0 {
+            for uv in uvs.iter_mut().filter(|uv| !uv.is_finite()) {
+                *uv = Vec2::ZERO;
+            }
+            warnings.push(format!(
+                "{count} of {} texture coordinates are not finite: read as (0, 0)",
+                uvs.len()
+            ));
+        }
+    }
+    warnings
+}

@@ -160,22 +160,21 @@ impl SourceFiles {
     /// Reads the text file at `path` and adds it; returns its base offset and its text. A
     /// failure is an error at `blame`; bad UTF-8 an error in the file itself.
     pub fn read_text(&mut self, path: &Path, blame: &Span) -> Result<(usize, &str), ParseError> {
-        let bytes = Self::read_bytes(path, blame)?;
-        let (text, bad) = match String::from_utf8(bytes) {
-            Ok(text) => (text, None),
-            Err(e) => {
-                let offset = e.utf8_error().valid_up_to();
-                (String::from_utf8_lossy(e.as_bytes()).into_owned(), Some(offset))
-            }
-        };
-        let base = self.add(path, text);
-        if let Some(offset) = bad {
-            return Err(ParseError::new(
-                "the file is not valid UTF-8 text",
-                base + offset..base + offset + 1,
-            ));
+        let (base, _, bad) = self.read_text_lossy(path, blame)?;
+        if let Some(bad) = bad {
+            return Err(ParseError::new("the file is not valid UTF-8 text", bad));
         }
         Ok((base, &self.files.last().expect("just added").text))
+    }
+
+    /// [`SourceFiles::read_text`], with bytes that are not UTF-8 read as U+FFFD: the span of the
+    /// first such byte is returned, for a warning.
+    pub fn read_text_lossy(&mut self, path: &Path, blame: &Span) -> Result<(usize, &str, Option<Span>), ParseError> {
+        let bytes = Self::read_bytes(path, blame)?;
+        let (text, bad) = decode_text(bytes);
+        let base = self.add(path, text);
+        let bad = bad.map(|offset| base + offset..base + offset + 1);
+        Ok((base, &self.files.last().expect("just added").text, bad))
     }
 
     /// The file a span starts in, and the span relative to that file (`None` without files).
@@ -267,19 +266,38 @@ pub fn read_file(path: &Path, options: &ReadOptions, progress: &dyn Progress) ->
     if options.format_of(path) == Format::Gltf {
         return gltf::read(path, bytes, &dir, progress);
     }
-    let text = match String::from_utf8(bytes) {
-        Ok(text) => text,
+    let (text, bad) = decode_text(bytes);
+    match bad {
+        // Exporters on Windows write OBJ names in the local code page: read, with a warning.
+        Some(offset) if options.format_of(path) == Format::Obj => {
+            let mut source = read_text(path, text, &dir, options, progress)?;
+            source
+                .description
+                .warnings
+                .insert(0, (NOT_UTF8.into(), offset..offset + 1));
+            Ok(source)
+        }
+        Some(offset) => Err(Error::Scene {
+            path: path.to_path_buf(),
+            text,
+            error: ParseError::new("the file is not valid UTF-8 text", offset..offset + 1),
+        }),
+        None => read_text(path, text, &dir, options, progress),
+    }
+}
+
+/// The warning for text read with bytes that are not UTF-8.
+pub(crate) const NOT_UTF8: &str = "the file is not valid UTF-8 text: bytes that are not were read as \u{FFFD}";
+
+/// Text from bytes, those that are not UTF-8 read as U+FFFD; the offset of the first of them.
+fn decode_text(bytes: Vec<u8>) -> (String, Option<usize>) {
+    match String::from_utf8(bytes) {
+        Ok(text) => (text, None),
         Err(e) => {
             let offset = e.utf8_error().valid_up_to();
-            let text = String::from_utf8_lossy(e.as_bytes()).into_owned();
-            return Err(Error::Scene {
-                path: path.to_path_buf(),
-                text,
-                error: ParseError::new("the file is not valid UTF-8 text", offset..offset + 1),
-            });
+            (String::from_utf8_lossy(e.as_bytes()).into_owned(), Some(offset))
         }
-    };
-    read_text(path, text, &dir, options, progress)
+    }
 }
 
 /// Reads scene text, reporting a "parse" phase; `path` names it in errors (and chooses its

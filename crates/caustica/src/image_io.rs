@@ -8,6 +8,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
+mod pfm;
+
 /// Largest texture accepted, in pixels (8192 × 4096): a small compressed file can declare a huge
 /// image, and each pixel costs 24 bytes once converted.
 const MAX_TEXTURE_PIXELS: u64 = 1 << 25;
@@ -31,6 +33,32 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
         },
         message,
     };
+    // PFM, which the image crate does not read: floats, linear as they are.
+    let pfm = match source {
+        ImageSource::File(path) => {
+            let mut magic = [0u8; 3];
+            let head = std::fs::File::open(path).and_then(|mut f| std::io::Read::read_exact(&mut f, &mut magic));
+            if head.is_ok() && pfm::is_pfm(&magic) {
+                Some(std::fs::read(path).map_err(|e| image_error(e.to_string()))?)
+            } else {
+                None
+            }
+        }
+        ImageSource::Memory { bytes, .. } => pfm::is_pfm(bytes).then(|| bytes.to_vec()),
+    };
+    if let Some(bytes) = pfm {
+        let (w, h, texels) = pfm::decode(&bytes, MAX_TEXTURE_PIXELS).map_err(image_error)?;
+        let texels = match encoding {
+            Encoding::Coverage => vec![Vec3::ONE; texels.len()],
+            Encoding::Mask => texels
+                .iter()
+                .map(|t| Vec3::splat(t.dot(Vec3::new(0.2126, 0.7152, 0.0722))))
+                .collect(),
+            Encoding::Bump(strength) => crate::texture::bump::normals_from_bump(w, h, &texels, strength),
+            _ => texels,
+        };
+        return Image::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()));
+    }
     let decoded = match source {
         ImageSource::File(path) => {
             let reader = || -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>> {
@@ -55,6 +83,14 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
     let (w, h) = (img.width() as usize, img.height() as usize);
     let texels: Vec<Vec3> = match img.color() {
         _ if encoding == Encoding::Coverage => img.to_rgba32f().pixels().map(|p| Vec3::splat(p[3])).collect(),
+        c if encoding == Encoding::Mask && c.has_alpha() => {
+            img.to_rgba32f().pixels().map(|p| Vec3::splat(p[3])).collect()
+        }
+        _ if encoding == Encoding::Mask => img
+            .to_rgb32f()
+            .pixels()
+            .map(|p| Vec3::splat(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]))
+            .collect(),
         image::ColorType::Rgb32F | image::ColorType::Rgba32F => {
             img.to_rgb32f().pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect()
         }
@@ -78,6 +114,10 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
                 )
             })
             .collect(),
+    };
+    let texels = match encoding {
+        Encoding::Bump(strength) => crate::texture::bump::normals_from_bump(w, h, &texels, strength),
+        _ => texels,
     };
     Image::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()))
 }

@@ -2,6 +2,8 @@
 //! of the texture coordinates, the wrap of each axis, the filter and a factor. (0, 0) is the
 //! image's bottom-left corner (§6.3); readers whose formats put v downwards flip it.
 
+pub mod bump;
+
 use crate::math::{Affine2, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -57,6 +59,12 @@ pub enum Encoding {
     /// Not the colour but the alpha channel, as coverage in all three channels (1 where the
     /// image has no alpha).
     Coverage,
+    /// Coverage from a mask (OBJ's `map_d`): the alpha channel where the image has one, else
+    /// its linear luminance.
+    Mask,
+    /// A bump map read as a tangent-space normal map (OBJ's `bump`/`map_Bump`), its x and y
+    /// times the strength: see [`bump::normals_from_bump`].
+    Bump(f32),
 }
 
 impl Encoding {
@@ -64,7 +72,7 @@ impl Encoding {
     #[inline]
     pub fn to_linear(self, stored: f32) -> f32 {
         match self {
-            Encoding::Linear | Encoding::Coverage => stored,
+            Encoding::Linear | Encoding::Coverage | Encoding::Mask | Encoding::Bump(_) => stored,
             Encoding::Srgb if stored <= 0.04045 => stored / 12.92,
             Encoding::Srgb => ((stored + 0.055) / 1.055).powf(2.4),
             Encoding::Gamma(g) => stored.max(0.0).powf(g),

@@ -9,8 +9,8 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, MetallicRoughness, NormalMap,
-    ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
+    repair_vertex_attributes, Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc,
+    MetallicRoughness, NormalMap, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{Error, ParseError, Result, Span};
 use crate::progress::Progress;
@@ -589,9 +589,7 @@ impl Reader<'_, '_> {
                         }
                     }
                 };
-                if !v.is_finite() {
-                    return Err(self.error(&apath, format!("element {i} is not a finite number")));
-                }
+                // Not-finite attributes are repaired once the primitive is whole.
                 out.push(v);
             }
         }
@@ -733,6 +731,10 @@ impl Reader<'_, '_> {
             });
             if triangles.is_empty() {
                 continue;
+            }
+            let (mut normals, mut uvs) = (normals, uvs);
+            for warning in repair_vertex_attributes(&points, &triangles, &mut normals, &mut uvs) {
+                self.warn(&format!("{path}.attributes"), warning);
             }
             let closed = is_closed(&points, &triangles);
             let material = self.material(primitive.material.map(|m| m.value()), closed, &path)?;

@@ -7,11 +7,13 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial,
-    SceneDescription, ShapeDesc, TrimeshDesc,
+    Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, NormalMap, ObjectDesc, Param,
+    PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{Error, ParseError, Result, Span};
+use crate::math::Affine2;
 use crate::progress::Progress;
+use crate::texture::{Encoding, Wrap};
 use glam::{Mat4, Vec2, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -204,13 +206,17 @@ impl ObjMesh {
                     }
                     // A name may hold spaces (some exporters write them unquoted): try the whole
                     // rest of the line first, then each word as its own file.
-                    let whole = rest_of_line(text, base, &args[0], &tokens);
+                    let whole = windows_path(&rest_of_line(text, base, &args[0], &tokens));
                     let names: Vec<(String, Span)> = if args.len() > 1 && dir.join(&whole).is_file() {
                         vec![(whole, args[0].1.start..args[args.len() - 1].1.end)]
                     } else {
-                        args.iter().map(|t| (t.0.to_string(), t.1.clone())).collect()
+                        args.iter().map(|t| (windows_path(t.0), t.1.clone())).collect()
                     };
                     for (name, span) in names {
+                        if args.iter().any(|t| t.0.contains('\\')) {
+                            mesh.warnings
+                                .push((format!("`{name}`: backslashes are read as /"), span.clone()));
+                        }
                         mesh.read_mtl(files, &dir.join(&name), &span, dir)?;
                     }
                 }
@@ -315,9 +321,12 @@ impl ObjMesh {
             ));
             return Ok(());
         }
-        let (base, text) = files.read_text(path, blame)?;
+        let (base, text, bad) = files.read_text_lossy(path, blame)?;
         let text = text.to_string();
         let mut warnings = Vec::new();
+        if let Some(bad) = bad {
+            warnings.push((super::NOT_UTF8.to_string(), bad));
+        }
         for (name, material) in parse_mtl(&text, base, dir, &mut warnings)? {
             self.materials.insert(name, material);
         }
@@ -433,6 +442,11 @@ fn push_checked<T>(list: &mut Vec<T>, value: T, at: &Token) -> Result<(), ParseE
     Ok(())
 }
 
+/// A file name as a Windows exporter may write it (`.\maps\wood.png`), with `/` between folders.
+fn windows_path(name: &str) -> String {
+    name.replace('\\', "/")
+}
+
 /// The text from `first` to the end of its logical line, trimmed.
 fn rest_of_line(text: &str, base: usize, first: &Token, tokens: &[Token]) -> String {
     let last = &tokens[tokens.len() - 1];
@@ -467,7 +481,141 @@ struct MtlEntry {
     illum: Option<u32>,
     pr: Option<f32>,
     pm: Option<f32>,
-    map_kd: Option<(PathBuf, Span)>,
+    map_kd: Option<MtlMap>,
+    map_ke: Option<MtlMap>,
+    map_d: Option<MtlMap>,
+    bump: Option<MtlMap>,
+    norm: Option<MtlMap>,
+}
+
+/// A texture statement (`map_Kd`, `map_Ke`, `map_d`, `bump`/`map_Bump`, `norm`) with the
+/// options caustica reads.
+struct MtlMap {
+    path: PathBuf,
+    span: Span,
+    /// `-s`: texture coordinates scaled by u, v.
+    scale: Vec2,
+    /// `-o`: then offset by u, v.
+    offset: Vec2,
+    /// `-clamp on`: the edge texels hold outside 0..1 (else the image repeats).
+    clamp: bool,
+    /// `-bm`: the bump's strength.
+    bump: f32,
+}
+
+impl MtlMap {
+    /// The image read with `encoding`, through its options.
+    fn image_map(&self, encoding: Encoding) -> ImageMap {
+        let mut map = ImageMap::colour(ImageSource::File(self.path.clone()), self.span.clone());
+        map.encoding = encoding;
+        if self.clamp {
+            map.sampler.wrap = [Wrap::Clamp; 2];
+        }
+        map.sampler.transform = Affine2::from_scale_angle_translation(self.scale, 0.0, self.offset);
+        map
+    }
+}
+
+/// Reads a texture statement: options first, then the file, the rest of the line (names may
+/// hold spaces, and Windows exporters write `\` between folders). A missing file is a warning
+/// (`None`), as is an option caustica does not read.
+fn texture_statement(
+    text: &str,
+    base: usize,
+    tokens: &[Token],
+    dir: &Path,
+    warnings: &mut Vec<(String, Span)>,
+) -> Result<Option<MtlMap>, ParseError> {
+    let head = &tokens[0];
+    let mut map = MtlMap {
+        path: PathBuf::new(),
+        span: head.1.clone(),
+        scale: Vec2::ONE,
+        offset: Vec2::ZERO,
+        clamp: false,
+        bump: 1.0,
+    };
+    let mut i = 1;
+    // Up to `most` numbers after an option.
+    let numbers = |i: &mut usize, most: usize| -> Result<Vec<f32>, ParseError> {
+        let mut out = Vec::new();
+        while out.len() < most && *i < tokens.len() && tokens[*i].0.parse::<f32>().is_ok() {
+            out.push(number(&tokens[*i], "texture option")?);
+            *i += 1;
+        }
+        Ok(out)
+    };
+    while i < tokens.len() && tokens[i].0.starts_with('-') && tokens[i].0.parse::<f32>().is_err() {
+        let option = &tokens[i];
+        i += 1;
+        match option.0 {
+            "-s" | "-o" => {
+                let v = numbers(&mut i, 3)?;
+                let uv = match v.as_slice() {
+                    [u] => Vec2::new(*u, if option.0 == "-s" { 1.0 } else { 0.0 }),
+                    [u, v, ..] => Vec2::new(*u, *v),
+                    [] => {
+                        return Err(ParseError::new(
+                            format!("`{}` needs numbers u v", option.0),
+                            option.1.clone(),
+                        ))
+                    }
+                };
+                if option.0 == "-s" {
+                    map.scale = uv;
+                } else {
+                    map.offset = uv;
+                }
+            }
+            "-bm" => {
+                map.bump = *numbers(&mut i, 1)?
+                    .first()
+                    .ok_or_else(|| ParseError::new("`-bm` needs a number", option.1.clone()))?;
+            }
+            "-clamp" => {
+                let on = tokens.get(i).map(|t| t.0);
+                map.clamp = on == Some("on");
+                i += usize::from(matches!(on, Some("on" | "off")));
+            }
+            _ => {
+                // -blendu/-blendv/-cc on|off, -boost/-texres/-imfchan/-type one word,
+                // -mm base gain and -t u v w numbers: skipped with their values.
+                let skipped = numbers(&mut i, 3)?.len();
+                if skipped == 0 && i + 1 < tokens.len() {
+                    i += 1;
+                }
+                warnings.push((
+                    format!("the texture option `{}` is not read", option.0),
+                    option.1.clone(),
+                ));
+            }
+        }
+    }
+    let Some(file) = tokens.get(i) else {
+        return Err(ParseError::new(format!("`{}` needs a file", head.0), head.1.clone()));
+    };
+    let written = rest_of_line(text, base, file, tokens);
+    let name = windows_path(&written);
+    let path = dir.join(&name);
+    map.span = file.1.start..tokens[tokens.len() - 1].1.end;
+    if written.contains('\\') {
+        warnings.push((format!("`{name}`: backslashes are read as /"), map.span.clone()));
+    }
+    if !path.is_file() {
+        let instead = match head.0 {
+            "map_Kd" => "the diffuse colour Kd is used",
+            "map_Ke" => "the emitted colour Ke is used",
+            "map_d" => "the dissolve d is used",
+            _ => "the surface is shaded without it",
+        };
+        warnings.push((
+            format!("the texture `{}` is missing: {instead}", path.display()),
+            map.span.clone(),
+        ));
+        return Ok(None);
+    }
+    map.path = path;
+    Ok(Some(map))
 }
 
 /// Reads an MTL file placed at `base`: each material mapped to both models.
@@ -529,29 +677,16 @@ pub fn parse_mtl(
                 let v = scalar("illumination model")?;
                 entry.illum = Some(v.clamp(0.0, 10.0) as u32);
             }
-            "map_Kd" => {
-                // Options (-s, -o, -bm …) come before the file name, which is the last word.
-                let file = args
-                    .last()
-                    .ok_or_else(|| ParseError::new("`map_Kd` needs a file", head.1.clone()))?;
-                if args.len() > 1 {
-                    warnings.push((
-                        "texture options are not read: the image is used as it is".into(),
-                        head.1.clone(),
-                    ));
-                }
-                let path = dir.join(file.0);
-                if path.is_file() {
-                    entry.map_kd = Some((path, file.1.clone()));
-                } else {
-                    warnings.push((
-                        format!(
-                            "the texture `{}` is missing: the diffuse colour Kd is used",
-                            path.display()
-                        ),
-                        file.1.clone(),
-                    ));
-                }
+            "map_Kd" | "map_Ke" | "map_d" | "bump" | "map_Bump" | "map_bump" | "norm" => {
+                let map = texture_statement(text, base, &tokens, dir, warnings)?;
+                let slot = match head.0 {
+                    "map_Kd" => &mut entry.map_kd,
+                    "map_Ke" => &mut entry.map_ke,
+                    "map_d" => &mut entry.map_d,
+                    "norm" => &mut entry.norm,
+                    _ => &mut entry.bump,
+                };
+                *slot = map;
             }
             other => {
                 ignored.entry(other.to_string()).or_insert_with(|| head.1.clone());
@@ -600,12 +735,27 @@ impl MtlEntry {
         if illum <= 1 {
             m.specular = Param::grey(0.0);
         }
-        if let Some((path, span)) = &self.map_kd {
-            m.diffuse = Param::Texture(Box::new(ImageMap::colour(
-                ImageSource::File(path.clone()),
-                span.clone(),
-            )));
+        if let Some(map) = &self.map_kd {
+            m.diffuse = Param::Texture(Box::new(map.image_map(Encoding::Srgb)));
         }
+        if let Some(map) = &self.map_ke {
+            // The texture times Ke when given (a black Ke keeps the surface dark).
+            let mut image = map.image_map(Encoding::Srgb);
+            image.sampler.scale = self.ke.unwrap_or(Vec3::ONE).max(Vec3::ZERO);
+            m.emissive = Param::Texture(Box::new(image));
+        }
+        // `norm` is a normal map; `bump` holds heights or, from Blender, a normal map.
+        m.normal_map = match (&self.norm, &self.bump) {
+            (Some(map), _) => Some(NormalMap {
+                map: map.image_map(Encoding::Linear),
+                scale: map.bump,
+            }),
+            (None, Some(map)) => Some(NormalMap {
+                map: map.image_map(Encoding::Bump(map.bump)),
+                scale: 1.0,
+            }),
+            (None, None) => None,
+        };
         if matches!(illum, 3 | 5 | 8) {
             m.reflective = Param::Constant(ks);
         }
@@ -619,6 +769,14 @@ impl MtlEntry {
             m.index = Param::grey(if self.ni.is_some() { index } else { 1.5 });
             m.diffuse = Param::grey(0.0);
             m.specular = Param::grey(0.0);
+        } else if let Some(map) = &self.map_d {
+            // A cut-out: the mask times d is the chance a ray meets the surface.
+            let mut coverage = map.image_map(Encoding::Mask);
+            coverage.sampler.scale = Vec3::splat(dissolve);
+            m.alpha = Some(Alpha {
+                coverage: Param::Texture(Box::new(coverage)),
+                cutoff: None,
+            });
         } else if dissolve < 1.0 {
             // See-through without bending: the opaque part keeps its colour.
             m.transmissive = Param::grey(1.0 - dissolve);
@@ -717,6 +875,12 @@ pub fn read_scene(
         _ => true,
     });
     description.lights = if options.lights.is_empty() && emits {
+        description.warnings.push((
+            "the mesh's emissive materials (Ke) are its only lights: the physical model (--model physical) \
+             lights with them, the course model does not (give it --point-light)"
+                .into(),
+            0..0,
+        ));
         Vec::new()
     } else if options.lights.is_empty() {
         // A point light over the camera's left shoulder, of unit irradiance at the centre.

@@ -20,8 +20,8 @@ use self::lexer::{Kind, Lexer, Token};
 use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
-    CameraDesc, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, ObjectDesc, Param,
-    PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
+    Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, NormalMap, ObjectDesc,
+    Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
@@ -857,9 +857,10 @@ impl<'f> Reader<'f> {
         params.float_or(name, default)
     }
 
-    /// GGX α from pbrt's `roughness` (or the mean of `uroughness`/`vroughness`).
-    fn roughness(&mut self, params: &Params, span: &Span) -> Result<f32, ParseError> {
-        let r = self.float_slot(params, "roughness", 0.0)?;
+    /// GGX α from pbrt's `roughness` (or the mean of `uroughness`/`vroughness`), `default`
+    /// when neither is given (0 in pbrt-v4; pbrt-v3's materials have their own).
+    fn roughness(&mut self, params: &Params, span: &Span, default: f32) -> Result<f32, ParseError> {
+        let r = self.float_slot(params, "roughness", default)?;
         let u = self.float_slot(params, "uroughness", r)?;
         let v = self.float_slot(params, "vroughness", r)?;
         if (u - v).abs() > 1e-6 {
@@ -876,9 +877,17 @@ impl<'f> Reader<'f> {
     fn material(&mut self, kind: &str, params: &Params, span: &Span) -> Result<CurrentMaterial, ParseError> {
         let m = match kind {
             "diffuse" => diffuse(self.colour(params, "reflectance", Vec3::splat(0.5))?),
-            "dielectric" | "thindielectric" => {
-                let (index, abbe) = self.eta(params)?;
-                let alpha = self.roughness(params, span)?;
+            "dielectric" | "thindielectric" | "glass" => {
+                // pbrt-v3 glass may give its index as `index`.
+                let (index, abbe) = if kind == "glass" && params.has("index") && !params.has("eta") {
+                    (self.float_slot(params, "index", 1.5)?, None)
+                } else {
+                    self.eta(params)?
+                };
+                let alpha = self.roughness(params, span, 0.0)?;
+                if kind == "glass" {
+                    self.v3_tints(params, span, &["Kr", "Kt"])?;
+                }
                 if alpha >= 1e-3 {
                     self.warn("rough glass is rendered smooth", span.clone());
                 }
@@ -897,8 +906,9 @@ impl<'f> Reader<'f> {
                 }
                 m
             }
-            "conductor" => {
-                let alpha = self.roughness(params, span)?;
+            "conductor" | "metal" => {
+                // pbrt-v3's metal is a little rough by default.
+                let alpha = self.roughness(params, span, if kind == "metal" { 0.01 } else { 0.0 })?;
                 let reflectance = params.has("reflectance");
                 let (eta, k, r) = if reflectance {
                     if params.has("eta") || params.has("k") {
@@ -936,17 +946,12 @@ impl<'f> Reader<'f> {
             }
             "coateddiffuse" => {
                 let base = self.colour(params, "reflectance", Vec3::splat(0.5))?;
-                let alpha = self.roughness(params, span)?;
+                let alpha = self.roughness(params, span, 0.0)?;
                 let eta = self.float_slot(params, "eta", 1.5)?.max(1.0);
-                let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
-                let mut m = diffuse(base.clone());
-                m.physical = Some(PhysicalMaterial::CoatedDiffuse {
-                    reflectance: base,
-                    eta,
-                    roughness: alpha,
-                });
-                course_gloss(&mut m, Vec3::splat(f0), alpha);
-                m
+                coated(base, eta, alpha)
+            }
+            "matte" | "plastic" | "substrate" | "mirror" | "uber" | "translucent" => {
+                self.v3_material(kind, params, span)?
             }
             "diffusetransmission" => {
                 let scale = params.float_or("scale", 1.0)?;
@@ -991,14 +996,212 @@ impl<'f> Reader<'f> {
                 diffuse(Param::grey(0.5))
             }
         };
-        for unread in ["displacement", "normalmap"] {
-            if let Some(s) = params.span_of(unread) {
-                let _ = params.string(unread);
-                let _ = params.spectrum(unread);
-                self.warn(format!("`{unread}` is not applied"), s);
+        let mut m = m;
+        if let Some(s) = params.span_of("displacement") {
+            let _ = params.spectrum("displacement");
+            self.warn("`displacement` is not applied", s);
+        }
+        // pbrt-v4's normal map: a linear image whose texels 2c − 1 are the normal in the frame
+        // of the surface's u direction and normal, repeating.
+        if let Some((file, s)) = params.string("normalmap")? {
+            let image = self.dir.join(&file);
+            if image.is_file() {
+                let mut map = ImageMap::colour(ImageSource::File(image), s);
+                map.encoding = Encoding::Linear;
+                m.normal_map = Some(NormalMap { map, scale: 1.0 });
+            } else {
+                self.warn(
+                    format!(
+                        "the normal map `{}` is missing: the surface is shaded without it",
+                        image.display()
+                    ),
+                    s,
+                );
             }
         }
         Ok(CurrentMaterial::Desc(Box::new(m)))
+    }
+
+    /// pbrt-v3's materials, read onto caustica's (docs/scene-formats.md says how; where the
+    /// reading is approximate, a warning says what is left out).
+    fn v3_material(&mut self, kind: &str, params: &Params, span: &Span) -> Result<MaterialDesc, ParseError> {
+        Ok(match kind {
+            "matte" => {
+                if self.float_slot(params, "sigma", 0.0)? > 0.0 {
+                    self.warn(
+                        "matte's Oren–Nayar roughness (sigma) is not modelled: Lambert",
+                        span.clone(),
+                    );
+                }
+                diffuse(self.colour(params, "Kd", Vec3::splat(0.5))?)
+            }
+            // Lambert under a highlight: a diffuse base under a clear coat of index 1.5 (the
+            // index pbrt-v3's plastic gives its Fresnel term); without Ks, the base alone.
+            "plastic" => {
+                let base = self.colour(params, "Kd", Vec3::splat(0.25))?;
+                let ks = self.colour(params, "Ks", Vec3::splat(0.25))?;
+                let alpha = self.roughness(params, span, 0.1)?;
+                if ks == Param::grey(0.0) {
+                    diffuse(base)
+                } else {
+                    self.warn_once(
+                        "plastic",
+                        "plastic is read as a diffuse base under a clear coat of index 1.5: Ks does not scale its highlight",
+                        span.clone(),
+                    );
+                    coated(base, 1.5, alpha)
+                }
+            }
+            // Ashikhmin–Shirley: a base under a coat whose normal reflectance is Ks.
+            "substrate" => {
+                let base = self.colour(params, "Kd", Vec3::splat(0.5))?;
+                let f0 = match self.colour(params, "Ks", Vec3::splat(0.5))? {
+                    Param::Constant(c) => c.dot(Vec3::splat(1.0 / 3.0)).clamp(0.0, 0.9),
+                    _ => {
+                        self.warn("a textured Ks of substrate is read as 0.04", span.clone());
+                        0.04
+                    }
+                };
+                let alpha = self.roughness(params, span, 0.1)?;
+                coated(base, (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()), alpha)
+            }
+            "mirror" => {
+                let kr = self.colour(params, "Kr", Vec3::splat(0.9))?;
+                mirror(kr)
+            }
+            // Its main lobe: glass where it transmits, a mirror where it only reflects, else a
+            // coated base; `opacity` below one lets rays through.
+            "uber" => {
+                let kd = self.colour(params, "Kd", Vec3::splat(0.25))?;
+                let ks = self.colour(params, "Ks", Vec3::splat(0.25))?;
+                let kr = self.colour(params, "Kr", Vec3::ZERO)?;
+                let kt = self.colour(params, "Kt", Vec3::ZERO)?;
+                let alpha = self.roughness(params, span, 0.1)?;
+                let index = if params.has("index") && !params.has("eta") {
+                    self.float_slot(params, "index", 1.5)?
+                } else {
+                    self.eta(params)?.0
+                };
+                let black = Param::grey(0.0);
+                let mut m = if kt != black {
+                    MaterialDesc {
+                        transmissive: kt,
+                        index: Param::grey(index),
+                        ..MaterialDesc::default()
+                    }
+                } else if kr != black && kd == black {
+                    mirror(kr)
+                } else if ks == black {
+                    diffuse(kd)
+                } else {
+                    coated(kd, index.max(1.0), alpha)
+                };
+                self.warn_once(
+                    "uber",
+                    "uber is read as its main lobe (glass where Kt, a mirror where only Kr, else a coated diffuse base)",
+                    span.clone(),
+                );
+                match self.colour(params, "opacity", Vec3::ONE)? {
+                    Param::Constant(c) if c.min_element() >= 1.0 => {}
+                    coverage => m.alpha = Some(Alpha { coverage, cutoff: None }),
+                }
+                m
+            }
+            "translucent" => {
+                let kd = self.colour(params, "Kd", Vec3::splat(0.25))?;
+                let reflect = self.colour(params, "reflect", Vec3::splat(0.5))?;
+                let transmit = self.colour(params, "transmit", Vec3::splat(0.5))?;
+                let times = |a: &Param, b: &Param| match (a, b) {
+                    (Param::Constant(a), Param::Constant(b)) => Param::Constant(*a * *b),
+                    (textured, _) => textured.clone(),
+                };
+                let (r, t) = (times(&kd, &reflect), times(&kd, &transmit));
+                self.warn(
+                    "translucent's glossy part (Ks) is not modelled: diffuse reflection and transmission",
+                    span.clone(),
+                );
+                MaterialDesc {
+                    diffuse: r.clone(),
+                    transmissive: t.clone(),
+                    index: Param::grey(1.0),
+                    physical: Some(PhysicalMaterial::DiffuseTransmission {
+                        reflectance: r,
+                        transmittance: t,
+                    }),
+                    ..MaterialDesc::default()
+                }
+            }
+            _ => unreachable!("only pbrt-v3's materials are read here"),
+        })
+    }
+
+    /// pbrt-v3 glass's Kr and Kt: other than white, a warning (caustica's glass is clear).
+    fn v3_tints(&mut self, params: &Params, span: &Span, names: &[&str]) -> Result<(), ParseError> {
+        for name in names {
+            if self.colour(params, name, Vec3::ONE)? != Param::grey(1.0) {
+                self.warn(
+                    format!("glass's {name} is not applied: the glass is clear"),
+                    span.clone(),
+                );
+            }
+        }
+        Ok(())
+    }
+
+    /// A pbrt-v3 spectrum file (wavelength–value pairs, `#` comments) at about 650, 550 and
+    /// 450 nm. A file that is not there is read by its name where it names a metal pbrt-v4
+    /// tabulates (`Au.eta.spd` as `metal-Au-eta`), else `default`, with a warning either way.
+    fn spd(&mut self, name: &str, span: Span, default: Vec3) -> Result<Vec3, ParseError> {
+        let path = self.dir.join(name);
+        if let Ok(text) = std::fs::read_to_string(&path) {
+            let numbers: Vec<f32> = text
+                .lines()
+                .map(|l| l.split('#').next().unwrap_or(""))
+                .flat_map(str::split_whitespace)
+                .map(str::parse)
+                .collect::<std::result::Result<_, _>>()
+                .map_err(|_| {
+                    ParseError::new(
+                        format!("`{}` holds something other than numbers", path.display()),
+                        span.clone(),
+                    )
+                })?;
+            let pairs: Vec<(f32, f32)> = numbers.chunks_exact(2).map(|p| (p[0], p[1])).collect();
+            if pairs.is_empty() || numbers.len() % 2 != 0 || pairs.windows(2).any(|w| w[1].0 <= w[0].0) {
+                return Err(ParseError::new(
+                    format!(
+                        "`{}` is not a list of wavelength–value pairs in rising order",
+                        path.display()
+                    ),
+                    span,
+                ));
+            }
+            return Ok(Vec3::new(
+                spectra::sample(&pairs, 650.0),
+                spectra::sample(&pairs, 550.0),
+                spectra::sample(&pairs, 450.0),
+            ));
+        }
+        let stem = Path::new(name).file_stem().and_then(|s| s.to_str()).unwrap_or("");
+        let tabulated = stem
+            .split_once('.')
+            .and_then(|(metal, part)| spectra::metal_part(&format!("metal-{metal}-{part}")).map(|v| (v, metal, part)));
+        Ok(match tabulated {
+            Some((v, metal, part)) => {
+                self.warn(
+                    format!(
+                        "`{}` is missing: pbrt-v4's metal-{metal}-{part} is used",
+                        path.display()
+                    ),
+                    span,
+                );
+                v
+            }
+            None => {
+                self.warn(format!("`{}` is missing: the default is used", path.display()), span);
+                default
+            }
+        })
     }
 
     /// A dielectric's `eta`: n_d, and V_d for named or sampled glasses.
@@ -1030,6 +1233,8 @@ impl<'f> Reader<'f> {
         Ok(match params.spectrum(name)? {
             None => default,
             Some((Spectrum::Rgb(c), _)) => c,
+            // pbrt-v3 names tabulated files, `spds/metals/Au.eta.spd`.
+            Some((Spectrum::Named(n), span)) if n.ends_with(".spd") => self.spd(&n, span, default)?,
             Some((Spectrum::Named(n), span)) => match spectra::metal_part(&n) {
                 Some(v) => v,
                 None => {
@@ -1318,7 +1523,9 @@ impl<'f> Reader<'f> {
     fn area_light(&mut self, t: &Token) -> Result<(), ParseError> {
         let kind = self.string_arg(t)?;
         let params = self.params()?;
-        if kind.text != "diffuse" {
+        // pbrt-v3 calls it "area" (and takes a sample count).
+        let _ = params.int("nsamples");
+        if kind.text != "diffuse" && kind.text != "area" {
             self.warn(
                 format!("the {} area light is not supported", kind.text),
                 kind.span.clone(),
@@ -1451,14 +1658,13 @@ impl<'f> Reader<'f> {
                 );
             }
         }
-        if params.has("alpha") {
-            let _ = params.spectrum("alpha");
-            self.warn_once(
-                "alpha",
-                "alpha cut-outs are not applied: shapes are drawn whole",
-                span.clone(),
-            );
-        }
+        // pbrt-v4's alpha: a ray passes where it is below one with the chance 1 − alpha; a
+        // shape of alpha 0 is not drawn at all.
+        let alpha = match self.colour(&params, "alpha", Vec3::ONE)? {
+            Param::Constant(a) if a.x >= 1.0 => None,
+            Param::Constant(a) if a.x <= 0.0 => return Ok(()),
+            coverage => Some(Alpha { coverage, cutoff: None }),
+        };
         self.report_unused(&params, &format!("the {} shape", kind.text));
         let material = match &self.state.material {
             CurrentMaterial::Desc(m) => (**m).clone(),
@@ -1473,6 +1679,9 @@ impl<'f> Reader<'f> {
         };
         for (shape, world_from_object) in shapes {
             let mut material = material.clone();
+            if alpha.is_some() {
+                material.alpha = alpha.clone();
+            }
             if let Some(light) = self.state.area_light.clone() {
                 let mut radiance = light.radiance;
                 if let Some(power) = light.power {
@@ -1614,6 +1823,38 @@ fn diffuse(reflectance: Param) -> MaterialDesc {
         diffuse: reflectance,
         ..MaterialDesc::default()
     }
+}
+
+/// A base of reflectance `base` under a clear coat of index `eta` and GGX α.
+fn coated(base: Param, eta: f32, alpha: f32) -> MaterialDesc {
+    let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+    let mut m = diffuse(base.clone());
+    m.physical = Some(PhysicalMaterial::CoatedDiffuse {
+        reflectance: base,
+        eta,
+        roughness: alpha,
+    });
+    course_gloss(&mut m, Vec3::splat(f0), alpha);
+    m
+}
+
+/// A smooth mirror of reflectance `r` (pbrt's `conductor` with `reflectance`, v3's `mirror`).
+fn mirror(r: Param) -> MaterialDesc {
+    let f0 = match &r {
+        Param::Constant(c) => *c,
+        _ => Vec3::splat(0.8),
+    };
+    let mut m = MaterialDesc {
+        physical: Some(PhysicalMaterial::Conductor {
+            eta: Vec3::ONE,
+            k: Vec3::ZERO,
+            reflectance: Some(r),
+            roughness: 0.0,
+        }),
+        ..MaterialDesc::default()
+    };
+    course_gloss(&mut m, f0, 0.0);
+    m
 }
 
 fn scaled(p: Param, s: f32) -> Param {

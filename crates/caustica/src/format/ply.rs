@@ -6,6 +6,7 @@
 //! offset. Counts are checked against the bytes present before anything is allocated.
 
 use super::SourceFiles;
+use crate::description::repair_vertex_attributes;
 use crate::error::{ParseError, Span};
 use glam::{Vec2, Vec3};
 use std::path::Path;
@@ -106,11 +107,9 @@ impl Body<'_> {
                 return Err("the file ends early".into());
             }
             let word = std::str::from_utf8(&self.bytes[start..self.pos]).unwrap_or("?");
-            let value: f64 = word.parse().map_err(|_| format!("expected a number, found `{word}`"))?;
-            if !value.is_finite() {
-                return Err(format!("`{word}` is not a finite number"));
-            }
-            return Ok(value);
+            // Not-finite values are read: counts and indices refuse them, vertex attributes
+            // are repaired once the mesh is whole.
+            return word.parse().map_err(|_| format!("expected a number, found `{word}`"));
         }
         let size = kind.size();
         let Some(raw) = self.bytes.get(self.pos..self.pos + size) else {
@@ -132,9 +131,6 @@ impl Body<'_> {
             Scalar::F32 => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
             Scalar::F64 => f64::from_le_bytes(b),
         };
-        if !v.is_finite() {
-            return Err("a value is not a finite number".into());
-        }
         Ok(v)
     }
 }
@@ -293,6 +289,14 @@ pub fn parse(files: &mut SourceFiles, path: &Path, bytes: &[u8]) -> Result<PlyMe
             format!("a face uses vertex {bad} but the file has {n} vertices"),
             span,
         ));
+    }
+    let repaired = repair_vertex_attributes(&mesh.points, &mesh.triangles, &mut mesh.normals, &mut mesh.uvs);
+    if !repaired.is_empty() {
+        let span = elements
+            .iter()
+            .find(|e| e.name == "vertex")
+            .map_or(at(0, 3), |e| e.span.clone());
+        mesh.warnings.extend(repaired.into_iter().map(|w| (w, span.clone())));
     }
     Ok(mesh)
 }
@@ -493,6 +497,35 @@ mod tests {
             assert_eq!(m.points[2], Vec3::new(0.0, 2.0, 0.0), "{name}");
             assert_eq!(m.triangles, vec![[0, 1, 2]], "{name}");
         }
+    }
+
+    /// Not-finite normals are recomputed from their faces and not-finite texture coordinates
+    /// read as (0, 0), each kind with a warning counting them; a NaN vertex index is refused.
+    #[test]
+    fn not_finite_attributes_are_repaired_with_a_count() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                    property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n\
+                    element face 2\nproperty list uchar int vertex_indices\nend_header\n\
+                    0 0 0 nan 0 1 0 0\n2 0 0 0 0 1 inf 0\n2 2 0 0 0 1 1 1\n0 2 0 0 0 1 0 nan\n3 0 1 2\n3 0 2 3\n";
+        let m = read_bytes(text.as_bytes()).unwrap();
+        let normals = m.normals.as_ref().unwrap();
+        assert!(normals.iter().all(|n| (*n - Vec3::Z).length() < 1e-6), "{normals:?}");
+        let uvs = m.uvs.as_ref().unwrap();
+        assert_eq!((uvs[1], uvs[3]), (Vec2::ZERO, Vec2::ZERO));
+        let warnings: Vec<&str> = m.warnings.iter().map(|(w, _)| w.as_str()).collect();
+        assert!(
+            warnings.iter().any(|w| w.starts_with("1 of 4 vertex normals")),
+            "{warnings:?}"
+        );
+        assert!(
+            warnings.iter().any(|w| w.starts_with("2 of 4 texture coordinates")),
+            "{warnings:?}"
+        );
+        let bad_index = text.replace("3 0 2 3", "3 0 nan 3");
+        assert!(read_bytes(bad_index.as_bytes())
+            .unwrap_err()
+            .message
+            .contains("not a vertex index"));
     }
 
     #[test]

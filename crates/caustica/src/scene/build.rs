@@ -176,7 +176,7 @@ fn convert_light(light: &LightDesc, warnings: &mut Vec<String>) -> Result<Option
                         format!("cannot read the environment map `{}`: {reason}", path.display()),
                         span.clone(),
                     )
-                    .with_help("environment maps are EXR or Radiance HDR images in latitude–longitude layout, resolved against the scene file's folder")
+                    .with_help("environment maps are EXR, Radiance HDR or PFM images in latitude–longitude layout, resolved against the scene file's folder")
                 })?),
             };
             if *equal_area {
@@ -526,7 +526,7 @@ impl Builder {
                                 other => other.to_string(),
                             };
                             ParseError::new(format!("cannot read the texture `{source}`: {reason}"), map.span.clone())
-                                .with_help("texture paths are resolved against the scene file's folder; PNG, JPEG, BMP, PPM, TGA, EXR and HDR are read")
+                                .with_help("texture paths are resolved against the scene file's folder; PNG, JPEG, BMP, PPM, TGA, EXR, HDR and PFM are read")
                         })?;
                         let image = std::sync::Arc::new(image);
                         self.images.insert(image_key, image.clone());

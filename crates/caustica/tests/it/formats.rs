@@ -482,3 +482,85 @@ fn no_format_mirrors_the_image() {
         assert!(left > 4.0 * right, "{format}: red left {left}, right {right}");
     }
 }
+
+/// A glTF whose NORMAL and TEXCOORD_0 hold a NaN and an infinity (as broken exporters write)
+/// loads with the normal recomputed from the faces, the coordinate read as (0, 0), a warning
+/// counting each; a NaN position leaves out the triangles that use it, with a warning too.
+#[test]
+fn gltf_not_finite_attributes_are_repaired_not_refused() {
+    let dir = std::env::temp_dir().join(format!("caustica-formats-{}-nan", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let positions: [f32; 15] = [
+        0.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        1.0,
+        1.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        f32::NAN,
+        5.0,
+        0.0,
+    ];
+    let normals: [f32; 15] = [
+        f32::NAN,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        1.0,
+        0.0,
+        0.0,
+        1.0,
+    ];
+    let uvs: [f32; 10] = [0.0, 0.0, f32::INFINITY, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 0.0];
+    let indices: [u16; 9] = [0, 1, 2, 0, 2, 3, 3, 2, 4];
+    let mut buffer: Vec<u8> = positions
+        .iter()
+        .chain(&normals)
+        .chain(&uvs)
+        .flat_map(|v| v.to_le_bytes())
+        .collect();
+    buffer.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
+    buffer.resize(buffer.len().next_multiple_of(4), 0);
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0,"NORMAL":1,"TEXCOORD_0":2}},"indices":3}}]}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":5,"type":"VEC3","min":[0,0,0],"max":[1,5,0]}},
+{{"bufferView":1,"componentType":5126,"count":5,"type":"VEC3"}},
+{{"bufferView":2,"componentType":5126,"count":5,"type":"VEC2"}},
+{{"bufferView":3,"componentType":5123,"count":9,"type":"SCALAR"}}],
+"bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":60}},{{"buffer":0,"byteOffset":60,"byteLength":60}},
+{{"buffer":0,"byteOffset":120,"byteLength":40}},{{"buffer":0,"byteOffset":160,"byteLength":18}}],
+"buffers":[{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}]}}"#,
+        buffer.len(),
+        base64(&buffer)
+    );
+    let path = dir.join("nan.gltf");
+    std::fs::write(&path, json).unwrap();
+    let scene = caustica::loader::load(&path, &caustica::loader::LoadSettings::default()).unwrap();
+    let warnings = scene.warnings().join("\n");
+    for counted in [
+        "1 of 5 vertex positions are not finite",
+        "1 of 5 vertex normals are not finite",
+        "1 of 5 texture coordinates are not finite",
+    ] {
+        assert!(warnings.contains(counted), "{counted}: {warnings}");
+    }
+    assert_eq!(scene.triangles().len(), 2, "the triangle on the NaN corner is left out");
+    let ray = caustica::math::Ray::new(Vec3::new(0.1, 0.05, 1.0), -Vec3::Z);
+    let hit = scene.intersect(&ray, f32::INFINITY).expect("the quad");
+    let normal = scene.surface(&ray, &hit).shading_normal;
+    assert!((normal - Vec3::Z).length() < 1e-5, "recomputed normal: {normal}");
+}

@@ -564,3 +564,243 @@ fn alpha_masks_are_holes_for_every_ray_and_blend_passes_in_proportion() {
     let want = 1.0 - 0.8 * 60.0 / 255.0;
     assert!((passed - want).abs() < 0.02, "{passed} passed, {want} expected");
 }
+
+/// An OBJ quad in the z = 0 plane (normal +z), u along +x and v along +y, with `material`
+/// written as its MTL; loaded with its warnings.
+fn obj_quad(dir: &Path, material: &str) -> Scene {
+    std::fs::write(dir.join("m.mtl"), format!("newmtl m\nKd 0.5 0.5 0.5\n{material}\n")).unwrap();
+    std::fs::write(
+        dir.join("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\n\
+         usemtl m\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n",
+    )
+    .unwrap();
+    load(&dir.join("m.obj"), &LoadSettings::default()).unwrap()
+}
+
+/// The shading normal where a ray straight down meets the quad at (x, y).
+fn shading_normal_at(scene: &Scene, x: f32, y: f32) -> Vec3 {
+    let ray = caustica::math::Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
+    let hit = scene.intersect(&ray, f32::INFINITY).expect("the quad");
+    scene.surface(&ray, &hit).shading_normal
+}
+
+/// OBJ bump maps: a grey `bump` image is heights, its slope (central differences, in texels,
+/// times `-bm`) tilting the normal against it; `map_Bump` holding a normal map (as Blender
+/// writes it) and `norm` read the same tilt, x and y times `-bm`.
+#[test]
+fn obj_bump_maps_are_heights_or_normal_maps() {
+    let dir = folder("obj-bump");
+    // Heights 0, 20, 40, … (of 255) rising along u, the same on both rows.
+    let ramp: Vec<[u8; 3]> = (0..2).flat_map(|_| (0..8u8).map(|x| [20 * x; 3])).collect();
+    std::fs::write(dir.join("ramp.png"), png(8, 2, &ramp)).unwrap();
+    let scene = obj_quad(&dir, "bump -bm 2 ramp.png");
+    assert!(scene.warnings().is_empty(), "{:?}", scene.warnings());
+    // Texel 3's centre: its neighbours differ by 40/255 over two texels.
+    let slope = 2.0 * (40.0 / 255.0) / 2.0;
+    let want = Vec3::new(-slope, 0.0, 1.0).normalize();
+    let got = shading_normal_at(&scene, 3.5 / 8.0, 0.25);
+    assert!(near(got, want, 1e-4), "height ramp: {got} against {want}");
+    let flat = obj_quad(&dir, "");
+    assert!(near(shading_normal_at(&flat, 0.4, 0.3), Vec3::Z, 1e-6));
+
+    let texel = [209u8, 128, 225];
+    std::fs::write(dir.join("normal.png"), png(1, 1, &[texel])).unwrap();
+    let m = Vec3::new(texel[0] as f32, texel[1] as f32, texel[2] as f32) / 255.0 * 2.0 - Vec3::ONE;
+    let want = Vec3::new(m.x * 0.5, m.y * 0.5, m.z).normalize();
+    for statement in ["map_Bump -bm 0.5 normal.png", "norm -bm 0.5 normal.png"] {
+        let got = shading_normal_at(&obj_quad(&dir, statement), 0.3, 0.6);
+        assert!(near(got, want, 1e-4), "{statement}: {got} against {want}");
+    }
+}
+
+/// OBJ `map_d`: the mask (alpha, or luminance where the image has none) times d is the chance a
+/// ray meets the surface: black texels are holes for camera and shadow rays.
+#[test]
+fn obj_map_d_cuts_holes() {
+    let dir = folder("obj-mask");
+    std::fs::write(dir.join("mask.png"), png(2, 1, &[[0, 0, 0], [255, 255, 255]])).unwrap();
+    let scene = obj_quad(&dir, "map_d mask.png");
+    let down = |x: f32| caustica::math::Ray::new(Vec3::new(x, 0.5, 1.0), -Vec3::Z);
+    assert!(scene.intersect(&down(0.25), f32::INFINITY).is_none(), "a hole");
+    assert!(scene.intersect(&down(0.75), f32::INFINITY).is_some());
+    assert!(scene.segment_clear(Vec3::new(0.25, 0.5, 1.0), Vec3::Z, Vec3::new(0.25, 0.5, -1.0), -Vec3::Z));
+    // d 0 leaves nothing of the surface.
+    let gone = obj_quad(&dir, "d 0\nmap_d mask.png");
+    assert!(gone.intersect(&down(0.75), f32::INFINITY).is_none());
+}
+
+/// OBJ `map_Ke` glows as its sRGB texels times Ke; texture options `-s`, `-o` and `-clamp on`
+/// move and hold the image; a file name with spaces, written with backslashes, is found.
+#[test]
+fn obj_map_ke_and_texture_options() {
+    let dir = folder("obj-options");
+    std::fs::create_dir_all(dir.join("maps")).unwrap();
+    std::fs::write(dir.join("maps/wood grain.png"), png(2, 1, &[[0, 0, 0], [200, 100, 50]])).unwrap();
+    let scene = obj_quad(&dir, "Ke 2 2 4\nmap_Ke maps\\wood grain.png");
+    // Said, not silent: the Windows path, and that the glow is the only light.
+    let warnings = scene.warnings().join("\n");
+    assert_eq!(scene.warnings().len(), 2, "{warnings}");
+    assert!(warnings.contains("backslashes are read as /"), "{warnings}");
+    assert!(
+        warnings.contains("only lights") && warnings.contains("--point-light"),
+        "{warnings}"
+    );
+    let material = scene
+        .materials()
+        .iter()
+        .find(|m| matches!(m.emissive, Channel::Texture(_)))
+        .expect("a textured emission");
+    let glow = |u: f32| material.eval(scene.textures(), Vec2::new(u, 0.5)).emissive;
+    assert_eq!(glow(0.25), Vec3::ZERO, "black texels do not glow");
+    let want = Vec3::new(2.0 * srgb(200), 2.0 * srgb(100), 4.0 * srgb(50));
+    assert!(near(glow(0.75), want, 1e-5), "{}", glow(0.75));
+
+    let b = Vec3::new(srgb(200), srgb(100), srgb(50));
+    // u ↦ 2u + 0.5: u = −0.125 reads texel 0's centre, u = 0.125 texel 1's; u = 0.5 reads 1.5,
+    // held at the edge texel (repeating would blend the two halves).
+    let scene = obj_quad(&dir, "map_Kd -s 2 1 -o 0.5 0 -clamp on maps/wood grain.png");
+    assert!(near(diffuse_at(&scene, Vec2::new(-0.125, 0.5)), Vec3::ZERO, 1e-6));
+    assert!(near(diffuse_at(&scene, Vec2::new(0.125, 0.5)), b, 1e-6));
+    assert!(near(diffuse_at(&scene, Vec2::new(0.5, 0.5)), b, 1e-6));
+    let scene = obj_quad(&dir, "map_Kd -s 2 1 -o 0.5 0 maps/wood grain.png");
+    assert!(near(diffuse_at(&scene, Vec2::new(0.5, 0.5)), b * 0.5, 1e-6));
+
+    // Unread options are warnings; a missing file is a warning naming what stands in.
+    let scene = obj_quad(&dir, "map_Kd -imfchan l -blendu off maps/wood grain.png\nbump gone.png");
+    let warnings = scene.warnings().join("\n");
+    assert!(
+        warnings.contains("`-imfchan` is not read") && warnings.contains("`-blendu` is not read"),
+        "{warnings}"
+    );
+    assert!(
+        warnings.contains("gone.png") && warnings.contains("without it"),
+        "{warnings}"
+    );
+    assert!(near(diffuse_at(&scene, Vec2::new(0.25, 0.5)), Vec3::ZERO, 1e-6));
+}
+
+/// A pbrt quad in the z = 0 plane (u along +x, v along +y) under `material`, with `shape`'s
+/// extra parameters; `textures` are declared before it.
+fn pbrt_quad(dir: &Path, textures: &str, material: &str, shape: &str) -> Scene {
+    let text = format!(
+        r#"LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+WorldBegin
+LightSource "point" "rgb I" [1 1 1] "point3 from" [0 0 2]
+{textures}
+Material {material}
+Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 1 1 0 0 1 0] "point2 uv" [0 0 1 0 1 1 0 1] "integer indices" [0 1 2 0 2 3] {shape}
+"#
+    );
+    std::fs::write(dir.join("scene.pbrt"), text).unwrap();
+    load(&dir.join("scene.pbrt"), &LoadSettings::default()).unwrap()
+}
+
+/// pbrt-v4's `normalmap` (a linear image, texels 2c − 1 in the frame of u and the normal)
+/// tilts the shading normal; a missing one is a warning.
+#[test]
+fn pbrt_normalmap_tilts_the_shading_normal() {
+    let dir = folder("pbrt-normal");
+    let texel = [160u8, 100, 240];
+    std::fs::write(dir.join("n.png"), png(1, 1, &[texel])).unwrap();
+    let scene = pbrt_quad(&dir, "", r#""diffuse" "string normalmap" "n.png""#, "");
+    let want = (Vec3::new(texel[0] as f32, texel[1] as f32, texel[2] as f32) / 255.0 * 2.0 - Vec3::ONE).normalize();
+    let got = shading_normal_at(&scene, 0.3, 0.6);
+    assert!(near(got, want, 1e-4), "{got} against {want}");
+    let missing = pbrt_quad(&dir, "", r#""diffuse" "string normalmap" "gone.png""#, "");
+    assert!(
+        missing.warnings().iter().any(|w| w.contains("gone.png")),
+        "{:?}",
+        missing.warnings()
+    );
+    assert!(near(shading_normal_at(&missing, 0.3, 0.6), Vec3::Z, 1e-6));
+}
+
+/// pbrt-v4's shape `alpha`: a float texture's zeros are holes, ones solid; a constant 0 leaves
+/// the shape out, a constant between lets rays through in proportion.
+#[test]
+fn pbrt_alpha_cuts_holes() {
+    let dir = folder("pbrt-alpha");
+    std::fs::write(dir.join("mask.png"), png(2, 1, &[[0, 0, 0], [255, 255, 255]])).unwrap();
+    let down = |x: f32, y: f32| caustica::math::Ray::new(Vec3::new(x, y, 1.0), -Vec3::Z);
+    let texture = r#"Texture "mask" "float" "imagemap" "string filename" "mask.png" "string filter" "point""#;
+    let scene = pbrt_quad(&dir, texture, r#""diffuse""#, r#""texture alpha" "mask""#);
+    assert!(scene.intersect(&down(0.25, 0.5), f32::INFINITY).is_none(), "a hole");
+    assert!(scene.intersect(&down(0.75, 0.5), f32::INFINITY).is_some());
+    let gone = pbrt_quad(&dir, "", r#""diffuse""#, r#""float alpha" 0"#);
+    assert!(gone.intersect(&down(0.75, 0.5), f32::INFINITY).is_none());
+    let whole = pbrt_quad(&dir, "", r#""diffuse""#, r#""float alpha" 1"#);
+    assert!(whole.intersect(&down(0.25, 0.5), f32::INFINITY).is_some());
+    let half = pbrt_quad(&dir, "", r#""diffuse""#, r#""float alpha" 0.3"#);
+    let n = 10_000;
+    let passed = (0..n)
+        .filter(|i| {
+            let (x, y) = (
+                0.02 + 0.96 * (i % 100) as f32 / 100.0,
+                0.02 + 0.96 * (i / 100) as f32 / 100.0,
+            );
+            half.intersect(&down(x, y), f32::INFINITY).is_none()
+        })
+        .count() as f32
+        / n as f32;
+    assert!((passed - 0.7).abs() < 0.03, "{passed} of rays passed, 0.7 expected");
+}
+
+/// PFM images (Bitterli's scenes use them) are read as the floats they hold, linear, rows
+/// stored bottom-up: a pbrt `imagemap` of a 2×1 PFM reads each texel at its centre.
+#[test]
+fn pfm_images_are_read_as_linear_floats() {
+    let dir = folder("pfm");
+    let mut bytes = b"PF\n2 1\n-1.0\n".to_vec();
+    for v in [0.25f32, 0.5, 2.0, 0.125, 0.0, 4.0] {
+        bytes.extend(v.to_le_bytes());
+    }
+    std::fs::write(dir.join("sky.pfm"), &bytes).unwrap();
+    let texture = r#"Texture "t" "spectrum" "imagemap" "string filename" "sky.pfm" "string filter" "point""#;
+    let scene = pbrt_quad(&dir, texture, r#""diffuse" "texture reflectance" "t""#, "");
+    assert_eq!(diffuse_at(&scene, Vec2::new(0.25, 0.5)), Vec3::new(0.25, 0.5, 2.0));
+    assert_eq!(diffuse_at(&scene, Vec2::new(0.75, 0.5)), Vec3::new(0.125, 0.0, 4.0));
+    // Cut short: a located refusal naming the file, not a panic.
+    std::fs::write(dir.join("sky.pfm"), &bytes[..bytes.len() - 3]).unwrap();
+    let Err(err) = load(&dir.join("scene.pbrt"), &LoadSettings::default()) else {
+        panic!("a cut-short image is refused");
+    };
+    let err = err.to_string();
+    assert!(err.contains("sky.pfm") && err.contains("cut short"), "{err}");
+}
+
+/// OBJ and MTL from Windows exporters: `.\` and backslashes between folders, and names in the
+/// local code page (not UTF-8), read with a warning each; the material still matches its
+/// `usemtl` (both names read alike) and its colour is used.
+#[test]
+fn obj_from_windows_exporters_reads_with_warnings() {
+    let dir = folder("obj-windows");
+    std::fs::create_dir_all(dir.join("mats")).unwrap();
+    // "Matériau" in Latin-1: é is the single byte 0xE9.
+    let mut mtl = b"newmtl Mat\xe9riau\nKd 0.2 0.4 0.6\n".to_vec();
+    mtl.extend(b"Ks 0 0 0\n");
+    std::fs::write(dir.join("mats/m.mtl"), mtl).unwrap();
+    let mut obj = b"mtllib .\\mats\\m.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl Mat\xe9riau\nf 1 2 3\n".to_vec();
+    obj.extend(b"# end\n");
+    std::fs::write(dir.join("m.obj"), obj).unwrap();
+    let scene = load(&dir.join("m.obj"), &LoadSettings::default()).unwrap();
+    let warnings = scene.warnings().join("\n");
+    assert!(
+        warnings.matches("not valid UTF-8").count() == 2,
+        "the OBJ and the MTL: {warnings}"
+    );
+    assert!(warnings.contains("backslashes are read as /"), "{warnings}");
+    assert!(
+        !warnings.contains("missing") && !warnings.contains("no material"),
+        "{warnings}"
+    );
+    let kd = scene
+        .materials()
+        .iter()
+        .map(|m| m.eval(scene.textures(), Vec2::ZERO).diffuse);
+    assert!(
+        kd.into_iter().any(|d| d == Vec3::new(0.2, 0.4, 0.6)),
+        "the MTL colour is used"
+    );
+}

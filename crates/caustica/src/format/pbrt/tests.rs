@@ -140,6 +140,94 @@ fn materials_map_to_both_models() {
     assert_eq!(m[5].diffuse, Param::Constant(Vec3::new(0.8, 0.0, 0.0)));
 }
 
+/// pbrt-v3's materials and area light, as pbrt-v3 defines their parameters: each read onto
+/// caustica's nearest material, with its own defaults (metal's roughness 0.01, plastic's Kd 0.25,
+/// mirror's Kr 0.9), `color` spellings and `index` for glass; approximations say so.
+#[test]
+fn pbrt_v3_materials_are_read() {
+    let dir = std::env::temp_dir().join(format!("caustica-v3-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("spds")).unwrap();
+    std::fs::write(
+        dir.join("spds/Odd.eta.spd"),
+        "# wavelength value\n400 1.0\n500 2.0\n600 3.0\n700 4.0\n",
+    )
+    .unwrap();
+    let text = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\nWorldBegin\n\
+         Material \"matte\" \"color Kd\" [0.2 0.3 0.4]\nShape \"sphere\"\n\
+         Material \"plastic\" \"color Kd\" [0.5 0.5 0.5] \"float roughness\" 0.04\nShape \"sphere\"\n\
+         Material \"glass\" \"float index\" 1.33\nShape \"sphere\"\n\
+         Material \"metal\" \"spectrum eta\" \"spds/Odd.eta.spd\" \"spectrum k\" \"spds/Au.k.spd\"\nShape \"sphere\"\n\
+         Material \"mirror\"\nShape \"sphere\"\n\
+         Material \"substrate\" \"color Kd\" [0.6 0.1 0.1] \"color Ks\" [0.04 0.04 0.04]\nShape \"sphere\"\n\
+         Material \"uber\" \"color Kd\" [0.3 0.3 0.3] \"color opacity\" [0.5 0.5 0.5]\nShape \"sphere\"\n\
+         Material \"translucent\" \"color Kd\" [0.8 0.8 0.8]\nShape \"sphere\"\n\
+         AttributeBegin\nAreaLightSource \"area\" \"color L\" [3 3 3] \"integer nsamples\" 4\nShape \"sphere\"\nAttributeEnd\n";
+    std::fs::write(dir.join("v3.pbrt"), text).unwrap();
+    let source = read(&dir.join("v3.pbrt"), text.to_string(), &dir, &NoProgress).unwrap();
+    let desc = &source.description;
+    let m: Vec<&MaterialDesc> = desc.objects.iter().map(|o| &o.material).collect();
+    assert_eq!(m[0].diffuse, Param::Constant(Vec3::new(0.2, 0.3, 0.4)));
+    assert!(m[0].physical.is_none());
+    match &m[1].physical {
+        Some(PhysicalMaterial::CoatedDiffuse {
+            eta,
+            roughness,
+            reflectance,
+        }) => {
+            assert_eq!((*eta, *reflectance == Param::grey(0.5)), (1.5, true));
+            assert!((roughness - 0.2).abs() < 1e-6, "remapped √0.04: {roughness}");
+        }
+        other => panic!("plastic: {other:?}"),
+    }
+    assert_eq!(
+        (m[2].index.clone(), m[2].transmissive.clone()),
+        (Param::grey(1.33), Param::grey(1.0))
+    );
+    match &m[3].physical {
+        Some(PhysicalMaterial::Conductor { eta, k, roughness, .. }) => {
+            // The file's table at 650, 550 and 450 nm; gold's k by name, the file being absent.
+            assert!((*eta - Vec3::new(3.5, 2.5, 1.5)).length() < 1e-5, "{eta}");
+            assert_eq!(*k, spectra::metal("metal-Au").unwrap().1);
+            assert!(
+                (roughness - 0.1).abs() < 1e-6,
+                "metal's default 0.01, remapped: {roughness}"
+            );
+        }
+        other => panic!("metal: {other:?}"),
+    }
+    assert!(
+        matches!(&m[4].physical, Some(PhysicalMaterial::Conductor { reflectance: Some(r), roughness, .. })
+        if *r == Param::grey(0.9) && *roughness == 0.0)
+    );
+    match &m[5].physical {
+        Some(PhysicalMaterial::CoatedDiffuse { eta, .. }) => {
+            assert!((eta - 1.5).abs() < 0.01, "Ks 0.04 is index 1.5: {eta}")
+        }
+        other => panic!("substrate: {other:?}"),
+    }
+    assert_eq!(m[6].alpha.as_ref().map(|a| a.coverage.clone()), Some(Param::grey(0.5)));
+    assert!(
+        matches!(&m[7].physical, Some(PhysicalMaterial::DiffuseTransmission { reflectance, transmittance })
+        if *reflectance == Param::grey(0.4) && *transmittance == Param::grey(0.4))
+    );
+    assert_eq!(m[8].emissive, Param::grey(3.0));
+    let warnings: Vec<&str> = desc.warnings.iter().map(|(w, _)| w.as_str()).collect();
+    for said in [
+        "plastic is read as",
+        "Au.k.spd` is missing: pbrt-v4's metal-Au-k",
+        "uber is read as",
+        "translucent's glossy part",
+    ] {
+        assert!(warnings.iter().any(|w| w.contains(said)), "{said}: {warnings:?}");
+    }
+    assert!(
+        !warnings
+            .iter()
+            .any(|w| w.contains("not supported") || w.contains("not read")),
+        "{warnings:?}"
+    );
+}
+
 #[test]
 fn lights_shapes_and_instances() {
     let desc = scene(

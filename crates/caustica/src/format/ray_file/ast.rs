@@ -144,8 +144,11 @@ impl RayScene {
                     ..placeholder.clone()
                 }]
             } else {
-                let (base, text) = files.read_text(&mesh.path, &mesh.span)?;
+                let (base, text, bad) = files.read_text_lossy(&mesh.path, &mesh.span)?;
                 let text = text.to_string();
+                if let Some(bad) = bad {
+                    warnings.push((crate::format::NOT_UTF8.to_string(), bad));
+                }
                 let dir = mesh.path.parent().unwrap_or(scene_dir).to_path_buf();
                 let obj = ObjMesh::parse(files, base, &text, &dir)?;
                 warnings.extend(obj.warnings.iter().cloned());
