@@ -1166,8 +1166,10 @@ impl<'f> Reader<'f> {
                         span.clone(),
                     )
                 })?;
-            let pairs: Vec<(f32, f32)> = numbers.chunks_exact(2).map(|p| (p[0], p[1])).collect();
-            if pairs.is_empty() || numbers.len() % 2 != 0 || pairs.windows(2).any(|w| w[1].0 <= w[0].0) {
+            let chunks = numbers.chunks_exact(2);
+            let unpaired = !chunks.remainder().is_empty();
+            let pairs: Vec<(f32, f32)> = chunks.map(|p| (p[0], p[1])).collect();
+            if pairs.is_empty() || unpaired || pairs.windows(2).any(|w| w[1].0 <= w[0].0) {
                 return Err(ParseError::new(
                     format!(
                         "`{}` is not a list of wavelength–value pairs in rising order",
