@@ -421,6 +421,42 @@ impl<P> PhysicalMaterial<P> {
     }
 }
 
+impl MaterialDesc {
+    /// Every image map the material reads (colours, physical lobes, cut-outs, normal map).
+    pub fn image_maps(&self) -> Vec<ImageMap> {
+        let mut maps = Vec::new();
+        let mut visit = |p: &Param| {
+            if let Param::Texture(m) = p {
+                maps.push((**m).clone());
+            }
+            Ok::<(), ()>(())
+        };
+        for p in [
+            &self.emissive,
+            &self.ambient,
+            &self.specular,
+            &self.reflective,
+            &self.diffuse,
+            &self.transmissive,
+            &self.shininess,
+            &self.index,
+        ] {
+            let _ = visit(p);
+        }
+        if let Some(p) = &self.physical {
+            let _ = p.try_map(&mut visit);
+        }
+        if let Some(a) = &self.alpha {
+            let _ = visit(&a.coverage);
+        }
+        if let Some(mr) = &self.metallic_roughness {
+            let _ = mr.try_map(&mut visit);
+        }
+        maps.extend(self.normal_map.as_ref().map(|n| n.map.clone()));
+        maps
+    }
+}
+
 impl Default for MaterialDesc {
     /// The all-default material of §6.1: colours zero, shininess 0, index 1.
     fn default() -> Self {

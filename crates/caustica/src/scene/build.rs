@@ -4,7 +4,7 @@
 use super::{Mesh, Scene, SceneParts, TriangleRef};
 use crate::camera::Camera;
 use crate::description::{
-    LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc,
+    ImageMap, LightDesc, MaterialDesc, ObjectDesc, Param, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc,
 };
 use crate::error::Span;
 use crate::error::{Error, ParseError};
@@ -16,7 +16,8 @@ use crate::light::{Environment, Light, SoftLight};
 use crate::material::{Channel, Material};
 use crate::math::{Aabb, Mat3, Vec3};
 use crate::progress::{NoProgress, Progress};
-use crate::texture::Texture;
+use crate::texture::{Image, Texture};
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Options for building a scene.
@@ -66,6 +67,7 @@ fn build_objects(
     {
         warnings.push("the scene has no lights: the image will be black".into());
     }
+    builder.decode_images(desc);
     let mut placed = 0;
     for object in &desc.objects {
         builder.add_object(object, &settings.shapes, &mut warnings)?;
@@ -255,7 +257,46 @@ struct Builder {
 #[derive(Clone, PartialEq, Eq, Hash)]
 struct MaterialKey(Vec<u32>);
 
+/// The decoded-image cache's key: one image per source and encoding.
+fn image_key(map: &ImageMap) -> String {
+    format!("{}\u{0}{:?}", map.source.name(), map.encoding)
+}
+
 impl Builder {
+    /// Decodes every image the scene's materials read, in parallel (real files name dozens of
+    /// large images), into the cache the materials are then built from. An image that fails
+    /// is left for the build to report at its material's place.
+    fn decode_images(&mut self, desc: &SceneDescription) {
+        let mut wanted: Vec<(String, ImageMap)> = Vec::new();
+        let mut seen = std::collections::HashSet::new();
+        for object in &desc.objects {
+            let vertex_materials = match &object.shape {
+                ShapeDesc::Trimesh(mesh) => mesh.materials.as_deref().unwrap_or(&[]),
+                _ => &[],
+            };
+            for material in std::iter::once(&object.material).chain(vertex_materials) {
+                for map in material.image_maps() {
+                    let key = image_key(&map);
+                    if seen.insert(key.clone()) {
+                        wanted.push((key, map));
+                    }
+                }
+            }
+        }
+        if wanted.len() < 2 {
+            return;
+        }
+        let decoded: Vec<(String, Option<Image>)> = wanted
+            .into_par_iter()
+            .map(|(key, map)| (key, image_io::load_image(&map.source, map.encoding).ok()))
+            .collect();
+        for (key, image) in decoded {
+            if let Some(image) = image {
+                self.images.insert(key, std::sync::Arc::new(image));
+            }
+        }
+    }
+
     fn add_object(
         &mut self,
         object: &ObjectDesc,
@@ -516,7 +557,7 @@ impl Builder {
                 if let Some(&id) = self.texture_ids.get(&key) {
                     return Ok(Channel::Texture(id));
                 }
-                let image_key = format!("{source}\u{0}{:?}", map.encoding);
+                let image_key = image_key(map);
                 let image = match self.images.get(&image_key) {
                     Some(image) => image.clone(),
                     None => {

@@ -804,3 +804,37 @@ fn obj_from_windows_exporters_reads_with_warnings() {
         "the MTL colour is used"
     );
 }
+
+/// Images are decoded in parallel before the materials are built: a scene of several images
+/// reads each as alone, and one that cannot be decoded is still refused at its own place.
+#[test]
+fn images_decoded_together_read_as_alone_and_fail_at_their_place() {
+    let dir = folder("parallel");
+    std::fs::write(dir.join("a.png"), png(1, 1, &[[10, 20, 30]])).unwrap();
+    std::fs::write(dir.join("b.png"), png(1, 1, &[[200, 100, 50]])).unwrap();
+    let textures = r#"Texture "a" "spectrum" "imagemap" "string filename" "a.png"
+Texture "b" "spectrum" "imagemap" "string filename" "b.png""#;
+    let scene = pbrt_quad(
+        &dir,
+        textures,
+        r#""diffuse" "texture reflectance" "a" "string normalmap" "b.png""#,
+        "",
+    );
+    assert_eq!(scene.textures().len(), 2);
+    assert!(near(
+        diffuse_at(&scene, Vec2::new(0.5, 0.5)),
+        Vec3::new(srgb(10), srgb(20), srgb(30)),
+        1e-6
+    ));
+    let cut = png(1, 1, &[[200, 100, 50]]);
+    std::fs::write(dir.join("b.png"), &cut[..cut.len() / 2]).unwrap();
+    let text = std::fs::read_to_string(dir.join("scene.pbrt")).unwrap();
+    let Err(err) = load(&dir.join("scene.pbrt"), &LoadSettings::default()) else {
+        panic!("a broken image is refused");
+    };
+    let err = err.to_string();
+    // The normal map names it last (texture "b" itself is never read).
+    let at = text.rfind("\"b.png\"").unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    assert!(err.contains("b.png") && err.contains(&format!(":{line}:")), "{err}");
+}
