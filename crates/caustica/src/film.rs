@@ -54,14 +54,18 @@ impl Film {
         self.pixels[y * self.width + x]
     }
 
-    /// Mean over the inclusive rectangle of rows `r0..=r1` and columns `c0..=c1`.
+    /// Mean over the inclusive rectangle of rows `r0..=r1` and columns `c0..=c1`, leaving out
+    /// pixels that are not finite (a reference renderer's stray NaN).
     pub fn region_mean(&self, rows: (usize, usize), cols: (usize, usize)) -> Vec3 {
         let mut sum = Vec3::ZERO;
         let mut n = 0.0;
         for y in rows.0..=rows.1.min(self.height - 1) {
             for x in cols.0..=cols.1.min(self.width - 1) {
-                sum += self.pixel(x, y);
-                n += 1.0;
+                let p = self.pixel(x, y);
+                if p.is_finite() {
+                    sum += p;
+                    n += 1.0;
+                }
             }
         }
         sum / n
@@ -135,6 +139,20 @@ mod tests {
         assert_eq!(encode_channel(f32::NAN, ToneMap::Clamp { exposure: 0.0 }), 0);
         // One stop down halves the value before clamping.
         assert_eq!(encode_channel(1.0, ToneMap::Clamp { exposure: -1.0 }), 127);
+    }
+
+    /// A NaN pixel is left out of a region's mean, not spread over it.
+    #[test]
+    fn region_means_leave_out_pixels_that_are_not_finite() {
+        let mut film = Film::new(2, 2);
+        film.pixels = vec![
+            Vec3::ONE,
+            Vec3::splat(3.0),
+            Vec3::new(f32::NAN, 0.0, 0.0),
+            Vec3::splat(f32::INFINITY),
+        ];
+        assert_eq!(film.region_mean((0, 1), (0, 1)), Vec3::splat(2.0));
+        assert_eq!(film.region_mean((0, 0), (1, 1)), Vec3::splat(3.0));
     }
 
     #[test]
