@@ -957,17 +957,7 @@ impl<'f> Reader<'f> {
                 let scale = params.float_or("scale", 1.0)?;
                 let r = self.colour(params, "reflectance", Vec3::splat(0.25))?;
                 let t = self.colour(params, "transmittance", Vec3::splat(0.25))?;
-                let (r, t) = (scaled(r, scale), scaled(t, scale));
-                MaterialDesc {
-                    diffuse: r.clone(),
-                    transmissive: t.clone(),
-                    index: Param::grey(1.0),
-                    physical: Some(PhysicalMaterial::DiffuseTransmission {
-                        reflectance: r,
-                        transmittance: t,
-                    }),
-                    ..MaterialDesc::default()
-                }
+                diffuse_transmission(scaled(r, scale), scaled(t, scale))
             }
             "interface" | "" | "none" => return Ok(CurrentMaterial::Interface),
             "mix" => {
@@ -1120,16 +1110,7 @@ impl<'f> Reader<'f> {
                     "translucent's glossy part (Ks) is not modelled: diffuse reflection and transmission",
                     span.clone(),
                 );
-                MaterialDesc {
-                    diffuse: r.clone(),
-                    transmissive: t.clone(),
-                    index: Param::grey(1.0),
-                    physical: Some(PhysicalMaterial::DiffuseTransmission {
-                        reflectance: r,
-                        transmittance: t,
-                    }),
-                    ..MaterialDesc::default()
-                }
+                diffuse_transmission(r, t)
             }
             _ => unreachable!("only pbrt-v3's materials are read here"),
         })
@@ -1823,6 +1804,21 @@ fn luminance(c: Vec3) -> f32 {
 fn diffuse(reflectance: Param) -> MaterialDesc {
     MaterialDesc {
         diffuse: reflectance,
+        ..MaterialDesc::default()
+    }
+}
+
+/// Lambert reflection `r` and Lambert transmission `t` (the course model's `diffuse` and
+/// `transmissive` at index 1).
+fn diffuse_transmission(r: Param, t: Param) -> MaterialDesc {
+    MaterialDesc {
+        diffuse: r.clone(),
+        transmissive: t.clone(),
+        index: Param::grey(1.0),
+        physical: Some(PhysicalMaterial::DiffuseTransmission {
+            reflectance: r,
+            transmittance: t,
+        }),
         ..MaterialDesc::default()
     }
 }

@@ -490,40 +490,13 @@ fn no_format_mirrors_the_image() {
 fn gltf_not_finite_attributes_are_repaired_not_refused() {
     let dir = std::env::temp_dir().join(format!("caustica-formats-{}-nan", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let positions: [f32; 15] = [
-        0.0,
-        0.0,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
-        1.0,
-        1.0,
-        0.0,
-        0.0,
-        1.0,
-        0.0,
-        f32::NAN,
-        5.0,
-        0.0,
+    // A quad and a fifth corner at a NaN; the first normal a NaN, the second uv an infinity.
+    let mut positions = [
+        0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 1.0, 0.0, 0.0, 5.0, 0.0,
     ];
-    let normals: [f32; 15] = [
-        f32::NAN,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
-        1.0,
-        0.0,
-        0.0,
-        1.0,
-    ];
+    positions[12] = f32::NAN;
+    let mut normals = [0.0f32, 0.0, 1.0].repeat(5);
+    normals[0] = f32::NAN;
     let uvs: [f32; 10] = [0.0, 0.0, f32::INFINITY, 0.0, 1.0, 1.0, 0.0, 1.0, 0.0, 0.0];
     let indices: [u16; 9] = [0, 1, 2, 0, 2, 3, 3, 2, 4];
     let mut buffer: Vec<u8> = positions
