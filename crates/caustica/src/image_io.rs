@@ -3,7 +3,7 @@
 
 use crate::error::{Error, Result};
 use crate::math::Vec3;
-use crate::texture::{Encoding, Image, ImageSource, Sampler, Texture};
+use crate::texture::{texel_luminance, Encoding, Image, ImageSource, Sampler, Texture};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
@@ -46,19 +46,32 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
         }
         ImageSource::Memory { bytes, .. } => pfm::is_pfm(bytes).then(|| bytes.to_vec()),
     };
-    if let Some(bytes) = pfm {
-        let (w, h, texels) = pfm::decode(&bytes, MAX_TEXTURE_PIXELS).map_err(image_error)?;
-        let texels = match encoding {
-            Encoding::Coverage => vec![Vec3::ONE; texels.len()],
-            Encoding::Mask => texels
-                .iter()
-                .map(|t| Vec3::splat(t.dot(Vec3::new(0.2126, 0.7152, 0.0722))))
-                .collect(),
-            Encoding::Bump(strength) => crate::texture::bump::normals_from_bump(w, h, &texels, strength),
-            _ => texels,
-        };
-        return Image::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()));
-    }
+    let (w, h, texels) = match pfm {
+        Some(bytes) => {
+            let (w, h, texels) = pfm::decode(&bytes, MAX_TEXTURE_PIXELS).map_err(image_error)?;
+            let texels = match encoding {
+                // No alpha channel: wholly covered, or masked by luminance.
+                Encoding::Coverage => vec![Vec3::ONE; texels.len()],
+                Encoding::Mask => texels.iter().map(|&t| Vec3::splat(texel_luminance(t))).collect(),
+                _ => texels,
+            };
+            (w, h, texels)
+        }
+        None => decode_with_image_crate(source, encoding, &image_error)?,
+    };
+    let texels = match encoding {
+        Encoding::Bump(strength) => crate::texture::bump::normals_from_bump(w, h, &texels, strength),
+        _ => texels,
+    };
+    Image::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()))
+}
+
+/// Decodes the formats the image crate reads: width, height and linear texels (rows from the top).
+fn decode_with_image_crate(
+    source: &ImageSource,
+    encoding: Encoding,
+    image_error: &dyn Fn(String) -> Error,
+) -> Result<(usize, usize, Vec<Vec3>)> {
     let decoded = match source {
         ImageSource::File(path) => {
             let reader = || -> Result<image::ImageReader<std::io::BufReader<std::fs::File>>> {
@@ -89,7 +102,7 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
         _ if encoding == Encoding::Mask => img
             .to_rgb32f()
             .pixels()
-            .map(|p| Vec3::splat(0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]))
+            .map(|p| Vec3::splat(texel_luminance(Vec3::new(p[0], p[1], p[2]))))
             .collect(),
         image::ColorType::Rgb32F | image::ColorType::Rgba32F => {
             img.to_rgb32f().pixels().map(|p| Vec3::new(p[0], p[1], p[2])).collect()
@@ -115,11 +128,7 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
             })
             .collect(),
     };
-    let texels = match encoding {
-        Encoding::Bump(strength) => crate::texture::bump::normals_from_bump(w, h, &texels, strength),
-        _ => texels,
-    };
-    Image::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()))
+    Ok((w, h, texels))
 }
 
 /// Refuses an image whose header declares more than [`MAX_TEXTURE_PIXELS`], before decoding.

@@ -219,6 +219,12 @@ impl Texture {
     }
 }
 
+/// The luminance of a linear texel (Rec. 709 weights): a grey mask's coverage, a bump map's height.
+#[inline]
+pub fn texel_luminance(t: Vec3) -> f32 {
+    t.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
 /// `x.floor()` as an integer, for |x| ≤ 2^40 (exact: the conversion truncates toward zero, and
 /// an f32 that large is whole). Without SSE4.1 `f32::floor` is a call into libm.
 #[inline(always)]

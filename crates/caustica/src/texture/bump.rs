@@ -32,7 +32,7 @@ pub fn normals_from_bump(width: usize, height: usize, texels: &[Vec3], strength:
             })
             .collect();
     }
-    let h = |x: usize, y: usize| texels[y * width + x].dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let h = |x: usize, y: usize| super::texel_luminance(texels[y * width + x]);
     let mut out = Vec::with_capacity(texels.len());
     for y in 0..height {
         let (up, down) = ((y + height - 1) % height, (y + 1) % height);
