@@ -272,10 +272,17 @@ impl Bsdf {
                 reflectance,
                 eta,
                 roughness,
+                layered,
             } => {
                 let eta = eta.max(1.0);
                 let f = fresnel_dielectric(cos_o, eta);
                 b.diffuse = wl.reflectance(clamp01(reflectance));
+                if layered {
+                    // The base's light reflected back down by the coat, again and again, and
+                    // spread over the wider cone it leaves by (radiance over η²).
+                    let inside = internal_diffuse_reflectance(eta);
+                    b.diffuse /= (Spectrum::ONE - b.diffuse * inside) * (eta * eta);
+                }
                 b.coat = eta;
                 b.pick[0] = b.diffuse.max_element() * (1.0 - f);
                 if roughness < SMOOTH_ALPHA {
@@ -763,6 +770,35 @@ pub fn fresnel_dielectric(cos_i: f32, eta: f32) -> f32 {
     0.5 * (r_parallel * r_parallel + r_perpendicular * r_perpendicular)
 }
 
+/// The share of cosine-distributed (diffuse) light inside a dielectric of relative index
+/// `eta` ≥ 1 that its smooth surface reflects back in: 1 − (1 − F̄)/η², F̄ the cosine-weighted mean
+/// of the reflectance from outside (what crosses inwards equals what crosses outwards, and
+/// inside, light beyond the critical angle is all reflected). Read from a table over η in
+/// [1, 4] built on first use.
+pub fn internal_diffuse_reflectance(eta: f32) -> f32 {
+    const STEPS: usize = 512;
+    const MAX: f32 = 4.0;
+    static TABLE: std::sync::OnceLock<Vec<f32>> = std::sync::OnceLock::new();
+    let table = TABLE.get_or_init(|| {
+        (0..=STEPS)
+            .map(|i| {
+                let eta = 1.0 + (MAX - 1.0) * i as f32 / STEPS as f32;
+                // F̄ = 2∫F(μ)μ dμ = ∫F(√s) ds over s = μ², by the midpoint rule.
+                let n = 1024;
+                let mean = (0..n)
+                    .map(|j| fresnel_dielectric(((j as f32 + 0.5) / n as f32).sqrt(), eta) as f64)
+                    .sum::<f64>()
+                    / n as f64;
+                1.0 - (1.0 - mean as f32) / (eta * eta)
+            })
+            .collect()
+    });
+    let x = ((eta.clamp(1.0, MAX) - 1.0) / (MAX - 1.0)) * STEPS as f32;
+    let i = (x as usize).min(STEPS - 1);
+    let t = x - i as f32;
+    table[i] + (table[i + 1] - table[i]) * t
+}
+
 #[cfg(test)]
 mod chi2;
 
@@ -1044,6 +1080,7 @@ mod tests {
                     reflectance: Vec3::ONE,
                     eta: 1.5,
                     roughness,
+                    layered: false,
                 };
                 let bsdf = Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &RGB);
                 let a = albedo(&bsdf, wo, 11);
@@ -1062,12 +1099,42 @@ mod tests {
                     reflectance: Vec3::ZERO,
                     eta: 1.5,
                     roughness: 0.0,
+                    layered: true,
                 };
                 if theta == 0.0 {
                     // A black base shows the coat alone: 4% at normal incidence for η 1.5.
                     let coat = albedo(&Bsdf::physical(&black, Vec3::Z, Vec3::Z, wo, &RGB), wo, 3);
                     assert!((coat - 0.04).abs() < 1e-3, "{coat}");
                 }
+            }
+        }
+    }
+
+    /// Under a layered smooth coat the base's light comes back down from the coat's underside:
+    /// the directional albedo is F(θo) + (1 − F(θo))·r(1 − F̄ᵢ)/(1 − r·F̄ᵢ), so a white base
+    /// reflects everything (the furnace shows nothing) and a grey one less than a single crossing
+    /// gives. F̄ᵢ for glass of index 1.5 is 0.596 (the published internal diffuse reflectance).
+    #[test]
+    fn layered_coat_returns_the_light_it_reflects_inside() {
+        assert_eq!(internal_diffuse_reflectance(1.0), 0.0);
+        let inside = internal_diffuse_reflectance(1.5);
+        assert!((inside - 0.596).abs() < 0.002, "{inside}");
+        for r in [1.0f32, 0.5] {
+            for theta in [0.0f32, 0.7, 1.3] {
+                let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
+                let m = PhysicalMaterial::CoatedDiffuse {
+                    reflectance: Vec3::splat(r),
+                    eta: 1.5,
+                    roughness: 0.0,
+                    layered: true,
+                };
+                let bsdf = Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &RGB);
+                let f = fresnel_dielectric(theta.cos(), 1.5);
+                let q = smooth_albedo_by_quadrature(&bsdf, wo) + f as f64;
+                let want = f + (1.0 - f) * r * (1.0 - inside) / (1.0 - r * inside);
+                assert!((q - want as f64).abs() < 2e-3, "r {r} θ {theta}: {q} vs {want}");
+                let sampled = albedo(&bsdf, wo, 13);
+                assert!((sampled - q).abs() < 0.01, "r {r} θ {theta}: sampled {sampled}, quadrature {q}");
             }
         }
     }

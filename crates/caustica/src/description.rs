@@ -328,6 +328,54 @@ pub struct MaterialDesc {
     /// Coverage of a mesh's surface (its x channel): where it is below the cutoff, or with no
     /// cutoff at random in proportion, rays and photons pass through.
     pub alpha: Option<Alpha>,
+    /// Which faces of the surface send out its `emissive` light.
+    pub emitting_faces: EmittingFaces,
+}
+
+/// The faces of a surface that emit. A face is named by the geometric normal: a triangle's
+/// `(b − a) × (c − a)`, a shape's outward normal. The course model, OBJ and glTF emit from both;
+/// pbrt's area lights from the front unless `twosided`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum EmittingFaces {
+    /// Both faces.
+    #[default]
+    Both,
+    /// The face the geometric normal points out of.
+    Front,
+    /// The other face.
+    Back,
+}
+
+impl EmittingFaces {
+    /// Whether light leaves a surface of unit geometric normal `normal` towards `dir`.
+    #[inline]
+    pub fn emit_towards(self, normal: Vec3, dir: Vec3) -> bool {
+        match self {
+            EmittingFaces::Both => true,
+            EmittingFaces::Front => normal.dot(dir) > 0.0,
+            EmittingFaces::Back => normal.dot(dir) < 0.0,
+        }
+    }
+
+    /// The sign of the normal that points out of the one emitting face; `None` for both.
+    #[inline]
+    pub fn sign(self) -> Option<f32> {
+        match self {
+            EmittingFaces::Both => None,
+            EmittingFaces::Front => Some(1.0),
+            EmittingFaces::Back => Some(-1.0),
+        }
+    }
+
+    /// How many faces emit.
+    #[inline]
+    pub fn count(self) -> f32 {
+        if self == EmittingFaces::Both {
+            2.0
+        } else {
+            1.0
+        }
+    }
 }
 
 /// How much of a surface is there: glTF's `alphaMode` MASK (a cutoff) and BLEND (none: a ray
@@ -364,6 +412,11 @@ pub enum PhysicalMaterial<P = Param> {
         eta: f32,
         /// GGX α of the coat; below 1e-3 smooth.
         roughness: f32,
+        /// Whether the coat's underside sends the base's light back down to it, again and again
+        /// (pbrt-v4's layered `coateddiffuse`): the base's albedo r counts as r / (η²(1 − r·F̄ᵢ)),
+        /// F̄ᵢ the coat's mean reflectance from inside. Otherwise light crosses the coat once
+        /// each way (glTF's Fresnel mix).
+        layered: bool,
     },
     /// Lambertian reflection and Lambertian transmission (leaves, paper, lampshades).
     DiffuseTransmission {
@@ -401,10 +454,12 @@ impl<P> PhysicalMaterial<P> {
                 reflectance,
                 eta,
                 roughness,
+                layered,
             } => PhysicalMaterial::CoatedDiffuse {
                 reflectance: f(reflectance)?,
                 eta: *eta,
                 roughness: *roughness,
+                layered: *layered,
             },
             PhysicalMaterial::DiffuseTransmission {
                 reflectance,
@@ -475,6 +530,7 @@ impl Default for MaterialDesc {
             normal_map: None,
             metallic_roughness: None,
             alpha: None,
+            emitting_faces: EmittingFaces::Both,
         }
     }
 }

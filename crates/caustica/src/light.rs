@@ -6,7 +6,7 @@
 //! the inverse square (the file's attenuation coefficients are ignored), a spot light's is the
 //! intensity on its axis; a directional light's colour is the irradiance E (W/m²) on a surface
 //! facing it, and so is a sun's, spread over its small disc; an emissive object emits radiance
-//! ke (W/m²/sr) from both faces; the environment's colour (times its map) is the radiance of
+//! ke (W/m²/sr) from both faces, or from the one its material names; the environment's colour (times its map) is the radiance of
 //! the sky. In the course model emissive objects are not light sources (their `emissive` term
 //! only colours themselves), a sun is a directional light and the environment is only seen, as
 //! the background.
@@ -680,6 +680,9 @@ pub(crate) fn visible_emission(
 ) -> Option<Spectrum> {
     let sample = &drawn.point;
     if drawn.nearest && light.uniform {
+        if !light.faces.emit_towards(sample.normal, -wi) {
+            return None;
+        }
         return scene
             .unoccluded_except(hit, wi, distance, sample.prim)
             .then(|| emission::area_radiance(light, scene, sample, wl));
@@ -690,7 +693,7 @@ pub(crate) fn visible_emission(
     if isect.prim != sample.prim || (isect.t - (sample.point - origin).length()).abs() > 1e-3 * (1.0 + distance) {
         return None;
     }
-    Some(scene.emission_spectrum(&scene.surface(&ray, &isect), wl))
+    Some(scene.emission_towards(&scene.surface(&ray, &isect), -wi, wl))
 }
 
 /// A point on an emissive object for lighting `p`, visibility included.

@@ -79,6 +79,8 @@ pub struct Material {
     pub metallic_roughness: Option<crate::description::MetallicRoughness<Channel>>,
     /// Coverage of a mesh's surface ([`crate::description::Alpha`]).
     pub alpha: Option<crate::description::Alpha<Channel>>,
+    /// Which faces send out `emissive`.
+    pub emitting_faces: crate::description::EmittingFaces,
 }
 
 /// A material's constant colours as fitted smooth spectra (for spectral transport); `None`
@@ -299,6 +301,7 @@ impl Material {
                     reflectance: base,
                     eta,
                     roughness: alpha,
+                    layered: false,
                 })
             };
         }

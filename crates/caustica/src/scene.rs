@@ -9,7 +9,8 @@ pub use build::{build, BuildSettings};
 use crate::accel::bvh::{Bvh, TriangleBvh, TriangleBvhHit};
 use crate::camera::Camera;
 use crate::geometry::triangle::Triangle;
-use crate::geometry::Shape;
+use crate::description::EmittingFaces;
+use crate::geometry::{Shape, ShapeKind};
 use crate::light::{Light, LightSet};
 use crate::material::{Lobes, Material, MaterialRef, MaterialSpectra, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
@@ -369,7 +370,37 @@ impl Scene {
         }
     }
 
-    /// The emitted radiance at a surface point at the wavelengths `wl`.
+    /// The radiance a surface point emits towards `wo` at the wavelengths `wl`: zero out of a
+    /// face that does not emit.
+    #[inline]
+    pub fn emission_towards(&self, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Spectrum {
+        let id = match hit.material {
+            MaterialRef::One(id) => id,
+            MaterialRef::Blend { ids, .. } => ids[0],
+        };
+        let faces = self.materials[id as usize].emitting_faces;
+        if faces != EmittingFaces::Both && !faces.emit_towards(self.front_normal(hit), wo) {
+            return Spectrum::ZERO;
+        }
+        self.emission_spectrum(hit, wl)
+    }
+
+    /// The normal that names a hit's front face: the geometric normal, except on a disk or
+    /// square, whose hits face the ray and whose front is their object-space +z.
+    fn front_normal(&self, hit: &SurfaceHit) -> Vec3 {
+        match hit.object {
+            ObjectRef::Shape(i) => {
+                let shape = &self.shapes[i as usize];
+                match shape.kind {
+                    ShapeKind::Disk { .. } | ShapeKind::Square => shape.world_normal(Vec3::Z),
+                    _ => hit.geometric_normal,
+                }
+            }
+            ObjectRef::Mesh(_) => hit.geometric_normal,
+        }
+    }
+
+    /// The emitted radiance at a surface point at the wavelengths `wl`, from either face.
     pub fn emission_spectrum(&self, hit: &SurfaceHit, wl: &Wavelengths) -> Spectrum {
         let le = self.emission(hit).max(Vec3::ZERO);
         match (wl.is_spectral(), hit.material) {

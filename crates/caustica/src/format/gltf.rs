@@ -975,6 +975,7 @@ impl Reader<'_, '_> {
                     reflectance: base,
                     eta: ior,
                     roughness: alpha,
+                    layered: false,
                 });
                 let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2) * specular.min(1.0);
                 if alpha < 1e-3 {

@@ -11,6 +11,7 @@
 //! and reading goes on; malformed input is an error.
 
 mod lexer;
+mod orientation;
 mod params;
 mod spectra;
 #[cfg(test)]
@@ -948,7 +949,7 @@ impl<'f> Reader<'f> {
                 let base = self.colour(params, "reflectance", Vec3::splat(0.5))?;
                 let alpha = self.roughness(params, span, 0.0)?;
                 let eta = self.float_slot(params, "eta", 1.5)?.max(1.0);
-                coated(base, eta, alpha)
+                coated(base, eta, alpha, true)
             }
             "matte" | "plastic" | "substrate" | "mirror" | "uber" | "translucent" => {
                 self.v3_material(kind, params, span)?
@@ -1039,7 +1040,7 @@ impl<'f> Reader<'f> {
                         "plastic is read as a diffuse base under a clear coat of index 1.5: Ks does not scale its highlight",
                         span.clone(),
                     );
-                    coated(base, 1.5, alpha)
+                    coated(base, 1.5, alpha, false)
                 }
             }
             // Ashikhmin–Shirley: a base under a coat whose normal reflectance is Ks.
@@ -1053,7 +1054,7 @@ impl<'f> Reader<'f> {
                     }
                 };
                 let alpha = self.roughness(params, span, 0.1)?;
-                coated(base, (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()), alpha)
+                coated(base, (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()), alpha, false)
             }
             "mirror" => {
                 let kr = self.colour(params, "Kr", Vec3::splat(0.9))?;
@@ -1084,7 +1085,7 @@ impl<'f> Reader<'f> {
                 } else if ks == black {
                     diffuse(kd)
                 } else {
-                    coated(kd, index.max(1.0), alpha)
+                    coated(kd, index.max(1.0), alpha, false)
                 };
                 self.warn_once(
                     "uber",
@@ -1660,7 +1661,14 @@ impl<'f> Reader<'f> {
                 return Ok(());
             }
         };
-        for (shape, world_from_object) in shapes {
+        let one_sided = self.state.area_light.as_ref().is_some_and(|l| !l.twosided);
+        for (mut shape, world_from_object) in shapes {
+            let front = orientation::orient(
+                &mut shape,
+                &world_from_object,
+                self.state.reverse_orientation,
+                one_sided,
+            );
             let mut material = material.clone();
             if alpha.is_some() {
                 material.alpha = alpha.clone();
@@ -1674,11 +1682,7 @@ impl<'f> Reader<'f> {
                         power / (sides * std::f32::consts::PI * area * luminance(radiance).max(1e-9)).max(1e-12);
                 }
                 if !light.twosided {
-                    self.warn_once(
-                        "onesided",
-                        "caustica's area lights emit from both faces; pbrt's one-sided ones only along the normal",
-                        span.clone(),
-                    );
+                    material.emitting_faces = front;
                 }
                 if self.defining.is_some() {
                     self.warn_once(
@@ -1823,14 +1827,17 @@ fn diffuse_transmission(r: Param, t: Param) -> MaterialDesc {
     }
 }
 
-/// A base of reflectance `base` under a clear coat of index `eta` and GGX α.
-fn coated(base: Param, eta: f32, alpha: f32) -> MaterialDesc {
+/// A base of reflectance `base` under a clear coat of index `eta` and GGX α; `layered`: light
+/// reflected inside the coat goes back to the base (pbrt-v4), not out of the picture (pbrt-v3's
+/// plastic and substrate add their lobes).
+fn coated(base: Param, eta: f32, alpha: f32, layered: bool) -> MaterialDesc {
     let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
     let mut m = diffuse(base.clone());
     m.physical = Some(PhysicalMaterial::CoatedDiffuse {
         reflectance: base,
         eta,
         roughness: alpha,
+        layered,
     });
     course_gloss(&mut m, Vec3::splat(f0), alpha);
     m

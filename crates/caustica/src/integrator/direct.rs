@@ -38,10 +38,10 @@ pub fn direct_light(
     l
 }
 
-/// Emitted radiance of a surface towards any direction (two-sided), at the wavelengths `wl`.
+/// Emitted radiance of a surface towards `wo`, at the wavelengths `wl`.
 #[inline]
-pub fn emitted(scene: &Scene, hit: &SurfaceHit, wl: &Wavelengths) -> Spectrum {
-    scene.emission_spectrum(hit, wl)
+pub fn emitted(scene: &Scene, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Spectrum {
+    scene.emission_towards(hit, wo, wl)
 }
 
 /// Whether BSDF samples can reach light at all: only emissive objects and the sky can be hit
@@ -62,7 +62,7 @@ pub fn direct_by_bsdf(scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample, wl: 
         None => lights.escaped_weighted(sample.wi, Some(sample.pdf), wl),
         Some(isect) => {
             let reached = scene.surface(&ray, &isect);
-            let le = emitted(scene, &reached, wl);
+            let le = emitted(scene, &reached, -sample.wi, wl);
             if le == Spectrum::ZERO {
                 return Spectrum::ZERO;
             }

@@ -205,7 +205,7 @@ impl<'a> Gi<'a> {
             segment += isect.t;
             let wo = -ray.dir;
             if let Some((point, pdf)) = direct_from.take() {
-                let le = emitted(scene, &hit, wl);
+                let le = emitted(scene, &hit, wo, wl);
                 if le != Spectrum::ZERO {
                     emitted_first = le * power_heuristic(pdf, lights.pdf_direct(point, &hit));
                 }

@@ -3,9 +3,10 @@
 //! pixel the point projects to. No kernel and no radius: the image is unbiased, and sharp where
 //! photon mapping blurs (the focus of a caustic), but noisy where little light reaches the eye.
 //!
+//! A light with an area is seen directly: each photon's starting point is joined to the eye.
 //! The camera is a pinhole, so a camera ray can never be continued from a photon path: mirrors
-//! and glass seen by the camera are black (as in `--no-camera-specular`), and so are lights seen
-//! directly. What lies behind or beyond them, seen by a photon, is not.
+//! and glass seen by the camera are black (as in `--no-camera-specular`), and so are point
+//! lights. What lies behind or beyond them, seen by a photon, is not.
 //!
 //! Determinism: a pass emits its photons in fixed batches; each batch records its splats and the
 //! batches are added to the film in index order, so the thread count never changes the image.
@@ -14,7 +15,8 @@ use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::Progressive;
 use crate::bsdf::{adjoint_correction, Bsdf, Transport};
 use crate::camera::Camera;
-use crate::math::{Ray, Vec3};
+use crate::light::emission::EmissionPoint;
+use crate::math::{offset_origin, Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
@@ -185,7 +187,16 @@ impl<'a> LightTracer<'a> {
         let Some(emitted) = scene.lights().emit(scene, wl, &mut rng) else {
             return;
         };
-        let mut power = emitted.flux * (1.0 / self.settings.photons_per_pass as f32);
+        let share = 1.0 / self.settings.photons_per_pass as f32;
+        if let Some(origin) = &emitted.origin {
+            if let Some((pixel, value)) = self.connect_light(origin, share) {
+                let rgb = wl.to_rgb(value);
+                if rgb.is_finite() {
+                    out.push((pixel as u32, rgb));
+                }
+            }
+        }
+        let mut power = emitted.flux * share;
         let mut ray = emitted.ray;
         let mut dispersed = false;
         for _ in 0..=self.settings.max_depth {
@@ -246,6 +257,24 @@ impl<'a> LightTracer<'a> {
         }
         let g = cos / (s.distance * s.distance);
         Some((s.pixel, power * f * (g * s.importance)))
+    }
+}
+
+impl LightTracer<'_> {
+    /// The pixel the light's own point `origin` shows in, and what it adds there (the light seen
+    /// directly): L/p(x) · |cos θ| / r² · We, times this photon's `share` of the pass.
+    fn connect_light(&self, origin: &EmissionPoint, share: f32) -> Option<(usize, Spectrum)> {
+        let s = self.sensor.sample(origin.point)?;
+        if !origin.faces.emit_towards(origin.normal, s.to_eye) {
+            return None;
+        }
+        let ray = Ray::new(offset_origin(origin.point, origin.normal, s.to_eye), s.to_eye);
+        let t_max = (s.distance - (ray.origin - origin.point).length()) * (1.0 - 1e-5);
+        if self.scene.any_hit(&ray, t_max, |_| true) {
+            return None;
+        }
+        let g = origin.normal.dot(s.to_eye).abs() / (s.distance * s.distance);
+        Some((s.pixel, origin.radiance * (share * g * s.importance)))
     }
 }
 

@@ -60,7 +60,7 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengt
         };
         let hit = scene.surface(&ray, &isect);
         let wo = -ray.dir;
-        let le = emitted(scene, &hit, wl);
+        let le = emitted(scene, &hit, wo, wl);
         if le != Spectrum::ZERO {
             let weight = if specular {
                 1.0

@@ -64,7 +64,7 @@ where
         let wo = -ray.dir;
         // Only the camera and specular chains reach here: emission counts in full.
         if !past_highlight {
-            l += beta * super::direct::emitted(scene, &hit, wl);
+            l += beta * super::direct::emitted(scene, &hit, wo, wl);
         }
         let bsdf = Bsdf::at(scene, &hit, wo, wl);
         if bsdf.is_black() {

@@ -941,7 +941,7 @@ impl<'a> Vcm<'a> {
             let bsdf = Bsdf::at(scene, &hit, wo, wl);
             let cos_in = bsdf.normal().dot(wo).abs();
             partial.arrive(d2, cos_in);
-            let le = scene.emission_spectrum(&hit, wl);
+            let le = scene.emission_towards(&hit, wo, wl);
             if le != Spectrum::ZERO {
                 without_last_merge.arrive(d2, cos_in);
                 l += throughput * le * self.emitter_weight(&hit, &without_last_merge, previous, wo, d2, length);

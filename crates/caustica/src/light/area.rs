@@ -6,9 +6,11 @@
 //! transform. The world-space area density then follows from the transform alone: a linear map
 //! M scales an area element with unit normal n_w by |det M| / |Mᵀ n_w|, so
 //! p(x) = |Mᵀ n_w| / (A_object · |det M|) for every shape kind, under any scale or shear.
-//! A mesh picks a triangle by area, then a uniform point in it. Emission is two-sided, like the
-//! `emissive` term of the course shading: the light leaves both faces with radiance ke.
+//! A mesh picks a triangle by area, then a uniform point in it. Light leaves with radiance ke by
+//! the faces the material names: both, like the `emissive` term of the course shading, or one
+//! (pbrt's one-sided area lights).
 
+use crate::description::EmittingFaces;
 use crate::geometry::cone::Cone;
 use crate::geometry::ShapeKind;
 use crate::math::{Mat3, Vec2, Vec3};
@@ -61,9 +63,10 @@ pub struct AreaLight {
     /// Centre and radius of a sphere under a similarity transform: seen from outside it is
     /// sampled by the cone of directions it subtends (no sample wasted on its far side).
     sphere: Option<(Vec3, f32)>,
-    /// A closed convex lamp that absorbs all light and holds nothing: what it emits inwards
-    /// dies on its own inside, so photons leave it outwards only.
-    pub outward_only: bool,
+    /// The faces light leaves by: the material's, or only the outer one of a closed convex
+    /// lamp that absorbs all light and holds nothing (what it emits inwards dies on its own
+    /// inside).
+    pub faces: EmittingFaces,
 }
 
 /// A point on a light sampled for a shading point, with the density in solid angle there.
@@ -124,7 +127,8 @@ impl AreaLight {
             ]
             .iter()
             .all(|c| !c.may_be_nonzero());
-            let outward_only = closed
+            let outward_only = material.emitting_faces == EmittingFaces::Both
+                && closed
                 && absorbs
                 && scene
                     .occluders_near(
@@ -140,7 +144,11 @@ impl AreaLight {
                 area,
                 sampler,
                 sphere,
-                outward_only,
+                faces: if outward_only {
+                    EmittingFaces::Front
+                } else {
+                    material.emitting_faces
+                },
             });
         }
         // Triangles by mesh, gathered in one pass over the scene's triangles.
@@ -190,7 +198,7 @@ impl AreaLight {
                 area,
                 sampler: Sampler::Mesh { triangles, cdf, area },
                 sphere: None,
-                outward_only: false,
+                faces: scene.materials()[mesh.material as usize].emitting_faces,
             });
         }
         lights
@@ -199,8 +207,7 @@ impl AreaLight {
     /// Emitted power (luminance) guess, π·A·L from each face that emits usefully, used to
     /// share samples.
     pub fn power(&self) -> f32 {
-        let faces = if self.outward_only { 1.0 } else { 2.0 };
-        faces * PI * self.area * crate::math::luminance(self.radiance).max(0.0)
+        self.faces.count() * PI * self.area * crate::math::luminance(self.radiance).max(0.0)
     }
 
     /// Centre and radius of a sphere lamp under a similarity transform (sampled uniformly by

@@ -15,6 +15,7 @@
 
 use super::area::{AreaLight, AreaSample};
 use super::{spot_profile, Light, LightSet};
+use crate::description::EmittingFaces;
 use crate::math::{luminance, offset_origin, Aabb, Frame, Ray, Vec2, Vec3};
 use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, Rng};
 use crate::scene::{ObjectRef, Scene};
@@ -361,7 +362,7 @@ impl Emitter {
             }
             Kind::Area | Kind::Soft { .. } => return None,
         };
-        Some(EmittedPhoton { ray, flux })
+        Some(EmittedPhoton { ray, flux, origin: None })
     }
 
     fn pick(&self, u: f32) -> usize {
@@ -467,6 +468,22 @@ pub struct EmittedPhoton {
     pub ray: Ray,
     /// Flux at the wavelengths it was emitted for (RGB in RGB mode).
     pub flux: Spectrum,
+    /// The surface point it left, when it left one (a light with an area), for the light tracer
+    /// to show the light itself.
+    pub origin: Option<EmissionPoint>,
+}
+
+/// A sampled point on an emitting surface.
+#[derive(Clone, Copy, Debug)]
+pub struct EmissionPoint {
+    /// World position.
+    pub point: Vec3,
+    /// Unit geometric normal, naming its faces.
+    pub normal: Vec3,
+    /// The faces light leaves by.
+    pub faces: EmittingFaces,
+    /// Emitted radiance over the density of the point (area density × the light's choice).
+    pub radiance: Spectrum,
 }
 
 impl LightSet {
@@ -479,6 +496,10 @@ impl LightSet {
         Some(EmittedPhoton {
             ray: photon.ray,
             flux: photon.flux / p_pick,
+            origin: photon.origin.map(|o| EmissionPoint {
+                radiance: o.radiance / p_pick,
+                ..o
+            }),
         })
     }
 }
@@ -492,15 +513,9 @@ fn emit_from_area(
 ) -> Option<EmittedPhoton> {
     let sample = light.sample(scene, u_pick, u)?;
     let le = area_radiance(light, scene, &sample, wl);
-    // A face at random (the outer one of a closed lamp that absorbs its own inward light), then
-    // a cosine-weighted direction: pdf ½·cos/π, or cos/π.
-    let (side, u2, faces) = if light.outward_only {
-        (1.0, u_dir, 1.0)
-    } else if u_dir.x < 0.5 {
-        (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y), 2.0)
-    } else {
-        (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y), 2.0)
-    };
+    // A face at random, or the one that emits, then a cosine-weighted direction: pdf ½·cos/π,
+    // or cos/π.
+    let (side, u2) = emitting_side(light, u_dir);
     let normal = sample.normal * side;
     let dir = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2));
     if dir.dot(normal) <= 0.0 {
@@ -508,8 +523,24 @@ fn emit_from_area(
     }
     Some(EmittedPhoton {
         ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
-        flux: le * (faces * PI / sample.pdf_area),
+        flux: le * (light.faces.count() * PI / sample.pdf_area),
+        origin: Some(EmissionPoint {
+            point: sample.point,
+            normal: sample.normal,
+            faces: light.faces,
+            radiance: le / sample.pdf_area,
+        }),
     })
+}
+
+/// The sign of the normal a cosine-weighted emission leaves along, and the direction's own
+/// random pair: the one emitting face, or either face with the first number split between them.
+pub(crate) fn emitting_side(light: &AreaLight, u: Vec2) -> (f32, Vec2) {
+    match light.faces.sign() {
+        Some(side) => (side, u),
+        None if u.x < 0.5 => (1.0, Vec2::new(u.x * 2.0, u.y)),
+        None => (-1.0, Vec2::new(u.x * 2.0 - 1.0, u.y)),
+    }
 }
 
 /// A photon from a light with a size: a point uniform on it, then a direction cosine-weighted
@@ -560,6 +591,12 @@ fn emit_from_soft(
     Some(EmittedPhoton {
         ray: Ray::new(s.point, dir),
         flux: wl.unbounded(s.radiance) * (cos * light.area() / pdf),
+        origin: Some(EmissionPoint {
+            point: s.point,
+            normal: s.normal,
+            faces: EmittingFaces::Front,
+            radiance: wl.unbounded(s.radiance) * light.area(),
+        }),
     })
 }
 
@@ -712,7 +749,12 @@ mod tests {
         ] {
             let s = scene(&objects);
             let lights = s.lights();
-            assert_eq!(lights.area_lights().next().unwrap().outward_only, outward, "{objects}");
+            let faces_emitting = if outward {
+                crate::description::EmittingFaces::Front
+            } else {
+                crate::description::EmittingFaces::Both
+            };
+            assert_eq!(lights.area_lights().next().unwrap().faces, faces_emitting, "{objects}");
             let mut rng = Rng::new(3, 0);
             let n = 100_000;
             let mut sum = 0.0f64;

@@ -505,6 +505,7 @@ impl Builder {
                 },
                 None => None,
             },
+            emitting_faces: desc.emitting_faces,
         };
         let key = MaterialKey(
             [
@@ -525,8 +526,12 @@ impl Builder {
             .chain([material.abbe.map_or(0, f32::to_bits)])
             .chain(
                 format!(
-                    "{:?} {:?} {:?} {:?}",
-                    material.physical, material.normal_map, material.metallic_roughness, material.alpha
+                    "{:?} {:?} {:?} {:?} {:?}",
+                    material.physical,
+                    material.normal_map,
+                    material.metallic_roughness,
+                    material.alpha,
+                    material.emitting_faces
                 )
                 .bytes()
                 .map(u32::from),

@@ -75,7 +75,7 @@ fn furnace_gi() {
 
 /// `--depth` N means one thing in every integrator: light reaches the eye after scattering at
 /// no more than N + 1 surfaces. Inside the furnace that is Le·(1 + a + … + a^(N+1)), which
-/// `path`, `ppm`, `gi` and `lt` (which cannot see the emitter itself, so lacks the first Le)
+/// `path`, `ppm`, `gi` and `lt` (the emitter itself seen by connecting its point to the eye)
 /// must each give at depths 0, 1 and 2, rendered through the options as the command line
 /// builds them. Were the path tracer's limit `--depth` surfaces rather than
 /// [`scattering_surfaces`] it would be a term short: 1·Le instead of 1.5·Le at depth 0,
@@ -86,12 +86,12 @@ fn depth_counts_the_same_bounces_in_every_integrator() {
     let le = Vec3::new(1.0, 0.5, 0.25);
     for depth in [0u32, 1, 2] {
         assert_eq!(scattering_surfaces(depth), depth + 1);
-        let terms = |from: u32| (from..=depth + 1).map(|k| 0.5f32.powi(k as i32)).sum::<f32>();
+        let terms = (0..=depth + 1).map(|k| 0.5f32.powi(k as i32)).sum::<f32>();
         for (kind, passes, expected) in [
-            (IntegratorKind::Path, 48, le * terms(0)),
-            (IntegratorKind::Ppm, 8, le * terms(0)),
-            (IntegratorKind::Gi, 8, le * terms(0)),
-            (IntegratorKind::Lt, 8, le * terms(1)),
+            (IntegratorKind::Path, 48, le * terms),
+            (IntegratorKind::Ppm, 8, le * terms),
+            (IntegratorKind::Gi, 8, le * terms),
+            (IntegratorKind::Lt, 8, le * terms),
         ] {
             let config = RenderConfig {
                 model: Some(Model::Physical),

@@ -486,8 +486,9 @@ fn a_metallic_roughness_texture_decides_metal_and_roughness_point_by_point() {
             reflectance,
             eta,
             roughness,
+            layered,
         }) => {
-            assert_eq!((reflectance, eta), (base, 1.5));
+            assert_eq!((reflectance, eta, layered), (base, 1.5, false));
             assert!((roughness - alpha(200)).abs() < 1e-6, "{roughness}");
         }
         other => panic!("a dielectric point: {other:?}"),

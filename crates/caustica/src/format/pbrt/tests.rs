@@ -1,4 +1,5 @@
 use super::*;
+use crate::description::EmittingFaces;
 use crate::error::Error;
 use crate::progress::NoProgress;
 
@@ -173,8 +174,9 @@ fn pbrt_v3_materials_are_read() {
             eta,
             roughness,
             reflectance,
+            layered,
         }) => {
-            assert_eq!((*eta, *reflectance == Param::grey(0.5)), (1.5, true));
+            assert_eq!((*eta, *reflectance == Param::grey(0.5), *layered), (1.5, true, false));
             assert!((roughness - 0.2).abs() < 1e-6, "remapped √0.04: {roughness}");
         }
         other => panic!("plastic: {other:?}"),
@@ -343,4 +345,57 @@ fn included_files_name_themselves_in_errors() {
     assert_eq!(path, dir.join("main.pbrt"));
     assert_eq!(error.span.start, 19);
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// One-sided area lights emit from pbrt's front: a mesh's given normals (turned by
+/// `ReverseOrientation`), else its world winding turned by `ReverseOrientation` or a mirroring
+/// transform (one of them, not both); a shape's outward normal under the same rule.
+#[test]
+fn one_sided_lights_face_pbrt_front() {
+    // A triangle wound towards +z; `normals` appends its normals, `before` goes before it.
+    let light = |before: &str, normals: &str, twosided: bool| {
+        let body = format!(
+            "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1] \"bool twosided\" {twosided}\n{before}\n\
+             Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 2] {normals}\nAttributeEnd"
+        );
+        let desc = scene(&body);
+        let object = &desc.objects[0];
+        let ShapeDesc::Trimesh(mesh) = &object.shape else {
+            panic!()
+        };
+        let [a, b, c] = mesh.triangles[0].map(|i| object.world_from_object.transform_point3(mesh.points[i as usize]));
+        ((b - a).cross(c - a).normalize(), object.material.emitting_faces)
+    };
+    let down = "\"normal N\" [0 0 -1 0 0 -1 0 0 -1]";
+    let cases: [(&str, &str, Vec3); 6] = [
+        ("", "", Vec3::Z),
+        ("ReverseOrientation", "", -Vec3::Z),
+        ("Scale 1 -1 1", "", Vec3::Z),
+        ("ReverseOrientation Scale 1 -1 1", "", -Vec3::Z),
+        ("", down, -Vec3::Z),
+        ("ReverseOrientation", down, Vec3::Z),
+    ];
+    for (before, normals, front) in cases {
+        let (winding, faces) = light(before, normals, false);
+        assert_eq!(faces, EmittingFaces::Front, "{before} {normals}");
+        assert!((winding - front).length() < 1e-6, "{before} {normals}: wound to {winding}");
+    }
+    let (winding, faces) = light("ReverseOrientation", "", true);
+    assert_eq!((winding, faces), (Vec3::Z, EmittingFaces::Both), "two-sided: left as wound");
+    let sphere = |before: &str| {
+        scene(&format!(
+            "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n{before}\nShape \"sphere\"\nAttributeEnd"
+        ))
+        .objects[0]
+            .material
+            .emitting_faces
+    };
+    assert_eq!(sphere(""), EmittingFaces::Front);
+    assert_eq!(sphere("ReverseOrientation"), EmittingFaces::Back);
+    assert_eq!(sphere("Scale -1 1 1"), EmittingFaces::Back);
+    assert_eq!(
+        scene("Shape \"sphere\"").objects[0].material.emitting_faces,
+        EmittingFaces::Both,
+        "no light"
+    );
 }

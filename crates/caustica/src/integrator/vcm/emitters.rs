@@ -15,7 +15,7 @@
 //! below is the mixture's, for the subpath's throughput and for every strategy's weight alike,
 //! so aiming changes where the samples go (many more caustic paths), never the expected image.
 
-use crate::light::emission::{area_radiance, Target};
+use crate::light::emission::{area_radiance, emitting_side, Target};
 use crate::light::{spot_profile, AreaLight, Light, LightSet};
 use crate::math::{offset_origin, Frame, Ray, Vec3};
 use crate::sampling::{
@@ -532,23 +532,17 @@ impl Emitters {
                             }
                             None => aim.sample(sample.point, u_pick, u_aim)?,
                         };
-                        // Leaves by the face it points out of (a closed lamp only by its outer one).
+                        // Leaves by the face it points out of, if that face emits.
                         let side = if dir.dot(sample.normal) >= 0.0 { 1.0 } else { -1.0 };
-                        if light.outward_only && side < 0.0 {
+                        if light.faces.sign().is_some_and(|s| s != side) {
                             return None;
                         }
                         (dir, sample.normal * side)
                     }
                     None => {
-                        // A face at random (only the outer one of a closed lamp), then a
-                        // cosine-weighted direction.
-                        let (side, u2) = if light.outward_only {
-                            (1.0, u_dir)
-                        } else if u_dir.x < 0.5 {
-                            (1.0, Vec2::new(u_dir.x * 2.0, u_dir.y))
-                        } else {
-                            (-1.0, Vec2::new(u_dir.x * 2.0 - 1.0, u_dir.y))
-                        };
+                        // A face at random, or the one that emits, then a cosine-weighted
+                        // direction.
+                        let (side, u2) = emitting_side(light, u_dir);
                         let normal = sample.normal * side;
                         (
                             Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2)),
@@ -558,7 +552,7 @@ impl Emitters {
                 };
                 let le = area_radiance(light, scene, &sample, wl);
                 let cos = dir.dot(normal);
-                let plain = cos / (PI * faces(light));
+                let plain = cos / (PI * light.faces.count());
                 let pdf = pick * self.start_pdf(light, sample.point, sample.normal, dir, plain);
                 (cos > 0.0 && pdf > 0.0).then(|| Emission {
                     ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
@@ -692,11 +686,10 @@ impl Emitters {
     /// Emission's density (point × direction, choice included) of leaving emissive object
     /// `light` (number `number`) at `point`, of unit normal `normal`, in direction `dir`.
     pub fn emission_pdf(&self, number: usize, light: &AreaLight, point: Vec3, normal: Vec3, dir: Vec3) -> f32 {
-        let cos = normal.dot(dir);
-        if light.outward_only && cos <= 0.0 {
+        if !light.faces.emit_towards(normal, dir) {
             return 0.0;
         }
-        let plain = cos.abs() / (PI * faces(light));
+        let plain = normal.dot(dir).abs() / (PI * light.faces.count());
         self.probability[number] * self.start_pdf(light, point, normal, dir, plain)
     }
 
@@ -834,15 +827,6 @@ impl Emitters {
                 })
             }
         }
-    }
-}
-
-/// How many faces of an emissive object emit.
-fn faces(light: &AreaLight) -> f32 {
-    if light.outward_only {
-        1.0
-    } else {
-        2.0
     }
 }
 
