@@ -1134,7 +1134,10 @@ mod tests {
                 let want = f + (1.0 - f) * r * (1.0 - inside) / (1.0 - r * inside);
                 assert!((q - want as f64).abs() < 2e-3, "r {r} θ {theta}: {q} vs {want}");
                 let sampled = albedo(&bsdf, wo, 13);
-                assert!((sampled - q).abs() < 0.01, "r {r} θ {theta}: sampled {sampled}, quadrature {q}");
+                assert!(
+                    (sampled - q).abs() < 0.01,
+                    "r {r} θ {theta}: sampled {sampled}, quadrature {q}"
+                );
             }
         }
     }

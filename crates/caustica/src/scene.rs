@@ -8,8 +8,8 @@ pub use build::{build, BuildSettings};
 
 use crate::accel::bvh::{Bvh, TriangleBvh, TriangleBvhHit};
 use crate::camera::Camera;
-use crate::geometry::triangle::Triangle;
 use crate::description::EmittingFaces;
+use crate::geometry::triangle::Triangle;
 use crate::geometry::{Shape, ShapeKind};
 use crate::light::{Light, LightSet};
 use crate::material::{Lobes, Material, MaterialRef, MaterialSpectra, SurfaceParams};

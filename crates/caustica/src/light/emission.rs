@@ -362,7 +362,11 @@ impl Emitter {
             }
             Kind::Area | Kind::Soft { .. } => return None,
         };
-        Some(EmittedPhoton { ray, flux, origin: None })
+        Some(EmittedPhoton {
+            ray,
+            flux,
+            origin: None,
+        })
     }
 
     fn pick(&self, u: f32) -> usize {

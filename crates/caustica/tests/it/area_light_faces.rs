@@ -132,7 +132,10 @@ fn one_sided_lights_emit_from_their_front_in_every_integrator() {
             100.0 * tol
         );
         if worst.is_nan() || worst >= tol {
-            failures.push(format!("{integrator}: the floor under the light is off by {:.2}%", 100.0 * worst));
+            failures.push(format!(
+                "{integrator}: the floor under the light is off by {:.2}%",
+                100.0 * worst
+            ));
         }
         if back > 1e-4 {
             failures.push(format!("{integrator}: the light's back is seen lit ({back})"));

@@ -17,6 +17,7 @@ mod corpus;
 mod corpus_render;
 mod density_estimate;
 mod extensions;
+mod field_scenes;
 mod formats;
 mod layers;
 mod light_tracing;

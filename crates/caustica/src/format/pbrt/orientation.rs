@@ -37,7 +37,11 @@ pub(super) fn orient(shape: &mut ShapeDesc, world_from_object: &Mat4, reverse: b
 /// round when `turn`.
 fn wind_to_front(mesh: &mut TrimeshDesc, world_from_object: &Mat4, turn: bool) {
     let normal_to_world = Mat3::from_mat4(*world_from_object).inverse().transpose();
-    let points: Vec<_> = mesh.points.iter().map(|&p| world_from_object.transform_point3(p)).collect();
+    let points: Vec<_> = mesh
+        .points
+        .iter()
+        .map(|&p| world_from_object.transform_point3(p))
+        .collect();
     for triangle in &mut mesh.triangles {
         let [a, b, c] = triangle.map(|i| points[i as usize]);
         let winding = (b - a).cross(c - a);

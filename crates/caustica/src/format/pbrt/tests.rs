@@ -378,10 +378,17 @@ fn one_sided_lights_face_pbrt_front() {
     for (before, normals, front) in cases {
         let (winding, faces) = light(before, normals, false);
         assert_eq!(faces, EmittingFaces::Front, "{before} {normals}");
-        assert!((winding - front).length() < 1e-6, "{before} {normals}: wound to {winding}");
+        assert!(
+            (winding - front).length() < 1e-6,
+            "{before} {normals}: wound to {winding}"
+        );
     }
     let (winding, faces) = light("ReverseOrientation", "", true);
-    assert_eq!((winding, faces), (Vec3::Z, EmittingFaces::Both), "two-sided: left as wound");
+    assert_eq!(
+        (winding, faces),
+        (Vec3::Z, EmittingFaces::Both),
+        "two-sided: left as wound"
+    );
     let sphere = |before: &str| {
         scene(&format!(
             "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 1 1]\n{before}\nShape \"sphere\"\nAttributeEnd"
