@@ -25,6 +25,22 @@ pub fn render_with(scene: &Scene, config: &caustica::integrator::RenderConfig) -
     session.image()
 }
 
+/// `scene` rendered square at `size` with `integrator`, `passes` passes and `photons` photons
+/// (or light paths) a pass, from `seed`.
+pub fn render_integrator(scene: &Scene, integrator: &str, size: usize, passes: u64, photons: usize, seed: u64) -> Film {
+    let config = caustica::integrator::RenderConfig {
+        integrator: Some(integrator.parse().unwrap()),
+        width: size,
+        height: Some(size),
+        passes: Some(passes.to_string()),
+        photons,
+        light_paths: Some(photons as u64),
+        seed,
+        ..caustica::integrator::RenderConfig::default()
+    };
+    render_with(scene, &config)
+}
+
 /// A control that reports nowhere and is never cancelled.
 pub fn control() -> Control<'static> {
     Control {

@@ -3,9 +3,8 @@
 //! closed form of a disk's view factor, and the camera sees its dark back; turned round, the
 //! floor stays black and the camera sees its lit face.
 
-use crate::common::{rel, render_with};
+use crate::common::{rel, render_integrator};
 use caustica::film::Film;
-use caustica::integrator::RenderConfig;
 use caustica::loader::{load, LoadSettings};
 use caustica::scene::Scene;
 use std::path::PathBuf;
@@ -43,17 +42,7 @@ AttributeEnd
 }
 
 fn render(scene: &Scene, integrator: &str, passes: u64, photons: usize) -> Film {
-    let config = RenderConfig {
-        integrator: Some(integrator.parse().unwrap()),
-        width: SIZE,
-        height: Some(SIZE),
-        passes: Some(passes.to_string()),
-        photons,
-        light_paths: Some(photons as u64),
-        seed: 7,
-        ..RenderConfig::default()
-    };
-    render_with(scene, &config)
+    render_integrator(scene, integrator, SIZE, passes, photons, 7)
 }
 
 /// Radiance of a floor point at distance `r` from the axis under the disk facing down: ρ·L·F,

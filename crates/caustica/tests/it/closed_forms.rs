@@ -4,9 +4,8 @@
 //! image (a caustic). `path` has no way to the light through the mirror (a point light seen in
 //! a mirror is a delta lobe on a delta light), so it sits that one out.
 
-use crate::common::{rel, render_with, scene};
+use crate::common::{rel, render_integrator, scene};
 use caustica::film::Film;
-use caustica::integrator::RenderConfig;
 use caustica::math::Vec3;
 use caustica::scene::Scene;
 use std::f32::consts::PI;
@@ -14,17 +13,7 @@ use std::f32::consts::PI;
 const SIZE: usize = 32;
 
 fn render(scene: &Scene, integrator: &str, passes: u64, photons: usize) -> Film {
-    let config = RenderConfig {
-        integrator: Some(integrator.parse().unwrap()),
-        width: SIZE,
-        height: Some(SIZE),
-        passes: Some(passes.to_string()),
-        photons,
-        light_paths: Some(photons as u64),
-        seed: 5,
-        ..RenderConfig::default()
-    };
-    render_with(scene, &config)
+    render_integrator(scene, integrator, SIZE, passes, photons, 5)
 }
 
 /// A white Lambertian sphere in a constant sky of radiance L reflects exactly L.
