@@ -11,10 +11,15 @@
 //! only colours themselves), a sun is a directional light and the environment is only seen, as
 //! the background.
 //!
-//! Photon emission is in [`emission`]; emissive objects are sampled by [`area`], the sky by
-//! [`environment`].
+//! Every light answers the same questions for every integrator: next-event estimation's sample
+//! towards a point with its density ([`LightSet::sample_light`]), the emission sample of a
+//! photon or light subpath with its densities ([`emission::Emitters`], aimed at the mirrors and
+//! glass by [`aim`], far lights across a [`beam`]), and its power for choosing it. Emissive
+//! objects are sampled by [`area`], the sky by [`environment`], lights with a size by [`soft`].
 
+pub mod aim;
 pub mod area;
+pub mod beam;
 pub mod cube_map;
 pub mod emission;
 pub mod environment;
@@ -24,7 +29,8 @@ pub use area::AreaLight;
 pub use environment::Environment;
 pub use soft::SoftLight;
 
-use emission::{camera_targets, Aim, Emitter, Target};
+use aim::{camera_targets, Aim};
+use emission::Emitters;
 
 use crate::math::{luminance, Ray, Vec3};
 use crate::sampling::{power_heuristic, sample_uniform_cone, Rng};
@@ -280,17 +286,33 @@ pub fn distance_attenuation(abc: [f32; 3], d: f32) -> f32 {
     }
 }
 
-/// A light sample for a shading point under the physical model.
+/// Next-event estimation's sample of one light for a shading point (physical model),
+/// visibility included.
 #[derive(Clone, Copy, Debug)]
 pub struct DirectSample {
     /// Unit direction towards the light.
     pub wi: Vec3,
+    /// Distance to the light's point (infinite for a far light).
+    pub distance: f32,
     /// Incident radiance (area lights, suns, the sky) or irradiance (point, spot, directional)
     /// at the path's wavelengths, divided by the probability of the sample: multiplied by f·cos
     /// it is the estimate.
     pub contribution: Spectrum,
-    /// Solid-angle pdf including the choice of light, for MIS; 0 for delta lights.
+    /// Solid-angle pdf including the choice of light, for weighting against BSDF sampling; 0
+    /// where no BSDF sample can reach the light (`delta`).
     pub pdf: f32,
+    /// The density of the draw, the choice included: per solid angle, and for a point or spot
+    /// light the choice × d², for a directional light the choice (vcm's measure).
+    pub direct_pdf: f32,
+    /// No ray meets the light (a point, spot, directional light, or a light with a size).
+    pub delta: bool,
+    /// The light's point (a point light's position; unused for far lights).
+    pub point: Vec3,
+    /// The light's unit normal there (emissive objects and lights with a size).
+    pub normal: Vec3,
+    /// Cosine at the light between its normal and the direction to the shading point (1 for
+    /// lights without a surface).
+    pub cos_light: f32,
 }
 
 /// Every light of a scene: the file's lights in file order, then its emissive objects. Under
@@ -304,8 +326,8 @@ pub struct LightSet {
     /// Light number of each shape and mesh (`u32::MAX` when it does not emit).
     shape_light: Vec<u32>,
     mesh_light: Vec<u32>,
-    /// Each light's uniform photon emitter.
-    emitters: Vec<Option<Emitter>>,
+    /// Where photons leave the lights.
+    emitters: Emitters,
     /// The sphere around the scene, across which directional light enters.
     scene_center: Vec3,
     scene_radius: f32,
@@ -314,9 +336,9 @@ pub struct LightSet {
 /// Scenes with at most this many lights sample each of them at every point.
 const SAMPLE_EVERY_LIGHT_UP_TO: usize = 8;
 
-/// The share of a sun's or the sky's photons sent over the whole scene rather than at the
-/// mirrors and glass in view.
-const FAR_LIGHT_SPREAD: f32 = 0.5;
+/// The share of a far light's photons sent at the mirrors and glass in view rather than over
+/// the whole scene.
+const FAR_LIGHT_AIM_SHARE: f32 = 0.5;
 
 impl LightSet {
     /// The file's `lights` followed by the emissive objects of `scene`.
@@ -351,24 +373,10 @@ impl LightSet {
                 }
             }
         }
-        let sphere = Target {
-            center: scene_center,
-            radius: scene_radius,
-        };
         // Far lights shine on the whole scene: half their photons go to the mirrors and glass
         // in view, where caustics come from, half everywhere for the rest of the light.
-        let in_view = camera_targets(scene);
-        let far_aim = Aim {
-            targets: &in_view,
-            spread: FAR_LIGHT_SPREAD,
-        };
-        let emitters = lights
-            .iter()
-            .map(|light| {
-                let far = matches!(light, Light::Sun { .. } | Light::Environment(_));
-                Emitter::new(light, far.then_some(far_aim), sphere)
-            })
-            .collect();
+        let far_aim = Aim::every(&camera_targets(scene), FAR_LIGHT_AIM_SHARE);
+        let emitters = Emitters::new(&lights, (scene_center, scene_radius), None, far_aim);
         LightSet {
             lights,
             emitters,
@@ -384,6 +392,16 @@ impl LightSet {
     /// All lights: the file's, then the emissive objects.
     pub fn iter(&self) -> std::slice::Iter<'_, Light> {
         self.lights.iter()
+    }
+
+    /// All lights, as a slice (numbered as [`LightSet::get`] numbers them).
+    pub fn as_slice(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// The emission of photons under the physical model.
+    pub fn emitters(&self) -> &Emitters {
+        &self.emitters
     }
 
     /// Number of lights.
@@ -488,15 +506,30 @@ impl LightSet {
     ) -> Option<DirectSample> {
         let (u_pick, u) = (rng.uniform(), rng.uniform2());
         let p = hit.point;
-        let (wi, distance, value) = match &self.lights[index] {
+        // A light no ray meets, at `point` (with its `normal`), seen by the solid-angle density
+        // `pdf` (a point light's: d², so that `value` is its intensity).
+        let delta = |point: Vec3, normal: Vec3, value: Vec3, pdf: f32, cos_light: f32| {
+            let to = point - p;
+            let distance = to.length();
+            if !(distance > 0.0 && distance.is_finite() && pdf > 0.0) {
+                return None;
+            }
+            let wi = to / distance;
+            scene.unoccluded(hit, wi, distance).then(|| DirectSample {
+                wi,
+                distance,
+                contribution: wl.unbounded(value / pdf) / p_pick,
+                pdf: 0.0,
+                direct_pdf: p_pick * pdf,
+                delta: true,
+                point,
+                normal,
+                cos_light,
+            })
+        };
+        match &self.lights[index] {
             Light::Point { position, color, .. } => {
-                let to = *position - p;
-                let d2 = to.length_squared();
-                if !(d2 > 0.0 && d2.is_finite()) {
-                    return None;
-                }
-                let d = d2.sqrt();
-                (to / d, d, *color / d2)
+                delta(*position, Vec3::ZERO, *color, (*position - p).length_squared(), 1.0)
             }
             Light::Spot {
                 position,
@@ -507,64 +540,73 @@ impl LightSet {
                 exponent,
                 ..
             } => {
-                let to = *position - p;
-                let d2 = to.length_squared();
-                if !(d2 > 0.0 && d2.is_finite()) {
-                    return None;
-                }
-                let d = d2.sqrt();
-                let wi = to / d;
-                let profile = spot_profile(-wi.dot(*direction), *cos_inner, *cos_outer, *exponent);
+                let out = (p - *position).normalize_or_zero();
+                let profile = spot_profile(out.dot(*direction), *cos_inner, *cos_outer, *exponent);
                 if profile <= 0.0 {
                     return None;
                 }
-                (wi, d, *color * (profile / d2))
+                let d2 = (*position - p).length_squared();
+                delta(*position, Vec3::ZERO, *color * profile, d2, 1.0)
             }
-            Light::Directional { direction, color } => (-*direction, f32::INFINITY, *color),
+            Light::Directional { direction, color } => {
+                let wi = -*direction;
+                scene.unoccluded(hit, wi, f32::INFINITY).then(|| DirectSample {
+                    wi,
+                    distance: f32::INFINITY,
+                    contribution: wl.unbounded(*color) / p_pick,
+                    pdf: 0.0,
+                    direct_pdf: p_pick,
+                    delta: true,
+                    point: p + wi,
+                    normal: *direction,
+                    cos_light: 1.0,
+                })
+            }
             light @ Light::Sun { direction, cos_max, .. } => {
                 let wi = sample_uniform_cone(u, -*direction, *cos_max);
                 let pdf = p_pick * self.sun_pdf(light);
-                if !scene.unoccluded(hit, wi, f32::INFINITY) {
-                    return None;
-                }
-                return Some(DirectSample {
+                scene.unoccluded(hit, wi, f32::INFINITY).then(|| DirectSample {
                     wi,
+                    distance: f32::INFINITY,
                     contribution: wl.unbounded(light.sun_radiance()) / pdf,
                     pdf,
-                });
+                    direct_pdf: pdf,
+                    delta: false,
+                    point: p + wi,
+                    normal: -wi,
+                    cos_light: 1.0,
+                })
             }
             Light::Environment(env) => {
                 let s = env.sample(u)?;
-                if !scene.unoccluded(hit, s.wi, f32::INFINITY) {
+                if s.radiance == Vec3::ZERO || !scene.unoccluded(hit, s.wi, f32::INFINITY) {
                     return None;
                 }
                 let pdf = p_pick * s.pdf;
-                return Some(DirectSample {
+                Some(DirectSample {
                     wi: s.wi,
+                    distance: f32::INFINITY,
                     contribution: wl.unbounded(s.radiance) / pdf,
                     pdf,
-                });
+                    direct_pdf: pdf,
+                    delta: false,
+                    point: p + s.wi,
+                    normal: -s.wi,
+                    cos_light: 1.0,
+                })
             }
-            Light::Area(light) => return sample_area_direct(scene, light, hit, p_pick, (u_pick, u), wl),
+            Light::Area(light) => sample_area_direct(scene, light, hit, p_pick, (u_pick, u), wl),
             // Rays never hit this light, so its sample takes no MIS weight (pdf 0, as a point light).
             Light::Soft(light) => {
                 let (s, pdf) = light.sample_towards(p, u)?;
                 let to = s.point - p;
-                let d = to.length();
-                if d.is_nan() || d <= 0.0 || pdf <= 0.0 {
+                let cos_light = -s.normal.dot(to) / to.length();
+                if cos_light.is_nan() || cos_light <= 0.0 {
                     return None;
                 }
-                (to / d, d, s.radiance / pdf)
+                delta(s.point, s.normal, s.radiance, pdf, cos_light)
             }
-        };
-        if !scene.unoccluded(hit, wi, distance) {
-            return None;
         }
-        Some(DirectSample {
-            wi,
-            contribution: wl.unbounded(value) / p_pick,
-            pdf: 0.0,
-        })
     }
 
     /// Solid-angle pdf of a sun's uniform cone.
@@ -718,8 +760,14 @@ fn sample_area_direct(
     let pdf = p_pick * drawn.pdf_solid;
     Some(DirectSample {
         wi,
+        distance: d,
         contribution: le / pdf,
         pdf,
+        direct_pdf: pdf,
+        delta: false,
+        point: sample.point,
+        normal: sample.normal,
+        cos_light: sample.normal.dot(wi).abs(),
     })
 }
 

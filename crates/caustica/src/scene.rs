@@ -258,6 +258,12 @@ impl Scene {
         scene
     }
 
+    /// The scene with `lights` in place of its own (its emissive objects kept).
+    #[cfg(test)]
+    pub(crate) fn set_lights(&mut self, lights: Vec<Light>) {
+        self.lights = LightSet::new(self, lights);
+    }
+
     /// The camera.
     pub fn camera(&self) -> &Camera {
         &self.camera

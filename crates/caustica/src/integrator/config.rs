@@ -560,7 +560,7 @@ pub fn integrator_note(given: &GivenOptions, hints: &RenderHints, scene: &crate:
                 | crate::light::Light::Sun { .. }
         )
     });
-    if named == IntegratorHint::Path && delta_lights && !crate::light::emission::caustic_targets(scene).is_empty() {
+    if named == IntegratorHint::Path && delta_lights && !crate::light::aim::caustic_targets(scene).is_empty() {
         note.push_str(
             "; a path tracer cannot show the caustics its mirrors and glass cast from point, spot or sun \
              lights: --integrator vcm shows them",

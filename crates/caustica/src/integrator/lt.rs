@@ -196,7 +196,7 @@ impl<'a> LightTracer<'a> {
                 }
             }
         }
-        let mut power = emitted.flux * share;
+        let mut power = emitted.throughput * share;
         let mut ray = emitted.ray;
         let mut dispersed = false;
         for _ in 0..=self.settings.max_depth {

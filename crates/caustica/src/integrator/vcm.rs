@@ -24,7 +24,7 @@
 //!   measured, light tracing it doubled the area light's image error.
 //!
 //! Merging still smooths indirect light and the caustics seen by a mirror or through glass.
-//! A share of the light subpaths is aimed at the mirrors and glass ([`emitters::Aim`]): caustic
+//! A share of the light subpaths is aimed at the mirrors and glass ([`Aim`]): caustic
 //! paths, a few percent of uniform emission on the race's scenes, become many times more
 //! frequent, and every weight uses the mixture's density. So is a share of their bounces off
 //! Lambertian surfaces ([`BOUNCE_AIM_SHARE`]), for the light a lit wall sends through a glass.
@@ -33,7 +33,6 @@
 //! Determinism: light subpaths are traced in fixed batches and added in index order.
 
 pub mod balance;
-pub mod emitters;
 pub mod focus;
 pub mod grid;
 pub mod mis;
@@ -44,14 +43,14 @@ use super::radius::{radius_factor, InitialRadius};
 use super::tiles::shade_tiles;
 use super::Progressive;
 use crate::bsdf::{adjoint_correction, Bsdf, BsdfSample, Transport};
-use crate::light::emission::caustic_targets;
+use crate::light::aim::{caustic_targets, Aim};
+use crate::light::emission::Emitters;
 use crate::math::{Ray, Vec3};
 use crate::progress::Control;
 use crate::sampling::{power_heuristic, Rng};
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths, SAMPLES};
 use balance::{balanced_light_paths, merging_growth, PassCosts, PixelSpread, CANDIDATE_COST};
-use emitters::{Aim, Emitters};
 use focus::CausticFocus;
 use grid::HashGrid;
 use mis::{ConnectionPdfs, DirectPdfs, Factors, Partial};
@@ -128,6 +127,10 @@ pub const BALANCED_FOOTPRINT: f32 = 2.0;
 /// light merged around the caustic (region error 1.4–2.2×) (docs/benchmarks/2026-12-02.md,
 /// "The caustics race, aimed vcm").
 pub const AIM_SHARE: f32 = 0.15;
+
+/// The share of a directional light's or sun's subpaths (and the sky's) aimed at the mirrors
+/// and glass: their beam covers the whole scene, where a glass may take a hundredth of it.
+pub const FAR_AIM_SHARE: f32 = 0.5;
 
 /// The share of the light subpaths' bounces off Lambertian surfaces aimed at the mirrors and
 /// glass. Light that a lamp-lit ceiling or wall sends through a glass is a second caustic over
@@ -417,14 +420,20 @@ impl<'a> Vcm<'a> {
             scene,
             sensor: Sensor::new(&camera, width, height),
             camera,
-            emitters: Emitters::new(
-                scene.lights(),
-                if settings.aim {
-                    Aim::new(&caustic_targets(scene), AIM_SHARE)
+            emitters: {
+                let targets = if settings.aim {
+                    caustic_targets(scene)
                 } else {
-                    None
-                },
-            ),
+                    Vec::new()
+                };
+                let lights = scene.lights();
+                Emitters::new(
+                    lights.as_slice(),
+                    lights.scene_sphere(),
+                    Aim::new(&targets, AIM_SHARE),
+                    Aim::new(&targets, FAR_AIM_SHARE),
+                )
+            },
             bounce_aim: if settings.aim {
                 Aim::new(&caustic_targets(scene), BOUNCE_AIM_SHARE)
             } else {
@@ -1140,7 +1149,8 @@ impl<'a> Vcm<'a> {
             if self.emitters.emits(number) {
                 let samples = self.direct_samples(number, v.length);
                 for _ in 0..samples {
-                    let Some(s) = self.emitters.sample_direct(self.scene, number, v.hit, wl, rng) else {
+                    let choice = lights.direct_probability(number);
+                    let Some(s) = lights.sample_light(number, choice, self.scene, v.hit, wl, rng) else {
                         continue;
                     };
                     let value = v.bsdf.eval(v.wo, s.wi);
@@ -1153,7 +1163,7 @@ impl<'a> Vcm<'a> {
                         bsdf_reverse: self.light_pdf(v.bsdf, v.hit.point, v.wo, v.bsdf.pdf_reverse(v.wo, s.wi)),
                         // Several samples are one strategy of that many times the density.
                         direct: s.direct_pdf * samples as f32,
-                        emission: s.emission_pdf,
+                        emission: self.emitters.emission_pdf_of(self.scene, number, &s, v.hit.point),
                         cos_here,
                         cos_light: s.cos_light,
                         delta: s.delta,
@@ -1475,7 +1485,7 @@ impl Vcm<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::emission::Target;
+    use crate::light::aim::Target;
     use crate::material::{Lobes, SurfaceParams};
 
     /// A light subpath's bounce off a Lambertian surface with a share aimed at a sphere: every

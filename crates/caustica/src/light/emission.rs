@@ -1,479 +1,79 @@
-//! Photon emission: photons leaving the lights, with their flux. Every light emits through an
-//! [`Emitter`], uniform or aimed:
+//! Light leaving the lights: the start of every photon and light subpath (photon mapping's
+//! photons, the light tracer's paths, vcm's light subpaths), with the densities weights need —
+//! how likely emission made a point and a direction (pbrt-v4's `SampleLe`/`PDF_Le`, SmallVCM's
+//! `Emit`). Next-event estimation's side is [`super::LightSet::sample_light`]; the two meet in
+//! [`Emitters::emission_pdf_of`].
 //!
-//! - uniform: point lights over the whole sphere, directional lights across a disc covering the
-//!   scene, emissive objects from a point uniform by area in a cosine-weighted direction;
-//! - aimed (point and directional lights): only towards the bounding spheres of the objects that
-//!   can make caustics. Point lights sample a mixture of cones (one per target, weighted by solid
-//!   angle); directional lights a mixture of discs on a plane across the beam (one per target,
-//!   weighted by area).
+//! Every light takes part in every strategy it can. A directional light, a sun or the sky
+//! starts its light on a plane across its beam outside the scene ([`Beam`]; the sky's beam is
+//! the direction its own sampling draws), so their densities are per unit area across the
+//! beam, with no distance to the first vertex. The course forks' lights with a size start
+//! theirs from a point on them; no ray meets them, so camera paths reach them by next-event
+//! estimation alone.
 //!
-//! Each photon carries the light's intensity (or irradiance, or radiance) divided by the pdf
-//! actually used, so aiming changes the noise, never the expected power. The physical model
-//! picks a light in proportion to its power ([`LightSet::emit`]); the course model shares a
-//! budget of stored caustic photons between its lights, each aimed.
+//! Aiming ([`Aim`]): a share of the light leaves towards the bounding spheres of the mirrors
+//! and glass (the caustics' sources), the rest everywhere the light shines; near lights (points,
+//! spots, emissive objects, lights with a size) and far ones (directional lights, suns, the
+//! sky) each have their own aim. A sphere lamp aims from the half of it that faces the chosen
+//! target. Every density is the mixture's, for the throughput and for every strategy's weight
+//! alike, so aiming changes where the samples go, never the expected image. Photon mapping
+//! aims the far lights at the mirrors and glass in view ([`LightSet::emit`]); the course model
+//! aims all its light at the caustics' sources; vcm chooses its shares ([`crate::integrator::vcm`]).
 
+use super::aim::Aim;
 use super::area::{AreaLight, AreaSample};
-use super::{spot_profile, Light, LightSet};
+use super::beam::Beam;
+use super::{spot_profile, DirectSample, Light, LightSet};
 use crate::description::EmittingFaces;
-use crate::math::{luminance, offset_origin, Aabb, Frame, Ray, Vec2, Vec3};
-use crate::sampling::{sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_disc, Rng};
-use crate::scene::{ObjectRef, Scene};
+use crate::math::{offset_origin, Frame, Ray, Vec3};
+use crate::sampling::{
+    sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf, uniform_sphere_pdf,
+    Distribution1D, Rng,
+};
+use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
+use glam::Vec2;
 use std::f32::consts::PI;
 
-/// A bounding sphere that photons are aimed at.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Target {
-    /// Centre.
-    pub center: Vec3,
-    /// Radius.
-    pub radius: f32,
+/// The lights that start photons and light subpaths, chosen in proportion to their power.
+#[derive(Clone, Debug, Default)]
+pub struct Emitters {
+    /// Probability of choosing each light of the scene's set (0: not an emitter here).
+    probability: Vec<f32>,
+    /// Light numbers of the emitters, and their choice distribution.
+    numbers: Vec<usize>,
+    choice: Option<Distribution1D>,
+    /// Where points, spots, emissive objects and lights with a size aim a share of their light.
+    near: Option<Aim>,
+    /// Where directional lights, suns and the sky aim a share of theirs.
+    far: Option<Aim>,
+    /// Each light's beam, for the directional lights and suns.
+    beams: Vec<Option<Beam>>,
+    /// The scene's sphere, for the sky's beams (one per direction).
+    sphere: (Vec3, f32),
 }
 
-impl Target {
-    /// The cone of directions from `from` that meet the sphere: its axis and the cosine of its
-    /// half-angle (−1, every direction, from inside).
-    pub fn cone_from(&self, from: Vec3) -> (Vec3, f32) {
-        let to = self.center - from;
-        let d2 = to.length_squared();
-        let r2 = self.radius * self.radius;
-        if d2 <= r2 * 1.0001 {
-            return (Vec3::Z, -1.0);
-        }
-        (to / d2.sqrt(), (1.0 - r2 / d2).max(0.0).sqrt())
-    }
-
-    /// The sphere around a box (slightly enlarged so grazing paths are not lost).
-    pub fn around(bounds: &Aabb) -> Target {
-        Target {
-            center: bounds.center(),
-            radius: 0.5 * bounds.extent().length() * 1.001 + 1e-4,
-        }
-    }
-}
-
-#[derive(Clone, Debug)]
-struct ConeLobe {
-    axis: Vec3,
-    cos_max: f32,
-}
-
-#[derive(Clone, Debug)]
-struct DiscLobe {
-    center: Vec2,
-    radius: f32,
-}
-
-/// A spot light's cone: the axis and its profile (see [`spot_profile`]).
+/// The start of a light subpath.
 #[derive(Clone, Copy, Debug)]
-struct SpotCone {
-    axis: Vec3,
-    cos_inner: f32,
-    cos_outer: f32,
-    exponent: f32,
-}
-
-#[derive(Clone, Debug)]
-enum Kind {
-    /// An emissive object, sampled by its own area sampler.
-    Area,
-    /// A point or spot light: a mixture of cones of directions.
-    Point {
-        position: Vec3,
-        cones: Vec<ConeLobe>,
-        spot: Option<SpotCone>,
-    },
-    /// A directional light or a sun: a mixture of discs on a plane across the beam; a sun's
-    /// photons leave in directions spread over its cone (cos_max, 1 − cos_max).
-    Directional {
-        direction: Vec3,
-        frame: Frame,
-        plane_origin: Vec3,
-        discs: Vec<DiscLobe>,
-        sun: Option<(f32, f32)>,
-    },
-    /// The sky: a direction by the environment's own sampling, then a point on a disc across
-    /// it, the scene's or the targets' as seen along that direction.
-    Environment { scene: Target, discs: Vec<Target> },
-    /// A light with a size: a point uniform on it, then a direction cosine-weighted about its
-    /// normal, or drawn from the cones from that point to the targets when aimed.
-    Soft { targets: Option<Vec<Target>> },
-}
-
-/// One light's photon source.
-#[derive(Clone, Debug)]
-pub struct Emitter {
-    kind: Kind,
-    color: Vec3,
-    /// Mixture weights (sum 1) and their running sums.
-    weights: Vec<f32>,
-    cdf: Vec<f32>,
-    power: f32,
-}
-
-/// Where photons are aimed: a share `1 − spread` goes towards `targets` (each in proportion
-/// to its solid angle or cross-section), the share `spread` everywhere the light shines.
-#[derive(Clone, Copy, Debug)]
-pub struct Aim<'a> {
-    /// The bounding spheres of the objects that make caustics.
-    pub targets: &'a [Target],
-    /// The share of photons sent everywhere (0: only at the targets).
-    pub spread: f32,
-}
-
-/// Mixture weights: the target lobes' own weights scaled to `1 − spread`, then the uniform lobe
-/// with `spread` (left out when 0).
-fn mix(target_weights: Vec<f32>, spread: f32) -> Vec<f32> {
-    if spread <= 0.0 {
-        return target_weights;
-    }
-    let total: f32 = target_weights.iter().sum();
-    let mut weights: Vec<f32> = if total > 0.0 {
-        target_weights.iter().map(|w| w / total * (1.0 - spread)).collect()
-    } else {
-        Vec::new()
-    };
-    weights.push(spread);
-    weights
-}
-
-impl Emitter {
-    /// The emitter of `light`, aimed as `aim` says (or uniform when it is `None`; emissive
-    /// objects are never aimed); `scene` is the sphere around the scene, across which directional
-    /// light enters. `None` when the light cannot send a photon anywhere useful.
-    pub fn new(light: &Light, aim: Option<Aim>, scene: Target) -> Option<Emitter> {
-        let spread = aim.map_or(1.0, |a| a.spread.clamp(0.0, 1.0));
-        let targets = aim.map(|a| a.targets).filter(|t| !t.is_empty() || spread <= 0.0);
-        let point = |position: Vec3, color: Vec3, spot: Option<SpotCone>| {
-            let everywhere = match spot {
-                None => ConeLobe {
-                    axis: Vec3::Z,
-                    cos_max: -1.0,
-                },
-                Some(spot) => ConeLobe {
-                    axis: spot.axis,
-                    cos_max: spot.cos_outer,
-                },
-            };
-            let (mut cones, weights): (Vec<ConeLobe>, Vec<f32>) = match targets {
-                None => (vec![everywhere.clone()], vec![1.0]),
-                Some(ts) => {
-                    let cones: Vec<ConeLobe> = ts.iter().map(|t| cone_towards(position, t)).collect();
-                    let weights = cones.iter().map(|c| 1.0 - c.cos_max).collect();
-                    (cones, mix(weights, spread))
-                }
-            };
-            if targets.is_some() && spread > 0.0 {
-                cones.push(everywhere);
-            }
-            let power = light.power(scene.radius);
-            Emitter::finish(Kind::Point { position, cones, spot }, color, weights, power)
-        };
-        let directional = |direction: Vec3, color: Vec3, sun: Option<(f32, f32)>| {
-            let frame = Frame::from_normal(direction);
-            let plane_origin = scene.center - direction * (scene.radius * 2.0 + 1.0);
-            // A sun's photons lean by up to its angular radius: widen each disc so that every
-            // leaning ray that can reach the target starts inside it.
-            let lean = sun.map_or(0.0, |(cos_max, _)| (1.0 - cos_max * cos_max).max(0.0).sqrt() / cos_max);
-            let to_disc = |t: &Target| {
-                let local = frame.to_local(t.center - plane_origin);
-                DiscLobe {
-                    center: Vec2::new(local.x, local.y),
-                    radius: t.radius + (local.z.max(0.0) + t.radius) * lean,
-                }
-            };
-            let (discs, weights): (Vec<DiscLobe>, Vec<f32>) = match targets {
-                None => (vec![to_disc(&scene)], vec![1.0]),
-                Some(ts) => {
-                    let mut discs: Vec<DiscLobe> = ts.iter().map(to_disc).collect();
-                    let weights = mix(discs.iter().map(|d| d.radius * d.radius).collect(), spread);
-                    if spread > 0.0 {
-                        discs.push(to_disc(&scene));
-                    }
-                    (discs, weights)
-                }
-            };
-            let power = luminance(color).max(0.0) * PI * scene.radius * scene.radius;
-            let kind = Kind::Directional {
-                direction,
-                frame,
-                plane_origin,
-                discs,
-                sun,
-            };
-            Emitter::finish(kind, color, weights, power)
-        };
-        match *light {
-            Light::Point { position, color, .. } => point(position, color, None),
-            Light::Spot {
-                position,
-                direction,
-                color,
-                cos_inner,
-                cos_outer,
-                exponent,
-                ..
-            } => point(
-                position,
-                color,
-                Some(SpotCone {
-                    axis: direction,
-                    cos_inner,
-                    cos_outer,
-                    exponent,
-                }),
-            ),
-            Light::Area(ref area) => Emitter::finish(Kind::Area, area.radiance, vec![1.0], area.power()),
-            Light::Soft(ref soft) => Emitter::finish(
-                Kind::Soft {
-                    targets: targets.map(<[Target]>::to_vec),
-                },
-                soft.color,
-                vec![1.0],
-                soft.power(),
-            ),
-            Light::Directional { direction, color } => directional(direction, color, None),
-            Light::Sun {
-                direction,
-                color,
-                cos_max,
-                one_minus_cos,
-            } => directional(direction, color, Some((cos_max, one_minus_cos))),
-            Light::Environment(ref env) => {
-                let (discs, weights): (Vec<Target>, Vec<f32>) = match targets {
-                    None => (vec![scene], vec![1.0]),
-                    Some(ts) => {
-                        let mut discs = ts.to_vec();
-                        let weights = mix(discs.iter().map(|d| d.radius * d.radius).collect(), spread);
-                        if spread > 0.0 {
-                            discs.push(scene);
-                        }
-                        (discs, weights)
-                    }
-                };
-                let kind = Kind::Environment { scene, discs };
-                Emitter::finish(
-                    kind,
-                    env.color.max(Vec3::splat(1e-30)),
-                    weights,
-                    light.power(scene.radius),
-                )
-            }
-        }
-    }
-
-    fn finish(kind: Kind, color: Vec3, weights: Vec<f32>, power: f32) -> Option<Emitter> {
-        let total: f32 = weights.iter().sum();
-        if total.is_nan() || total <= 0.0 || !total.is_finite() || color.max_element() <= 0.0 {
-            return None;
-        }
-        let weights: Vec<f32> = weights.iter().map(|w| w / total).collect();
-        let mut acc = 0.0;
-        let cdf = weights
-            .iter()
-            .map(|w| {
-                acc += w;
-                acc
-            })
-            .collect();
-        Some(Emitter {
-            kind,
-            color,
-            weights,
-            cdf,
-            power,
-        })
-    }
-
-    /// The light's power (luminance), used to share a photon budget between lights.
-    pub fn power(&self) -> f32 {
-        self.power
-    }
-
-    /// A photon from `light` (the light this emitter was made for) with its flux before
-    /// division by the number of photons emitted.
-    pub fn sample(&self, light: &Light, scene: &Scene, wl: &Wavelengths, rng: &mut Rng) -> Option<EmittedPhoton> {
-        if let (Kind::Area, Light::Area(area)) = (&self.kind, light) {
-            let u_pick = rng.uniform();
-            let (u, u_dir) = (rng.uniform2(), rng.uniform2());
-            return emit_from_area(area, scene, (u_pick, u, u_dir), wl);
-        }
-        if let (Kind::Soft { targets }, Light::Soft(soft)) = (&self.kind, light) {
-            return emit_from_soft(soft, targets.as_deref(), wl, rng);
-        }
-        let lobe = self.pick(rng.uniform());
-        let u = rng.uniform2();
-        let (ray, flux) = match &self.kind {
-            Kind::Point { position, cones, spot } => {
-                let dir = sample_uniform_cone(u, cones[lobe].axis, cones[lobe].cos_max);
-                let pdf = self.cone_pdf(cones, dir);
-                let profile = spot.map_or(1.0, |s| {
-                    spot_profile(dir.dot(s.axis), s.cos_inner, s.cos_outer, s.exponent)
-                });
-                (pdf > 0.0 && profile > 0.0)
-                    .then(|| (Ray::new(*position, dir), wl.unbounded(self.color) * (profile / pdf)))?
-            }
-            Kind::Directional {
-                direction,
-                frame,
-                plane_origin,
-                discs,
-                sun,
-            } => {
-                let disc = &discs[lobe];
-                let p = disc.center + sample_uniform_disc(u) * disc.radius;
-                let pdf = self.disc_pdf(discs, p);
-                let origin = *plane_origin + frame.x * p.x + frame.y * p.y;
-                let (dir, spread) = match sun {
-                    None => (*direction, 1.0),
-                    // Over the sun's disc: radiance E / (π sin²θ) × cos × the cone's solid angle.
-                    Some((cos_max, one_minus_cos)) => {
-                        let dir = sample_uniform_cone(rng.uniform2(), *direction, *cos_max);
-                        (dir, 2.0 * dir.dot(*direction) / (2.0 - one_minus_cos))
-                    }
-                };
-                (pdf > 0.0).then(|| (Ray::new(origin, dir), wl.unbounded(self.color) * (spread / pdf)))?
-            }
-            Kind::Environment { scene, discs } => {
-                let Light::Environment(env) = light else {
-                    return None;
-                };
-                let sky = env.sample(rng.uniform2())?;
-                let dir = -sky.wi;
-                let frame = Frame::from_normal(dir);
-                let plane_origin = scene.center - dir * (scene.radius * 2.0 + 1.0);
-                let project = |t: &Target| {
-                    let local = frame.to_local(t.center - plane_origin);
-                    DiscLobe {
-                        center: Vec2::new(local.x, local.y),
-                        radius: t.radius,
-                    }
-                };
-                let lobes: Vec<DiscLobe> = discs.iter().map(project).collect();
-                let disc = &lobes[lobe];
-                let p = disc.center + sample_uniform_disc(u) * disc.radius;
-                let pdf_area = self.disc_pdf(&lobes, p);
-                let origin = plane_origin + frame.x * p.x + frame.y * p.y;
-                (pdf_area > 0.0 && sky.pdf > 0.0).then(|| {
-                    let radiance = wl.unbounded(sky.radiance);
-                    (Ray::new(origin, dir), radiance / (sky.pdf * pdf_area))
-                })?
-            }
-            Kind::Area | Kind::Soft { .. } => return None,
-        };
-        Some(EmittedPhoton {
-            ray,
-            flux,
-            origin: None,
-        })
-    }
-
-    fn pick(&self, u: f32) -> usize {
-        self.cdf.iter().position(|&c| u < c).unwrap_or(self.cdf.len() - 1)
-    }
-
-    /// Solid-angle pdf of the cone mixture.
-    fn cone_pdf(&self, cones: &[ConeLobe], dir: Vec3) -> f32 {
-        cones
-            .iter()
-            .zip(&self.weights)
-            .filter(|(c, _)| c.cos_max <= -1.0 || dir.dot(c.axis) >= c.cos_max)
-            .map(|(c, w)| w / (2.0 * PI * (1.0 - c.cos_max)))
-            .sum()
-    }
-
-    /// Area pdf of the disc mixture on the emission plane.
-    fn disc_pdf(&self, discs: &[DiscLobe], p: Vec2) -> f32 {
-        discs
-            .iter()
-            .zip(&self.weights)
-            .filter(|(d, _)| (p - d.center).length_squared() <= d.radius * d.radius * (1.0 + 1e-5))
-            .map(|(d, w)| w / (PI * d.radius * d.radius))
-            .sum()
-    }
-}
-
-fn cone_towards(position: Vec3, target: &Target) -> ConeLobe {
-    let (axis, cos_max) = target.cone_from(position);
-    ConeLobe { axis, cos_max }
-}
-
-/// The bounding spheres photons are aimed at: one per reflective or transmissive object.
-pub fn caustic_targets(scene: &Scene) -> Vec<Target> {
-    specular_targets(scene).into_iter().map(|(_, target)| target).collect()
-}
-
-/// The targets of the mirrors and glass the camera sees, directly or through other mirrors and
-/// glass (followed straight on, which is enough to find them): a sky or a sun lights the whole
-/// scene, and photons aimed at objects out of view make caustics nobody sees.
-pub fn camera_targets(scene: &Scene) -> Vec<Target> {
-    let targets = specular_targets(scene);
-    if targets.is_empty() {
-        return Vec::new();
-    }
-    const GRID: usize = 48;
-    const MAX_CHAIN: usize = 4;
-    let mut seen = std::collections::HashSet::new();
-    for j in 0..GRID {
-        for i in 0..GRID {
-            let (sx, sy) = ((i as f32 + 0.5) / GRID as f32, (j as f32 + 0.5) / GRID as f32);
-            let mut ray = scene.camera().generate_ray(sx, sy);
-            for _ in 0..MAX_CHAIN {
-                let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                    break;
-                };
-                let hit = scene.surface(&ray, &isect);
-                if !scene.object_is_specular(hit.object) {
-                    break;
-                }
-                seen.insert(hit.object);
-                ray = Ray::new(hit.ray_origin(ray.dir), ray.dir);
-            }
-        }
-    }
-    targets
-        .into_iter()
-        .filter(|(object, _)| seen.contains(object))
-        .map(|(_, target)| target)
-        .collect()
-}
-
-/// Each reflective or transmissive object with its target: for a shape, the smaller of the
-/// sphere around its world bounds and its own bounding sphere (a rotated ring's world box is
-/// much larger than the ring, and every photon aimed past the ring is traced for nothing).
-fn specular_targets(scene: &Scene) -> Vec<(ObjectRef, Target)> {
-    scene
-        .objects()
-        .filter(|(object, bounds)| scene.object_is_specular(*object) && !bounds.is_empty())
-        .map(|(object, bounds)| {
-            let around = Target::around(&bounds);
-            let ObjectRef::Shape(i) = object else {
-                return (object, around);
-            };
-            let (center, radius) = scene.shapes()[i as usize].bounding_sphere();
-            let own = Target {
-                center,
-                radius: radius * 1.001 + 1e-4,
-            };
-            if own.radius < around.radius && own.radius.is_finite() && center.is_finite() {
-                (object, own)
-            } else {
-                (object, around)
-            }
-        })
-        .collect()
-}
-
-/// A photon leaving a light: its ray and its flux before division by the photon count.
-#[derive(Clone, Copy, Debug)]
-pub struct EmittedPhoton {
-    /// Origin and unit direction.
+pub struct Emission {
+    /// Leaves the light.
     pub ray: Ray,
-    /// Flux at the wavelengths it was emitted for (RGB in RGB mode).
-    pub flux: Spectrum,
-    /// The surface point it left, when it left one (a light with an area), for the light tracer
-    /// to show the light itself.
+    /// Radiance × cosine over the density of the whole sample (choice of light included).
+    pub throughput: Spectrum,
+    /// Density of the point (area) × direction (solid angle), choice of light included.
+    pub emission_pdf: f32,
+    /// Cosine between the direction and the light's normal (1 for a point).
+    pub cos: f32,
+    /// The light is a point or spot.
+    pub delta: bool,
+    /// Light number.
+    pub light: usize,
+    /// The point's unit normal (for an emissive object; the direction for a point).
+    pub normal: Vec3,
+    /// The light is a directional light or a sun: the densities are across the beam, and the
+    /// first segment's length does not change them.
+    pub far: bool,
+    /// The point on a light with an area it left, for the light tracer to show the light itself.
     pub origin: Option<EmissionPoint>,
 }
 
@@ -491,50 +91,409 @@ pub struct EmissionPoint {
 }
 
 impl LightSet {
-    /// One photon from a light chosen by power, its flux divided by the probability of the
-    /// choice; `None` if the sample carries nothing.
-    pub fn emit(&self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng) -> Option<EmittedPhoton> {
-        let (index, p_pick) = self.pick(rng.uniform())?;
-        let emitter = self.emitters[index].as_ref()?;
-        let photon = emitter.sample(&self.lights[index], scene, wl, rng)?;
-        Some(EmittedPhoton {
-            ray: photon.ray,
-            flux: photon.flux / p_pick,
-            origin: photon.origin.map(|o| EmissionPoint {
-                radiance: o.radiance / p_pick,
-                ..o
-            }),
-        })
+    /// One photon from a light chosen by power: its throughput is its flux before division by
+    /// the number of photons emitted. `None` if the sample carries nothing.
+    pub fn emit(&self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng) -> Option<Emission> {
+        self.emitters().emit(scene, wl, rng)
     }
 }
 
-/// A photon from an emissive object: a point by area, a face, a cosine-weighted direction.
-fn emit_from_area(
-    light: &AreaLight,
-    scene: &Scene,
-    (u_pick, u, u_dir): (f32, Vec2, Vec2),
-    wl: &Wavelengths,
-) -> Option<EmittedPhoton> {
-    let sample = light.sample(scene, u_pick, u)?;
-    let le = area_radiance(light, scene, &sample, wl);
-    // A face at random, or the one that emits, then a cosine-weighted direction: pdf ½·cos/π,
-    // or cos/π.
-    let (side, u2) = emitting_side(light, u_dir);
-    let normal = sample.normal * side;
-    let dir = Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2));
-    if dir.dot(normal) <= 0.0 {
-        return None;
+impl Emitters {
+    /// The emitters of `lights` in the scene's sphere (`center`, `radius`): points, spots,
+    /// emissive objects and lights with a size aimed as `near` says, directional lights, suns
+    /// and the sky as `far` says.
+    pub fn new(lights: &[Light], sphere: (Vec3, f32), near: Option<Aim>, far: Option<Aim>) -> Emitters {
+        let powers: Vec<f32> = lights.iter().map(|light| light.power(sphere.1).max(0.0)).collect();
+        let (targets, share) = far.as_ref().map_or((&[][..], 0.0), |a| (a.targets(), a.share()));
+        let beams = lights
+            .iter()
+            .map(|light| match *light {
+                Light::Directional { direction, .. } => Some(Beam::new(direction, None, sphere, targets, share)),
+                Light::Sun {
+                    direction,
+                    cos_max,
+                    one_minus_cos,
+                    ..
+                } => Some(Beam::new(
+                    direction,
+                    Some((cos_max, one_minus_cos)),
+                    sphere,
+                    targets,
+                    share,
+                )),
+                _ => None,
+            })
+            .collect();
+        let numbers: Vec<usize> = (0..powers.len()).filter(|&i| powers[i] > 0.0).collect();
+        let total: f32 = numbers.iter().map(|&i| powers[i]).sum();
+        let probability = powers
+            .iter()
+            .map(|&p| {
+                if total > 0.0 && total.is_finite() {
+                    p / total
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let weights: Vec<f32> = numbers.iter().map(|&i| powers[i]).collect();
+        let choice = (total > 0.0 && total.is_finite()).then(|| Distribution1D::new(&weights));
+        Emitters {
+            probability,
+            numbers,
+            choice,
+            near,
+            far,
+            beams,
+            sphere,
+        }
     }
-    Some(EmittedPhoton {
-        ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
-        flux: le * (light.faces.count() * PI / sample.pdf_area),
-        origin: Some(EmissionPoint {
-            point: sample.point,
-            normal: sample.normal,
-            faces: light.faces,
-            radiance: le / sample.pdf_area,
-        }),
-    })
+
+    /// Solid-angle density of a direction `dir` leaving `from`, whose density without aiming
+    /// is `plain`: the mixture of that and the aimed cones.
+    fn direction_pdf(&self, from: Vec3, dir: Vec3, plain: f32) -> f32 {
+        match &self.near {
+            None => plain,
+            Some(aim) => (1.0 - aim.share()) * plain + aim.share() * aim.pdf(from, dir),
+        }
+    }
+
+    /// Draws whether this subpath is aimed; if so, the aim and the random numbers its sample
+    /// uses.
+    fn aimed_lobe(&self, rng: &mut Rng) -> Option<(&Aim, f32, Vec2)> {
+        let aim = self.near.as_ref()?;
+        let (u_lobe, u_pick, u) = (rng.uniform(), rng.uniform(), rng.uniform2());
+        (u_lobe < aim.share()).then_some((aim, u_pick, u))
+    }
+
+    /// Draws whether this subpath is aimed; if so, its direction from `from`.
+    fn aimed(&self, from: Vec3, rng: &mut Rng) -> Option<Option<Vec3>> {
+        self.aimed_lobe(rng).map(|(aim, u_pick, u)| aim.sample(from, u_pick, u))
+    }
+
+    /// Density (area × solid angle) of leaving emissive object `light` at `point`, of unit
+    /// normal `normal`, in `dir`, whose direction density without aiming is `plain`.
+    fn start_pdf(&self, light: &AreaLight, point: Vec3, normal: Vec3, dir: Vec3, plain: f32) -> f32 {
+        let area = light.pdf_area(normal);
+        match (&self.near, light.sphere()) {
+            (None, _) => area * plain,
+            (Some(aim), Some((center, radius))) => {
+                (1.0 - aim.share()) * area * plain + aim.share() * aim.sphere_pdf(center, radius, point, dir)
+            }
+            (Some(_), None) => area * self.direction_pdf(point, dir, plain),
+        }
+    }
+
+    /// Area density of the start point `sample` on emissive object `light` (before the
+    /// choice of light): a sphere lamp's aimed starts lie on the halves facing their targets.
+    fn point_pdf(&self, light: &AreaLight, sample: &AreaSample) -> f32 {
+        let area = light.pdf_area(sample.normal);
+        match (&self.near, light.sphere()) {
+            (Some(aim), Some((center, radius))) => {
+                (1.0 - aim.share()) * area + aim.share() * aim.sphere_point_pdf(center, radius, sample.point)
+            }
+            _ => area,
+        }
+    }
+
+    /// Solid-angle density, without aiming, of a point or spot light's direction `dir`.
+    fn point_plain_pdf(light: &Light, dir: Vec3) -> f32 {
+        match light {
+            Light::Spot {
+                direction, cos_outer, ..
+            } if dir.dot(*direction) < *cos_outer => 0.0,
+            Light::Spot { cos_outer, .. } => uniform_cone_pdf(*cos_outer),
+            _ => uniform_sphere_pdf(),
+        }
+    }
+
+    /// Whether light `number` starts light subpaths.
+    pub fn emits(&self, number: usize) -> bool {
+        self.probability.get(number).is_some_and(|&p| p > 0.0)
+    }
+
+    /// Whether no light starts light subpaths.
+    pub fn is_empty(&self) -> bool {
+        self.choice.is_none()
+    }
+
+    /// The start of a light subpath from a light chosen by power, at the wavelengths `wl`.
+    pub fn emit(&self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng) -> Option<Emission> {
+        let (_, slot, _) = self.choice.as_ref()?.sample(rng.uniform());
+        let number = self.numbers[slot];
+        self.emit_light(scene, number, self.probability[number], wl, rng)
+    }
+
+    /// The start of a light subpath from light `number` itself (its densities without the
+    /// choice of light): the course model shares its photons between the lights itself.
+    pub fn emit_from(&self, scene: &Scene, number: usize, wl: &Wavelengths, rng: &mut Rng) -> Option<Emission> {
+        if !self.emits(number) {
+            return None;
+        }
+        self.emit_light(scene, number, 1.0, wl, rng)
+    }
+
+    /// The start of a light subpath from light `number`, taken with probability `pick`.
+    fn emit_light(&self, scene: &Scene, number: usize, pick: f32, wl: &Wavelengths, rng: &mut Rng) -> Option<Emission> {
+        let (u, u_dir) = (rng.uniform2(), rng.uniform2());
+        match scene.lights().get(number)? {
+            light @ Light::Point { position, color, .. } => {
+                let dir = match self.aimed(*position, rng) {
+                    Some(aimed) => aimed?,
+                    None => sample_uniform_sphere(u),
+                };
+                let pdf = pick * self.direction_pdf(*position, dir, Self::point_plain_pdf(light, dir));
+                (pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(*position, dir),
+                    throughput: wl.unbounded(*color) / pdf,
+                    emission_pdf: pdf,
+                    cos: 1.0,
+                    delta: true,
+                    light: number,
+                    normal: dir,
+                    far: false,
+                    origin: None,
+                })
+            }
+            light @ Light::Spot {
+                position,
+                direction,
+                color,
+                cos_inner,
+                cos_outer,
+                exponent,
+                ..
+            } => {
+                let dir = match self.aimed(*position, rng) {
+                    Some(aimed) => aimed?,
+                    None => sample_uniform_cone(u, *direction, *cos_outer),
+                };
+                let profile = spot_profile(dir.dot(*direction), *cos_inner, *cos_outer, *exponent);
+                let pdf = pick * self.direction_pdf(*position, dir, Self::point_plain_pdf(light, dir));
+                (profile > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(*position, dir),
+                    throughput: wl.unbounded(*color) * (profile / pdf),
+                    emission_pdf: pdf,
+                    cos: 1.0,
+                    delta: true,
+                    light: number,
+                    normal: dir,
+                    far: false,
+                    origin: None,
+                })
+            }
+            Light::Area(light) => {
+                let mut sample = light.sample(scene, rng.uniform(), u)?;
+                let (dir, normal) = match self.aimed_lobe(rng) {
+                    Some((aim, u_pick, u_aim)) => {
+                        let dir = match light.sphere() {
+                            Some((center, radius)) => {
+                                let (normal, dir) =
+                                    aim.sample_from_sphere(center, radius, sample.normal, u_pick, u_aim)?;
+                                sample.normal = normal;
+                                sample.point = center + normal * radius;
+                                dir
+                            }
+                            None => aim.sample(sample.point, u_pick, u_aim)?,
+                        };
+                        // Leaves by the face it points out of, if that face emits.
+                        let side = if dir.dot(sample.normal) >= 0.0 { 1.0 } else { -1.0 };
+                        if light.faces.sign().is_some_and(|s| s != side) {
+                            return None;
+                        }
+                        (dir, sample.normal * side)
+                    }
+                    None => {
+                        // A face at random, or the one that emits, then a cosine-weighted
+                        // direction.
+                        let (side, u2) = emitting_side(light, u_dir);
+                        let normal = sample.normal * side;
+                        (
+                            Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2)),
+                            normal,
+                        )
+                    }
+                };
+                let le = area_radiance(light, scene, &sample, wl);
+                let cos = dir.dot(normal);
+                let plain = cos / (PI * light.faces.count());
+                let pdf = pick * self.start_pdf(light, sample.point, sample.normal, dir, plain);
+                let point_pdf = pick * self.point_pdf(light, &sample);
+                (cos > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
+                    throughput: le * (cos / pdf),
+                    emission_pdf: pdf,
+                    cos,
+                    delta: false,
+                    light: number,
+                    normal,
+                    far: false,
+                    origin: (point_pdf > 0.0).then(|| EmissionPoint {
+                        point: sample.point,
+                        normal: sample.normal,
+                        faces: light.faces,
+                        radiance: le / point_pdf,
+                    }),
+                })
+            }
+            light @ (Light::Directional { .. } | Light::Sun { .. }) => {
+                let beam = self.beams[number].as_ref()?;
+                let (origin, plane_pdf) = beam.sample(rng.uniform(), rng.uniform(), u)?;
+                let (dir, radiance) = match beam.sun {
+                    Some((cos_max, _)) => (
+                        sample_uniform_cone(u_dir, beam.direction, cos_max),
+                        light.sun_radiance(),
+                    ),
+                    None => (beam.direction, light.color()),
+                };
+                let lean = dir.dot(beam.direction);
+                let pdf = pick * beam.direction_pdf() * plane_pdf / lean;
+                (lean > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(origin, dir),
+                    throughput: wl.unbounded(radiance) / pdf,
+                    emission_pdf: pdf,
+                    cos: 1.0,
+                    delta: beam.sun.is_none(),
+                    light: number,
+                    normal: dir,
+                    far: true,
+                    origin: None,
+                })
+            }
+            Light::Environment(env) => {
+                // A direction by the sky's own sampling, then a start across that beam.
+                let sky = env.sample(u_dir)?;
+                let dir = -sky.wi;
+                let (origin, plane_pdf) = self.sky_beam(dir).sample(rng.uniform(), rng.uniform(), u)?;
+                let pdf = pick * sky.pdf * plane_pdf;
+                (pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(origin, dir),
+                    throughput: wl.unbounded(sky.radiance) / pdf,
+                    emission_pdf: pdf,
+                    cos: 1.0,
+                    delta: false,
+                    light: number,
+                    normal: dir,
+                    far: true,
+                    origin: None,
+                })
+            }
+            Light::Soft(light) => {
+                // A point uniform by area, then a cosine-weighted direction (or an aimed one).
+                let s = light.sample_point(u);
+                let dir = match self.aimed(s.point, rng) {
+                    Some(aimed) => aimed?,
+                    None => Frame::from_normal(s.normal).to_world(sample_cosine_hemisphere(u_dir)),
+                };
+                let cos = dir.dot(s.normal);
+                let pdf = pick * self.direction_pdf(s.point, dir, cos.max(0.0) / PI) / light.area();
+                (cos > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(s.point, dir),
+                    throughput: wl.unbounded(s.radiance) * (cos / pdf),
+                    emission_pdf: pdf,
+                    cos,
+                    // No ray meets it: camera paths never reach it but by next-event estimation.
+                    delta: true,
+                    light: number,
+                    normal: s.normal,
+                    far: false,
+                    origin: Some(EmissionPoint {
+                        point: s.point,
+                        normal: s.normal,
+                        faces: EmittingFaces::Front,
+                        radiance: wl.unbounded(s.radiance) * (light.area() / pick),
+                    }),
+                })
+            }
+        }
+    }
+
+    /// Area density with which next-event estimation from `from` draws the start of `e`.
+    pub fn direct_pdf(&self, scene: &Scene, e: &Emission, from: Vec3) -> f32 {
+        let lights = scene.lights();
+        let choice = lights.direct_probability(e.light);
+        match lights.get(e.light) {
+            Some(Light::Area(light)) => {
+                let to = from - e.ray.origin;
+                let d2 = to.length_squared();
+                let cos = e.normal.dot(to).abs() / d2.sqrt();
+                choice * light.pdf_towards(from, e.ray.origin, e.normal) * cos / d2
+            }
+            Some(Light::Soft(light)) => choice * light.pdf_area_towards(from, e.ray.origin, e.normal),
+            // A sun's and the sky's are per solid angle (no distance to a far light).
+            Some(Light::Sun { .. }) => choice * self.beams[e.light].as_ref().map_or(0.0, Beam::direction_pdf),
+            Some(Light::Environment(env)) => choice * env.pdf(-e.ray.dir),
+            _ => choice,
+        }
+    }
+
+    /// What a camera path leaving `from` in direction `dir` (unit) sees of far light `number`
+    /// (a sun or the sky): its radiance, next-event estimation's solid-angle density of that
+    /// direction, and emission's density of the subpath that would have come along it (`None`:
+    /// the light is neither or starts no subpaths, or `dir` misses the sun).
+    pub fn far_seen(&self, scene: &Scene, number: usize, from: Vec3, dir: Vec3) -> Option<(Vec3, f32, f32)> {
+        if !self.emits(number) {
+            return None;
+        }
+        let choice = scene.lights().direct_probability(number);
+        let emit = self.probability[number];
+        match scene.lights().get(number)? {
+            light @ Light::Sun { .. } => {
+                let beam = self.beams.get(number)?.as_ref()?;
+                if !beam.holds(-dir) {
+                    return None;
+                }
+                let direct = choice * beam.direction_pdf();
+                let emission = emit * beam.direction_pdf() * beam.across_pdf(from, -dir);
+                Some((light.sun_radiance(), direct, emission))
+            }
+            Light::Environment(env) => {
+                let pdf = env.pdf(dir);
+                let emission = emit * pdf * self.sky_beam(-dir).across_pdf(from, -dir);
+                Some((env.radiance(dir), choice * pdf, emission))
+            }
+            _ => None,
+        }
+    }
+
+    /// The sky's beam travelling in `dir`.
+    fn sky_beam(&self, dir: Vec3) -> Beam {
+        let (targets, share) = self.far.as_ref().map_or((&[][..], 0.0), |a| (a.targets(), a.share()));
+        Beam::new(dir, None, self.sphere, targets, share)
+    }
+
+    /// Emission's density (point × direction, choice included) of leaving emissive object
+    /// `light` (number `number`) at `point`, of unit normal `normal`, in direction `dir`.
+    pub fn emission_pdf(&self, number: usize, light: &AreaLight, point: Vec3, normal: Vec3, dir: Vec3) -> f32 {
+        if !light.faces.emit_towards(normal, dir) {
+            return 0.0;
+        }
+        let plain = normal.dot(dir).abs() / (PI * light.faces.count());
+        self.probability[number] * self.start_pdf(light, point, normal, dir, plain)
+    }
+
+    /// Emission's density (point × direction, choice included) of the start that next-event
+    /// estimation's sample `s` of light `number`, taken from `from`, joins: the light subpath
+    /// that would have left the light's point towards `from`.
+    pub fn emission_pdf_of(&self, scene: &Scene, number: usize, s: &DirectSample, from: Vec3) -> f32 {
+        let emit = self.probability.get(number).copied().unwrap_or(0.0);
+        if emit <= 0.0 {
+            return 0.0;
+        }
+        let out = -s.wi;
+        match scene.lights().get(number) {
+            Some(light @ (Light::Point { .. } | Light::Spot { .. })) => {
+                emit * self.direction_pdf(s.point, out, Self::point_plain_pdf(light, out))
+            }
+            Some(Light::Area(light)) => self.emission_pdf(number, light, s.point, s.normal, out),
+            Some(Light::Directional { .. } | Light::Sun { .. }) => self.beams[number]
+                .as_ref()
+                .map_or(0.0, |beam| emit * beam.direction_pdf() * beam.across_pdf(from, out)),
+            Some(Light::Environment(env)) => emit * env.pdf(s.wi) * self.sky_beam(out).across_pdf(from, out),
+            Some(Light::Soft(light)) => emit * self.direction_pdf(s.point, out, s.cos_light / PI) / light.area(),
+            None => 0.0,
+        }
+    }
 }
 
 /// The sign of the normal a cosine-weighted emission leaves along, and the direction's own
@@ -545,63 +504,6 @@ pub(crate) fn emitting_side(light: &AreaLight, u: Vec2) -> (f32, Vec2) {
         None if u.x < 0.5 => (1.0, Vec2::new(u.x * 2.0, u.y)),
         None => (-1.0, Vec2::new(u.x * 2.0 - 1.0, u.y)),
     }
-}
-
-/// A photon from a light with a size: a point uniform on it, then a direction cosine-weighted
-/// about its normal, or (aimed) from the mixture of the cones from that point to the targets;
-/// its flux is L·cos·A / pdf(direction).
-fn emit_from_soft(
-    light: &super::SoftLight,
-    targets: Option<&[Target]>,
-    wl: &Wavelengths,
-    rng: &mut Rng,
-) -> Option<EmittedPhoton> {
-    let s = light.sample_point(rng.uniform2());
-    let u = rng.uniform2();
-    let (dir, pdf) = match targets {
-        None => {
-            let dir = Frame::from_normal(s.normal).to_world(sample_cosine_hemisphere(u));
-            (dir, dir.dot(s.normal).max(0.0) / PI)
-        }
-        Some(targets) => {
-            let cones: Vec<ConeLobe> = targets.iter().map(|t| cone_towards(s.point, t)).collect();
-            let weights: Vec<f32> = cones.iter().map(|c| 1.0 - c.cos_max).collect();
-            let total: f32 = weights.iter().sum();
-            if total.is_nan() || total <= 0.0 {
-                return None;
-            }
-            let mut pick = rng.uniform() * total;
-            let lobe = weights
-                .iter()
-                .position(|w| {
-                    pick -= w;
-                    pick < 0.0
-                })
-                .unwrap_or(cones.len() - 1);
-            let dir = sample_uniform_cone(u, cones[lobe].axis, cones[lobe].cos_max);
-            let pdf: f32 = cones
-                .iter()
-                .zip(&weights)
-                .filter(|(c, _)| c.cos_max <= -1.0 || dir.dot(c.axis) >= c.cos_max)
-                .map(|(c, w)| w / total / (2.0 * PI * (1.0 - c.cos_max)))
-                .sum();
-            (dir, pdf)
-        }
-    };
-    let cos = dir.dot(s.normal);
-    if !(cos > 0.0 && pdf > 0.0) {
-        return None;
-    }
-    Some(EmittedPhoton {
-        ray: Ray::new(s.point, dir),
-        flux: wl.unbounded(s.radiance) * (cos * light.area() / pdf),
-        origin: Some(EmissionPoint {
-            point: s.point,
-            normal: s.normal,
-            faces: EmittingFaces::Front,
-            radiance: wl.unbounded(s.radiance) * light.area(),
-        }),
-    })
 }
 
 /// The radiance an emissive object sends from its sampled point `sample`, at the wavelengths
@@ -630,16 +532,25 @@ fn emission_at(scene: &Scene, sample: &AreaSample) -> Vec3 {
 mod tests {
     use super::*;
 
-    /// Uniform, aimed only, and aimed with a third spread everywhere: each must carry the same
-    /// expected flux.
-    fn aims(targets: &[Target]) -> [Option<Aim<'_>>; 3] {
-        [
-            None,
-            Some(Aim { targets, spread: 0.0 }),
-            Some(Aim { targets, spread: 0.3 }),
-        ]
-    }
+    use crate::light::aim::Target;
+    use crate::math::Aabb;
     use crate::scene::build::test_scene as scene;
+
+    /// Uniform, aimed only, and aimed with 0.7 of the light: each must carry the same expected
+    /// flux.
+    fn aims(targets: &[Target]) -> [Option<Aim>; 3] {
+        [None, Aim::every(targets, 1.0), Aim::every(targets, 0.7)]
+    }
+
+    /// `light` alone in an empty scene, with its emitters aimed as `aim` says (near and far
+    /// alike), across the sphere around `bounds`.
+    fn emitters_of(light: &Light, aim: Option<Aim>, bounds: Aabb) -> (Scene, Emitters) {
+        let mut s = scene("");
+        s.set_lights(vec![light.clone()]);
+        let sphere = Target::around(&bounds);
+        let e = Emitters::new(s.lights().as_slice(), (sphere.center, sphere.radius), aim.clone(), aim);
+        (s, e)
+    }
 
     fn bounds() -> Aabb {
         Aabb::new(Vec3::splat(-10.0), Vec3::splat(10.0))
@@ -672,14 +583,15 @@ mod tests {
         let cos_max = (1.0f32 - 1.0 / 25.0).sqrt();
         let exact = 2.0 * PI * (1.0 - cos_max); // intensity 1 × solid angle of the first sphere
         for aim in aims(&targets) {
-            let e = Emitter::new(&light, aim, Target::around(&bounds())).unwrap();
+            let (s, e) = emitters_of(&light, aim.clone(), bounds());
             let mut rng = Rng::new(1, 0);
-            let empty = scene("");
             let n = 200_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                let photon = e.sample(&light, &empty, &Wavelengths::Rgb, &mut rng).unwrap();
-                let (ray, power) = (photon.ray, photon.flux);
+                let Some(photon) = e.emit_from(&s, 0, &Wavelengths::Rgb, &mut rng) else {
+                    continue;
+                };
+                let (ray, power) = (photon.ray, photon.throughput);
                 let to = target.center - ray.origin;
                 if ray.dir.dot(to.normalize()) >= cos_max {
                     sum += power.x as f64;
@@ -712,14 +624,15 @@ mod tests {
         let exact = 2.0 * PI; // irradiance 2 through the unit disc across the beam
         for aim in aims(&targets) {
             let small = Aabb::new(Vec3::splat(-3.0), Vec3::splat(3.0));
-            let e = Emitter::new(&light, aim, Target::around(&small)).unwrap();
+            let (s, e) = emitters_of(&light, aim.clone(), small);
             let mut rng = Rng::new(2, 0);
-            let empty = scene("");
             let n = 2_000_000;
             let mut sum = 0.0f64;
             for _ in 0..n {
-                let photon = e.sample(&light, &empty, &Wavelengths::Rgb, &mut rng).unwrap();
-                let (ray, power) = (photon.ray, photon.flux);
+                let Some(photon) = e.emit_from(&s, 0, &Wavelengths::Rgb, &mut rng) else {
+                    continue;
+                };
+                let (ray, power) = (photon.ray, photon.throughput);
                 let p = ray.origin;
                 if p.x * p.x + p.y * p.y <= 1.0 {
                     sum += power.x as f64;
@@ -764,7 +677,7 @@ mod tests {
             let mut sum = 0.0f64;
             for _ in 0..n {
                 if let Some(p) = lights.emit(&s, &Wavelengths::Rgb, &mut rng) {
-                    sum += p.flux.x as f64;
+                    sum += p.throughput.x as f64;
                     let outside = (p.ray.origin - Vec3::ZERO).dot(p.ray.dir) > 0.0;
                     assert!(outside || !outward, "an outward-only lamp emitted inwards");
                 }
@@ -799,10 +712,8 @@ mod tests {
             center: Vec3::new(0.7, -0.2, 0.4),
             radius: 0.6,
         };
-        let scene_sphere = Target {
-            center: Vec3::ZERO,
-            radius: 3.0,
-        };
+        // The box whose sphere has radius 3.
+        let scene_box = Aabb::new(Vec3::splat(-1.732), Vec3::splat(1.732));
         let lights = [
             (
                 Light::Directional {
@@ -817,23 +728,22 @@ mod tests {
             ),
             (Light::Environment(sky), PI * 0.36 * sky_flux_density),
         ];
-        let empty = scene("");
         for (light, exact) in lights {
             let targets = [target];
             for aim in aims(&targets) {
-                let e = Emitter::new(&light, aim, scene_sphere).unwrap();
+                let (s, e) = emitters_of(&light, aim.clone(), scene_box);
                 let mut rng = Rng::new(4, 0);
                 let n = 400_000;
                 let mut sum = 0.0f64;
                 for _ in 0..n {
-                    let Some(p) = e.sample(&light, &empty, &Wavelengths::Rgb, &mut rng) else {
+                    let Some(p) = e.emit_from(&s, 0, &Wavelengths::Rgb, &mut rng) else {
                         continue;
                     };
                     // Does the ray pass through the sphere?
                     let oc = target.center - p.ray.origin;
                     let t = oc.dot(p.ray.dir);
                     if t > 0.0 && (oc - p.ray.dir * t).length_squared() <= target.radius * target.radius {
-                        sum += crate::math::luminance(p.flux.truncate()) as f64;
+                        sum += crate::math::luminance(p.throughput.truncate()) as f64;
                     }
                 }
                 let estimate = sum / n as f64;

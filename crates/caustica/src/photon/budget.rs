@@ -15,7 +15,8 @@
 
 use super::trace::{trace_batch, trace_path, CourseModel, BATCH};
 use super::Photon;
-use crate::light::emission::{caustic_targets, Aim, Emitter, Target};
+use crate::light::aim::{caustic_targets, Aim};
+use crate::light::emission::Emitters;
 use crate::light::Light;
 use crate::math::luminance;
 use crate::progress::Control;
@@ -170,12 +171,20 @@ const PILOT_EMITTED: u64 = 1 << 16;
 /// reached, sharing the budget by delivered power (or as `settings.per_light` says).
 pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control) -> (Vec<Photon>, PhotonStats) {
     let start = Instant::now();
-    let lights: Vec<&Light> = scene.lights().course_lights().collect();
+    let (numbers, lights): (Vec<usize>, Vec<&Light>) = scene
+        .lights()
+        .iter()
+        .enumerate()
+        .filter(|(_, light)| light.is_course_light())
+        .unzip();
     let mut stats = PhotonStats {
         per_light: vec![(0, 0); lights.len()],
         ..PhotonStats::default()
     };
-    let (emitters, none) = emitters(scene, settings, &lights);
+    let (emitters, none) = emitters(scene, settings);
+    // Each course light's number among the scene's lights, where it emits.
+    let emitting: Vec<Option<usize>> = numbers.iter().map(|&n| emitters.emits(n).then_some(n)).collect();
+    let none = none.or_else(|| emitting.iter().all(Option::is_none).then_some(NoCaustics::NoLight));
     if let Some(reason) = none {
         stats.none = Some(reason);
         stats.seconds = start.elapsed().as_secs_f64();
@@ -188,9 +197,10 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
     let cap = settings.emission_cap();
     control.progress.start("photons", budget as u64);
     let tracer = |index: usize| {
-        emitters[index].as_ref().map(|emitter| Tracer {
+        emitting[index].map(|number| Tracer {
             scene,
-            emitter,
+            emitters: &emitters,
+            number,
             model: CourseModel {
                 light: lights[index],
                 first_hit: settings.first_hit,
@@ -203,7 +213,7 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
     };
 
     // The pilot: a few photons from each light, kept as the start of its run.
-    let active = emitters.iter().flatten().count() as u64;
+    let active = emitting.iter().flatten().count() as u64;
     let pilot_cap = PILOT_EMITTED.min(cap / (4 * active).max(1)).max(1);
     let mut runs: Vec<LightRun> = (0..lights.len())
         .map(|index| {
@@ -230,7 +240,7 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
     let shares: Vec<usize> = match &settings.per_light {
         Some(counts) => (0..lights.len())
             .map(|i| {
-                if emitters[i].is_some() {
+                if emitting[i].is_some() {
                     counts.get(i).copied().unwrap_or(0)
                 } else {
                     0
@@ -278,11 +288,10 @@ pub fn trace_photons(scene: &Scene, settings: &PhotonSettings, control: Control)
     (photons, stats)
 }
 
-/// Each light's emitter, or why no photon can make a caustic (known before emitting any).
-fn emitters(scene: &Scene, settings: &PhotonSettings, lights: &[&Light]) -> (Vec<Option<Emitter>>, Option<NoCaustics>) {
+/// The lights' emitters, every one aimed at the caustics' sources only (unless the settings
+/// say otherwise), or why no photon can make a caustic (known before emitting any).
+fn emitters(scene: &Scene, settings: &PhotonSettings) -> (Emitters, Option<NoCaustics>) {
     let targets = caustic_targets(scene);
-    let aim = settings.aim && !settings.first_hit;
-    let bounds = scene.bounds();
     let none = if settings.first_hit {
         None
     } else if targets.is_empty() {
@@ -293,20 +302,16 @@ fn emitters(scene: &Scene, settings: &PhotonSettings, lights: &[&Light]) -> (Vec
         None
     };
     if none.is_some() {
-        return (lights.iter().map(|_| None).collect(), none);
+        return (Emitters::default(), none);
     }
-    let emitters: Vec<Option<Emitter>> = lights
-        .iter()
-        .map(|light| {
-            let aim = aim.then_some(Aim {
-                targets: &targets,
-                spread: 0.0,
-            });
-            Emitter::new(light, aim, Target::around(&bounds))
-        })
-        .collect();
-    let none = emitters.iter().all(Option::is_none).then_some(NoCaustics::NoLight);
-    (emitters, none)
+    let aim = if settings.aim && !settings.first_hit {
+        Aim::every(&targets, 1.0)
+    } else {
+        None
+    };
+    let lights = scene.lights();
+    let emitters = Emitters::new(lights.as_slice(), lights.scene_sphere(), aim.clone(), aim);
+    (emitters, None)
 }
 
 /// `budget` shared in proportion to `weights` by largest remainder: the shares sum to the
@@ -343,7 +348,9 @@ fn share_out(budget: usize, weights: &[f64]) -> Vec<usize> {
 /// Emits one light's photons.
 struct Tracer<'a> {
     scene: &'a Scene,
-    emitter: &'a Emitter,
+    emitters: &'a Emitters,
+    /// The light's number among the scene's lights.
+    number: usize,
     model: CourseModel<'a>,
     light_index: usize,
     settings: &'a PhotonSettings,
@@ -399,7 +406,8 @@ impl LightRun {
     fn extend(&mut self, tracer: &Tracer, want: usize, cap: u64, cut: Cut) {
         let Tracer {
             scene,
-            emitter,
+            emitters,
+            number,
             model,
             light_index,
             settings,
@@ -427,12 +435,12 @@ impl LightRun {
                     let count = BATCH.min(cap - first.min(cap));
                     trace_batch(first..first + count, |i, out| {
                         let mut rng = Rng::new(settings.seed, stream | i);
-                        if let Some(photon) = emitter.sample(model.light, scene, &Wavelengths::Rgb, &mut rng) {
+                        if let Some(photon) = emitters.emit_from(scene, *number, &Wavelengths::Rgb, &mut rng) {
                             trace_path(
                                 scene,
                                 model,
                                 photon.ray,
-                                photon.flux,
+                                photon.throughput,
                                 settings.max_bounces,
                                 &mut rng,
                                 out,

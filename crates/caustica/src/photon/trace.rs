@@ -59,7 +59,7 @@ pub fn trace_count(
             let (photons, _) = trace_batch(first..(first + BATCH).min(count), |i, out| {
                 let mut rng = Rng::new(seed, (stream << 40) ^ i);
                 if let Some(emitted) = lights.emit(scene, wl, &mut rng) {
-                    let flux = emitted.flux * scale;
+                    let flux = emitted.throughput * scale;
                     let model = PhysicalModel { wl: *wl, max_bounces };
                     trace_path(scene, &model, emitted.ray, flux, max_bounces, &mut rng, out);
                 }

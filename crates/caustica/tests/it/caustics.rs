@@ -400,7 +400,7 @@ fn photons_gain_no_power_inside_glass() {
          scale(30, square { material = { diffuse = (1, 1, 1); } })",
     );
     let map = trace(&scene, photons(50_000), 100);
-    let targets = caustica::light::emission::caustic_targets(&scene);
+    let targets = caustica::light::aim::caustic_targets(&scene);
     assert_eq!(targets.len(), 1);
     let emitted_power = std::f32::consts::PI * targets[0].radius.powi(2) / map.stats.emitted as f32;
     let largest = map

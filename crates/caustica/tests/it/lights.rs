@@ -121,7 +121,7 @@ fn spot_light_lights_its_cone() {
     let mut sum = 0.0f64;
     for _ in 0..n {
         if let Some(p) = s.lights().emit(&s, &Wavelengths::Rgb, &mut rng) {
-            sum += p.flux.x as f64;
+            sum += p.throughput.x as f64;
         }
     }
     let cos = |deg: f32| deg.to_radians().cos();
