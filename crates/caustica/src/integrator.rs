@@ -213,7 +213,14 @@ fn check_radius(radius: InitialRadius) -> Result<()> {
 
 /// An integrator that renders the image as a series of independent passes.
 pub trait Progressive: Send + Sync {
-    /// Renders pass `pass` (global index); `None` when cancelled.
+    /// Work done once before the first pass (pilot runs that choose the passes' settings);
+    /// `false` when cancelled. [`RenderSession`] runs it; a caller driving passes itself calls
+    /// it first.
+    fn prepare(&mut self, _control: Control) -> bool {
+        true
+    }
+
+    /// Renders pass `pass` (global index); `None` when cancelled (or not prepared).
     fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>>;
 
     /// The time pass `pass` takes relative to a full pass, for a time limit's plan.

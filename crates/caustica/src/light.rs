@@ -495,7 +495,7 @@ impl LightSet {
     }
 
     /// Samples light `index`, taken with probability `p_pick`, for the point `hit`.
-    pub(crate) fn sample_light(
+    pub fn sample_light(
         &self,
         index: usize,
         p_pick: f32,

@@ -190,6 +190,8 @@ pub struct RenderSession<'a> {
     /// The course model's image (kept as it is: one pass needs no sums).
     whitted_image: Option<Film>,
     passes: Option<Box<dyn Progressive + 'a>>,
+    /// Whether the integrator's work before its first pass is done ([`Progressive::prepare`]).
+    prepared: bool,
     caustic_map: Option<PhotonMap>,
     photon_seconds: f64,
 }
@@ -224,6 +226,7 @@ impl<'a> RenderSession<'a> {
             },
             whitted_image: None,
             passes,
+            prepared: false,
             caustic_map: None,
             photon_seconds: 0.0,
         })
@@ -275,8 +278,25 @@ impl<'a> RenderSession<'a> {
         self.render_sized_pass(pass, None, control)
     }
 
+    /// Runs the integrator's work before its first pass (vcm's pilots), once; `false` when
+    /// cancelled (it runs again on the next call). Passes run it themselves when it has not
+    /// been run; a caller that times its run calls it within the time.
+    pub fn prepare(&mut self, control: Control) -> bool {
+        if !self.prepared {
+            if let Some(passes) = &mut self.passes {
+                self.prepared = passes.prepare(control);
+            } else {
+                self.prepared = true;
+            }
+        }
+        self.prepared
+    }
+
     /// [`RenderSession::render_pass`], at `share` of a full pass when given.
     pub fn render_sized_pass(&mut self, pass: u64, share: Option<f64>, control: Control) -> bool {
+        if self.passes.is_some() && !self.prepare(control) {
+            return false;
+        }
         if let Some(passes) = &self.passes {
             let (pixels, weight) = match share {
                 Some(share) => (passes.render_share(pass, share, control), share),
@@ -339,6 +359,8 @@ impl<'a> RenderSession<'a> {
             (_, Some(t)) => ((t * 10.0).ceil() as u64, true),
             (None, None) => (DEFAULT_PASSES, false),
         };
+        // The pilots count in the time limit (the passes' sizes leave room for them).
+        self.prepare(control);
         control.progress.start("passes", bar_total);
         let mut reported = 0u64;
         let mut pass = plan.first;

@@ -16,7 +16,15 @@ use caustica::integrator::radius::InitialRadius;
 use caustica::integrator::vcm::{Vcm, VcmSettings};
 use caustica::integrator::Progressive;
 use caustica::math::Vec3;
+use caustica::scene::Scene;
 use std::f32::consts::PI;
+
+/// A vcm renderer with its pilots run, as a session runs them before the first pass.
+fn prepared<'a>(s: &'a Scene, settings: VcmSettings, width: usize, height: usize, seed: u64) -> Vcm<'a> {
+    let mut vcm = Vcm::new(s, settings, width, height, seed);
+    assert!(vcm.prepare(control()), "the pilots were cancelled");
+    vcm
+}
 
 /// A point light over a Lambertian floor seen from above (as in light_tracing.rs): each
 /// floor point sends L = ρ/π · I cos θ / d² towards the eye.
@@ -64,7 +72,7 @@ fn vcm_matches_a_point_light_over_a_diffuse_plane() {
             connections,
             ..VcmSettings::default()
         };
-        let vcm = Vcm::new(&s, settings, 32, 32, 5);
+        let vcm = prepared(&s, settings, 32, 32, 5);
         let film = render_passes(&vcm, 32, 32, 0, 16).film();
         let err = plane_error(&s, &film);
         eprintln!(
@@ -130,7 +138,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
             connections,
             ..VcmSettings::default()
         };
-        let vcm = Vcm::new(&s, settings, 32, 32, 2);
+        let vcm = prepared(&s, settings, 32, 32, 2);
         let got = quadrants(&render_passes(&vcm, 32, 32, 0, 256).film());
         for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
             eprintln!("connections {connections}, quadrant {i}: vcm {g:.4} path {r:.4}");
@@ -147,7 +155,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
         max_depth: depth,
         ..VcmSettings::default()
     };
-    let vcm = Vcm::new(&s, settings, 32, 32, 4);
+    let vcm = prepared(&s, settings, 32, 32, 4);
     let mut acc = Accumulator::new(32, 32, "resized");
     for pass in 0..256 {
         let share = if pass % 2 == 0 { 0.25 } else { 1.75 };
@@ -199,7 +207,7 @@ fn vcm_merges_behind_coated_glass() {
         max_depth: depth,
         ..VcmSettings::default()
     };
-    let vcm = Vcm::new(&s, settings, 32, 32, 2);
+    let vcm = prepared(&s, settings, 32, 32, 2);
     let got = quadrants(&render_passes(&vcm, 32, 32, 0, 256).film());
     for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
         eprintln!("quadrant {i}: vcm {g:.4} path {r:.4} ({:+.2}%)", (g / r - 1.0) * 100.0);
@@ -230,8 +238,32 @@ fn vcm_is_deterministic_and_merges() {
             connections,
             ..VcmSettings::default()
         };
-        assert_deterministic_and_merges(&Vcm::new(&s, settings, 32, 32, 7), 32, 32);
+        assert_deterministic_and_merges(&prepared(&s, settings, 32, 32, 7), 32, 32);
     }
+}
+
+/// The pilots run once, before the first pass, and a cancel stops them: a cancelled prepare
+/// keeps nothing, passes before the pilots render nothing, and a prepare run afterwards gives
+/// the same passes as an uninterrupted one.
+#[test]
+fn vcm_pilots_are_a_cancellable_step_before_the_passes() {
+    use caustica::progress::{Control, NoProgress};
+    use std::sync::atomic::AtomicBool;
+    let s = scene(DIFFUSE_BOX);
+    let mut vcm = Vcm::new(&s, VcmSettings::default(), 32, 32, 7);
+    assert!(vcm.render_pass(0, control()).is_none(), "a pass before the pilots");
+    assert_eq!(vcm.chosen_paths_per_pass(), None);
+    let cancelled = AtomicBool::new(true);
+    let stop = Control {
+        progress: &NoProgress,
+        cancel: &cancelled,
+    };
+    assert!(!vcm.prepare(stop), "cancelled pilots reported done");
+    assert!(vcm.render_pass(0, control()).is_none());
+    assert!(vcm.prepare(control()));
+    let whole = prepared(&s, VcmSettings::default(), 32, 32, 7);
+    assert_eq!(vcm.chosen_paths_per_pass(), whole.chosen_paths_per_pass());
+    assert_eq!(vcm.render_pass(0, control()), whole.render_pass(0, control()));
 }
 
 /// With the default light subpath count the first two passes trace half as many and weigh
@@ -240,7 +272,7 @@ fn vcm_is_deterministic_and_merges() {
 #[test]
 fn vcm_passes_weigh_their_light_subpaths() {
     let s = scene(DIFFUSE_BOX);
-    let vcm = Vcm::new(&s, VcmSettings::default(), 32, 32, 7);
+    let vcm = prepared(&s, VcmSettings::default(), 32, 32, 7);
     assert_eq!(
         (vcm.pass_weight(0), vcm.pass_weight(1), vcm.pass_weight(2)),
         (0.5, 0.5, 1.0)
@@ -283,7 +315,7 @@ fn vcm_converges_to_the_cornell_references() {
             max_depth: REFERENCE_DEPTH,
             ..VcmSettings::default()
         };
-        let vcm = Vcm::new(&s, settings, w, h, 21);
+        let vcm = prepared(&s, settings, w, h, 21);
         let film = render_passes(&vcm, w, h, 0, PASSES).film();
         let (worst, text) = report(&film, &reference, &REGIONS);
         let caustic = region_error(&film, &reference, CAUSTIC);
@@ -456,7 +488,7 @@ fn vcm_sends_light_subpaths_from_the_sky() {
         initial_radius: InitialRadius::Pixels(1.0),
         ..VcmSettings::default()
     };
-    let vcm = Vcm::new(&s, settings, n, n, 6);
+    let vcm = prepared(&s, settings, n, n, 6);
     let got = block_means(&render_passes(&vcm, n, n, 0, 1024).film(), &blocks);
     for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
         eprintln!(
@@ -504,7 +536,7 @@ fn vcm_against_light_tracing(src: &str, aims: &[bool], min_lit: f32, lt_passes: 
             initial_radius: InitialRadius::Pixels(1.0),
             ..VcmSettings::default()
         };
-        let vcm = Vcm::new(&s, settings, n, n, 6);
+        let vcm = prepared(&s, settings, n, n, 6);
         let got = means(&render_passes(&vcm, n, n, 0, 384).film());
         for &i in &lit {
             let (g, r) = (got[i], reference[i]);
@@ -588,7 +620,7 @@ fn focus_pixels_take_more_camera_samples() {
                     focus_samples,
                     ..VcmSettings::default()
                 };
-                let film = render_passes(&Vcm::new(&s, settings, w, h, seed), w, h, 0, 1).film();
+                let film = render_passes(&prepared(&s, settings, w, h, seed), w, h, 0, 1).film();
                 let mut sum = 0.0;
                 for y in 135..140 {
                     for x in 41..46 {
@@ -632,7 +664,7 @@ fn vcm_balances_light_subpaths_against_camera_paths() {
     let count = |text: &str, threads: usize| {
         let s = scene(text);
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-        pool.install(|| Vcm::new(&s, VcmSettings::default(), 32, 32, 7).chosen_paths_per_pass())
+        pool.install(|| prepared(&s, VcmSettings::default(), 32, 32, 7).chosen_paths_per_pass())
     };
     let plane = count(PLANE, 1).unwrap();
     let diffuse = count(DIFFUSE_BOX, 1).unwrap();
@@ -656,7 +688,7 @@ fn vcm_balance_weighs_merging_as_its_radius_shrinks() {
             alpha,
             ..VcmSettings::default()
         };
-        Vcm::new(&s, settings, 32, 32, 7).chosen_paths_per_pass().unwrap()
+        prepared(&s, settings, 32, 32, 7).chosen_paths_per_pass().unwrap()
     };
     let (shrinking, kept) = (count(2.0 / 3.0), count(1.0));
     let ratio = shrinking as f64 / kept as f64;

@@ -1,0 +1,359 @@
+//! Camera subpaths: each vertex gathers the emitters it hits, next-event estimation, the
+//! connections to the pass's light vertices and, at its first smooth vertex, merging
+//! ([`super::merging`]), every strategy weighted by [`mis`].
+
+use super::*;
+
+impl<'a> Vcm<'a> {
+    /// Radiance along the camera ray `ray`, joined to the pass's light subpaths (`own`: the
+    /// one this pixel connects to).
+    pub(super) fn camera_path(
+        &self,
+        ray: Ray,
+        pass: &PassData,
+        own: usize,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        work: &mut CameraWork,
+    ) -> Spectrum {
+        let f = &pass.factors;
+        let scene = self.scene;
+        let camera_pdf = self.sensor.importance(ray.dir);
+        if camera_pdf <= 0.0 {
+            return Spectrum::ZERO;
+        }
+        let mut partial = Partial::camera(f, camera_pdf);
+        let mut ray = ray;
+        let mut throughput = wl.grey(1.0);
+        let mut l = Spectrum::ZERO;
+        let mut previous = ray.origin;
+        let mut dispersed = false;
+        // The last bounce's density, for the sky and suns (None: seen directly or by a mirror).
+        let mut last_pdf: Option<f32> = None;
+        // The sums as they would be without merging at the first vertex, taken if the second
+        // turns out to be a mirror or glass (the eye then sees a caustic there), and the sums
+        // with it, kept along the mirrors and glass that follow: light that reached them from
+        // a diffuse surface (not a direct caustic) is merged at the first vertex again.
+        let mut without_first_merge = Partial::default();
+        let mut with_first_merge: Option<Partial> = None;
+        // The sums without merging at the last vertex, for an emitter hit next (light reaches
+        // that vertex first).
+        let mut without_last_merge = Partial::default();
+        // Whether the path scattered off a smooth lobe before: merging is a strategy at the
+        // first vertex where it does (the delta lobes of coated glass, as mirrors and glass,
+        // pass the merge on to the next vertex).
+        let mut smooth_before = false;
+        // Whether the first vertex lies where caustics are focused.
+        let mut first_focused = false;
+        for length in 1..=self.max_length {
+            work.rays += 1;
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                l += throughput * self.escaped(ray.dir, previous, last_pdf, &without_last_merge, length, wl);
+                break;
+            };
+            let hit = scene.surface(&ray, &isect);
+            let wo = -ray.dir;
+            let d2 = (hit.point - previous).length_squared();
+            let bsdf = Bsdf::at(scene, &hit, wo, wl);
+            let cos_in = bsdf.normal().dot(wo).abs();
+            partial.arrive(d2, cos_in);
+            let le = scene.emission_towards(&hit, wo, wl);
+            if le != Spectrum::ZERO {
+                without_last_merge.arrive(d2, cos_in);
+                l += throughput * le * self.emitter_weight(&hit, &without_last_merge, previous, wo, d2, length);
+            }
+            if length == 2 && !bsdf.is_smooth() && first_focused {
+                without_first_merge.arrive(d2, cos_in);
+                with_first_merge = Some(partial);
+                partial = without_first_merge;
+            } else if let Some(mut with) = with_first_merge {
+                with.arrive(d2, cos_in);
+                with_first_merge = Some(with);
+                if bsdf.is_smooth() {
+                    partial = with;
+                    with_first_merge = None;
+                }
+            }
+            if !self.settings.connections && length > 1 {
+                // The sum's first term stands for a connection that makes this vertex (for an
+                // emitter, next-event estimation, counted above).
+                partial.vcm = 0.0;
+            }
+            if length >= self.max_length || bsdf.is_black() {
+                break;
+            }
+            let merges_here = bsdf.is_smooth() && !smooth_before;
+            if length == 1 {
+                first_focused = self.focus.contains(hit.point);
+            }
+            if bsdf.is_smooth() {
+                let v = CameraVertex {
+                    hit: &hit,
+                    bsdf: &bsdf,
+                    wo,
+                    throughput,
+                    partial,
+                    length,
+                    dispersed,
+                };
+                l += self.direct(&v, f, wl, rng, work);
+                let paths = &pass.paths;
+                if self.settings.connections && own + 1 < paths.ends.len() {
+                    let (start, end) = (paths.ends[own] as usize, paths.ends[own + 1] as usize);
+                    for z in &paths.vertices[start..end] {
+                        l += self.connect(&v, z, f, wl, merges_here);
+                    }
+                }
+                if merges_here && f.merge > 0.0 {
+                    let merged = self.merge(&v, pass, work);
+                    work.merged += merged;
+                    l += merged;
+                }
+            }
+            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
+                break;
+            };
+            let cos_out = bsdf.normal().dot(sample.wi).abs();
+            smooth_before |= !sample.specular;
+            if sample.specular {
+                partial.scatter_specular(cos_out);
+                if let Some(with) = with_first_merge.as_mut() {
+                    with.scatter_specular(cos_out);
+                }
+                without_last_merge = partial;
+                if length == 1 {
+                    without_first_merge = partial;
+                }
+                last_pdf = None;
+            } else {
+                let reverse = self.light_pdf(&bsdf, hit.point, wo, bsdf.pdf_reverse(wo, sample.wi));
+                without_last_merge = partial;
+                without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
+                if length == 1 {
+                    without_first_merge = without_last_merge;
+                    // An emitter hit next is direct light at the first vertex: no light tracing
+                    // there either (its term is the sum's first at the eye's first vertex).
+                    without_last_merge = Partial { vcm: 0.0, ..partial };
+                    without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
+                }
+                partial.scatter(f, sample.pdf, reverse, cos_out, merges_here);
+                last_pdf = Some(sample.pdf);
+            }
+            throughput *= sample.weight;
+            if sample.dispersive {
+                wl.terminate_secondary(&mut throughput, &mut dispersed);
+            }
+            if length >= ROULETTE_DEPTH {
+                let q = throughput.max_element().min(0.95);
+                if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                    break;
+                }
+                throughput /= q;
+            }
+            previous = hit.point;
+            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+        }
+        if l.is_finite() {
+            l
+        } else {
+            Spectrum::ZERO
+        }
+    }
+
+    /// What a camera path leaving `from` in `dir` after `length` segments sees of the sky and
+    /// suns: those that start light subpaths weighed against every strategy (`camera`: the
+    /// sums without merging at the last vertex, where light arrives first), any other against
+    /// next-event estimation alone, as in the path tracer (`last_pdf`: the last bounce's).
+    fn escaped(
+        &self,
+        dir: Vec3,
+        from: Vec3,
+        last_pdf: Option<f32>,
+        camera: &Partial,
+        length: u32,
+        wl: &Wavelengths,
+    ) -> Spectrum {
+        let lights = self.scene.lights();
+        let mut l = lights.escaped_weighted_except(dir, last_pdf, wl, |number| self.emitters.emits(number));
+        for number in 0..lights.len() {
+            if let Some((radiance, direct, emission)) = self.emitters.far_seen(self.scene, number, from, dir) {
+                let weight = if length == 1 {
+                    1.0
+                } else {
+                    mis::emitter_hit(
+                        camera,
+                        direct * self.direct_samples(number, length - 1) as f32,
+                        emission,
+                    )
+                };
+                l += wl.unbounded(radiance) * weight;
+            }
+        }
+        l
+    }
+
+    /// The weight of an emitter the camera path hit after `length` segments.
+    fn emitter_weight(&self, hit: &SurfaceHit, camera: &Partial, from: Vec3, wo: Vec3, d2: f32, length: u32) -> f32 {
+        if length == 1 {
+            return 1.0;
+        }
+        let lights = self.scene.lights();
+        let Some((number, light)) = lights.area_light_of(hit) else {
+            return 1.0;
+        };
+        if !self.emitters.emits(number) {
+            return 1.0;
+        }
+        let normal = hit.geometric_normal;
+        // Next-event estimation at the vertex before took this many samples.
+        let samples = self.direct_samples(number, length - 1) as f32;
+        let direct = samples
+            * lights.direct_probability(number)
+            * light.pdf_towards(from, hit.point, normal)
+            * normal.dot(wo).abs()
+            / d2;
+        let emission = self.emitters.emission_pdf(number, light, hit.point, normal, wo);
+        mis::emitter_hit(camera, direct, emission)
+    }
+
+    /// Next-event samples of emitter `number` at the camera vertex `length` segments from the
+    /// eye: [`FIRST_VERTEX_LIGHT_SAMPLES`] for a light with a size at the first, whose penumbrae
+    /// the eye sees directly.
+    fn direct_samples(&self, number: usize, length: u32) -> u32 {
+        match self.scene.lights().get(number) {
+            Some(crate::light::Light::Area(_)) if length == 1 => FIRST_VERTEX_LIGHT_SAMPLES,
+            _ => 1,
+        }
+    }
+
+    /// Next-event estimation at a camera vertex: every light when there are few, else one by
+    /// power (as the path tracer).
+    pub(super) fn direct(
+        &self,
+        v: &CameraVertex,
+        f: &Factors,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        work: &mut CameraWork,
+    ) -> Spectrum {
+        if v.length + 1 > self.max_length {
+            return Spectrum::ZERO;
+        }
+        let lights = self.scene.lights();
+        let mut l = Spectrum::ZERO;
+        let mut one = |number: usize, pick: f32, rng: &mut Rng| {
+            work.rays += 1;
+            if self.emitters.emits(number) {
+                let samples = self.direct_samples(number, v.length);
+                for _ in 0..samples {
+                    let choice = lights.direct_probability(number);
+                    let Some(s) = lights.sample_light(number, choice, self.scene, v.hit, wl, rng) else {
+                        continue;
+                    };
+                    let value = v.bsdf.eval(v.wo, s.wi);
+                    if value == Spectrum::ZERO {
+                        continue;
+                    }
+                    let cos_here = v.bsdf.normal().dot(s.wi).abs();
+                    let pdfs = DirectPdfs {
+                        bsdf: v.bsdf.pdf(v.wo, s.wi),
+                        bsdf_reverse: self.light_pdf(v.bsdf, v.hit.point, v.wo, v.bsdf.pdf_reverse(v.wo, s.wi)),
+                        // Several samples are one strategy of that many times the density.
+                        direct: s.direct_pdf * samples as f32,
+                        emission: self.emitters.emission_pdf_of(self.scene, number, &s, v.hit.point),
+                        cos_here,
+                        cos_light: s.cos_light,
+                        delta: s.delta,
+                    };
+                    // Light reaches this vertex first: merging is no strategy here, and light
+                    // tracing none either if it is the eye's first (the sum's first term there).
+                    let camera = if v.length == 1 {
+                        Partial { vcm: 0.0, ..v.partial }
+                    } else {
+                        v.partial
+                    };
+                    let weight = mis::direct(f, &camera, &pdfs, false);
+                    l += v.throughput * value * s.contribution * (cos_here * weight / samples as f32);
+                }
+            } else if let Some(s) = lights.sample_light(number, pick, self.scene, v.hit, wl, rng) {
+                // Far lights and lights with a size: the camera's strategies only.
+                let value = v.bsdf.eval(v.wo, s.wi);
+                let weight = if s.pdf > 0.0 {
+                    power_heuristic(s.pdf, v.bsdf.pdf(v.wo, s.wi))
+                } else {
+                    1.0
+                };
+                l += v.throughput * value * s.contribution * (v.bsdf.normal().dot(s.wi).abs() * weight);
+            }
+        };
+        if lights.samples_every_light() {
+            for number in 0..lights.len() {
+                if lights.direct_probability(number) > 0.0 {
+                    one(number, 1.0, rng);
+                }
+            }
+        } else if let Some((number, pick)) = lights.pick_for_direct(rng.uniform()) {
+            one(number, pick, rng);
+        }
+        l
+    }
+
+    /// A connection between a camera vertex and a light vertex (`camera_merges`: merging is a
+    /// strategy at the camera vertex).
+    fn connect(
+        &self,
+        v: &CameraVertex,
+        z: &LightVertex,
+        f: &Factors,
+        wl: &Wavelengths,
+        camera_merges: bool,
+    ) -> Spectrum {
+        if v.length + z.length + 1 > self.max_length {
+            return Spectrum::ZERO;
+        }
+        let to = z.hit.point - v.hit.point;
+        let d2 = to.length_squared();
+        if !(d2 > 0.0 && d2.is_finite()) {
+            return Spectrum::ZERO;
+        }
+        let dir = to / d2.sqrt();
+        let camera_f = v.bsdf.eval(v.wo, dir);
+        if camera_f == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        let light_bsdf = Bsdf::at(self.scene, &z.hit, z.wo, wl);
+        let light_f = light_bsdf.eval(z.wo, -dir);
+        if light_f == Spectrum::ZERO {
+            return Spectrum::ZERO;
+        }
+        let cos_camera = v.bsdf.normal().dot(dir).abs();
+        let cos_light = light_bsdf.normal().dot(dir).abs();
+        let pdfs = ConnectionPdfs {
+            camera_to_light: v.bsdf.pdf(v.wo, dir) * cos_light / d2,
+            camera_reverse: self.light_pdf(v.bsdf, v.hit.point, v.wo, v.bsdf.pdf_reverse(v.wo, dir)),
+            light_to_camera: self.light_pdf(&light_bsdf, z.hit.point, -dir, light_bsdf.pdf(z.wo, -dir)) * cos_camera
+                / d2,
+            light_reverse: light_bsdf.pdf_reverse(z.wo, -dir),
+        };
+        // The camera vertex is smooth, so merging is no strategy at the light vertex.
+        let weight = mis::connection(f, &v.partial, &z.partial, &pdfs, (camera_merges, false));
+        let (ng_c, ng_l) = (v.hit.geometric_normal, z.hit.geometric_normal);
+        let side_c = if ng_c.dot(dir) >= 0.0 { ng_c } else { -ng_c };
+        let side_l = if ng_l.dot(dir) <= 0.0 { ng_l } else { -ng_l };
+        if !self.scene.segment_clear(v.hit.point, side_c, z.hit.point, side_l) {
+            return Spectrum::ZERO;
+        }
+        let g = cos_camera * cos_light / d2;
+        v.throughput * camera_f * light_f * z.throughput * (g * weight * both_dispersed(v.dispersed, z.dispersed))
+    }
+}
+
+/// Both subpaths kept only the hero wavelength, so each scaled it by the number of wavelengths:
+/// one of the factors goes.
+pub(super) fn both_dispersed(a: bool, b: bool) -> f32 {
+    if a && b {
+        1.0 / SAMPLES as f32
+    } else {
+        1.0
+    }
+}

@@ -1,0 +1,310 @@
+//! Light subpaths: traced from the lights' emission ([`Emitters`]), each smooth vertex stored
+//! for connections and merging and joined to the eye (light tracing), a share of the bounces
+//! off Lambertian surfaces aimed at the mirrors and glass.
+
+use super::*;
+
+impl<'a> Vcm<'a> {
+    /// Traces light subpath `index` of pass `pass`: stores its smooth vertices and joins each
+    /// to the eye.
+    /// (The pilot run, `to_eye` false, only stores.)
+    fn trace_light(&self, pass: u64, index: u64, f: &Factors, wl: &Wavelengths, to_eye: bool, out: &mut LightPaths) {
+        let connected = self.settings.connections && index < self.pixels() as u64;
+        let scene = self.scene;
+        let mut rng = Rng::new(self.seed ^ LIGHT_SEED, (pass << 40) ^ index);
+        let Some(emission) = self.emitters.emit(scene, wl, &mut rng) else {
+            return;
+        };
+        let mut throughput = emission.throughput;
+        let start = throughput.max_element();
+        let mut partial = Partial::default();
+        let mut ray = emission.ray;
+        let mut previous = emission.ray.origin;
+        let mut dispersed = false;
+        // Only mirrors and glass so far.
+        let mut all_specular = true;
+        for length in 1..self.max_length {
+            out.rays += 1;
+            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+                return;
+            };
+            let hit = scene.surface(&ray, &isect);
+            let wo = -ray.dir;
+            let bsdf = Bsdf::at(scene, &hit, wo, wl);
+            if length == 1 {
+                // Next-event estimation's density of the light point depends on where it is
+                // seen from (a sphere is sampled by its cone).
+                let direct = self.emitters.direct_pdf(scene, &emission, hit.point);
+                partial = Partial::light(f, emission.emission_pdf, direct, emission.cos, emission.delta);
+            }
+            // A far light's densities are across its beam: no distance to its first vertex.
+            let d2 = if length == 1 && emission.far {
+                1.0
+            } else {
+                (hit.point - previous).length_squared()
+            };
+            partial.arrive(d2, bsdf.normal().dot(wo).abs());
+            if !self.settings.connections && length > 1 {
+                // The sum's first term stands for a connection that makes this vertex.
+                partial.vcm = 0.0;
+            }
+            let direct_caustic = length > 1 && all_specular;
+            if bsdf.is_smooth() {
+                let vertex = LightVertex {
+                    hit,
+                    wo,
+                    throughput,
+                    partial,
+                    length,
+                    dispersed,
+                    direct_caustic,
+                };
+                if to_eye {
+                    // Direct light is not traced to the eye (see trace_to_eye).
+                    out.rays += u64::from(length > 1);
+                    self.trace_to_eye(&vertex, &bsdf, f, wl, &mut out.splats);
+                }
+                // Light reaching a vertex first is never merged (see the module's notes).
+                if length > 1 {
+                    out.merge_points.push(hit.point);
+                    out.merge_vertices.push(MergeVertex {
+                        wo,
+                        normal: hit.geometric_normal,
+                        throughput,
+                        partial,
+                        length,
+                        dispersed,
+                        direct_caustic,
+                    });
+                }
+                if connected {
+                    out.vertices.push(vertex);
+                }
+            }
+            all_specular &= !bsdf.is_smooth();
+            // A further vertex must still reach the eye within the longest path.
+            if length + 2 > self.max_length {
+                return;
+            }
+            let aim = self.bounce_aim.as_ref().filter(|_| bsdf.is_lambertian());
+            let Some((sample, towards_target)) = light_bounce(&bsdf, hit.point, wo, aim, &mut rng) else {
+                return;
+            };
+            let cos_out = bsdf.normal().dot(sample.wi).abs();
+            if sample.specular {
+                partial.scatter_specular(cos_out);
+            } else {
+                // A light vertex with a smooth vertex after it is never the camera path's first
+                // smooth one: no merging here.
+                partial.scatter(f, sample.pdf, bsdf.pdf_reverse(wo, sample.wi), cos_out, false);
+            }
+            // Flux, as the photon tracer carries it: Veach's correction for interpolated
+            // normals (1 on flat geometry). Without it a caustic through smooth-shaded glass
+            // came out 1.7% brighter than the photon tracer's.
+            let Some(correction) = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi) else {
+                return;
+            };
+            let weight = sample.weight * correction;
+            // The photon tracer's roulette keeps the subpath's power near its start, except
+            // that a bounce towards a mirror or glass where bounces are aimed goes on with the
+            // little it carries (the point of aiming it); a diffuse bounce after it brings the
+            // power back or ends the subpath.
+            let q = if towards_target {
+                1.0
+            } else if sample.specular {
+                weight.max_element().min(1.0)
+            } else {
+                (weight.max_element() * (throughput.max_element() / start).min(1.0)).min(1.0)
+            };
+            if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+                return;
+            }
+            throughput *= weight / q;
+            if sample.dispersive {
+                wl.terminate_secondary(&mut throughput, &mut dispersed);
+            }
+            previous = hit.point;
+            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+        }
+    }
+
+    /// Light tracing: the light vertex seen by the eye, splatted onto its pixel.
+    fn trace_to_eye(&self, v: &LightVertex, bsdf: &Bsdf, f: &Factors, wl: &Wavelengths, splats: &mut Vec<(u32, Vec3)>) {
+        // Direct light is the camera strategies' (see the module's notes).
+        if v.length == 1 || v.length + 1 > self.max_length {
+            return;
+        }
+        let Some(s) = self.sensor.sample(v.hit.point) else {
+            return;
+        };
+        let value = bsdf.eval(v.wo, s.to_eye);
+        if value == Spectrum::ZERO {
+            return;
+        }
+        let (ns, ng) = (v.hit.shading_normal, v.hit.geometric_normal);
+        let wo_ng = v.wo.dot(ng).abs();
+        if wo_ng <= 0.0 || !self.scene.unoccluded(&v.hit, s.to_eye, s.distance) {
+            return;
+        }
+        let inv_d2 = 1.0 / (s.distance * s.distance);
+        // The adjoint BSDF's shading-normal correction, as in light tracing.
+        let cos = s.to_eye.dot(ng).abs() * v.wo.dot(ns).abs() / wo_ng;
+        let camera_pdf = s.importance * bsdf.normal().dot(s.to_eye).abs() * inv_d2;
+        let weight = mis::light_tracing(
+            f,
+            &v.partial,
+            camera_pdf,
+            bsdf.pdf_reverse(v.wo, s.to_eye),
+            v.length > 1 && !(v.direct_caustic && self.focus.contains(v.hit.point)),
+        );
+        let splat = v.throughput * value * (cos * inv_d2 * s.importance * weight / f.light_paths);
+        let rgb = wl.to_rgb(splat);
+        if rgb.is_finite() {
+            splats.push((s.pixel as u32, rgb));
+        }
+    }
+
+    /// The first `count` light subpaths of pass `pass`, traced in batches in parallel and kept
+    /// in index order in `scratch.paths` (emptied first; `scratch.batches` lends the batches'
+    /// memory). `None` when `cancel` is set. `to_eye`: joined to the eye (a pilot that only
+    /// looks for the focus does not).
+    pub(super) fn light_paths(
+        &self,
+        (pass, count): (u64, u64),
+        f: &Factors,
+        wl: &Wavelengths,
+        to_eye: bool,
+        cancel: &AtomicBool,
+        scratch: &mut Scratch,
+    ) -> Option<()> {
+        let batch_count = count.div_ceil(BATCH) as usize;
+        let batches = &mut scratch.batches;
+        batches.resize_with(batches.len().max(batch_count), LightPaths::default);
+        let complete = batches[..batch_count].par_iter_mut().enumerate().all(|(b, out)| {
+            if cancel.load(Ordering::Relaxed) {
+                return false;
+            }
+            out.clear();
+            let b = b as u64;
+            for i in b * BATCH..((b + 1) * BATCH).min(count) {
+                self.trace_light(pass, i, f, wl, to_eye, out);
+                out.ends.push(out.vertices.len() as u32);
+            }
+            true
+        });
+        if !complete {
+            return None;
+        }
+        let all = &mut scratch.paths;
+        all.clear();
+        all.ends.push(0);
+        for batch in &batches[..batch_count] {
+            all.append(batch);
+        }
+        Some(())
+    }
+
+    /// The density with which a light subpath leaves a vertex at `point`, with `bsdf`, in `dir`
+    /// where the BSDF alone draws it with density `plain`: on a Lambertian surface, the mixture
+    /// with the cones aimed at mirrors and glass ([`BOUNCE_AIM_SHARE`]).
+    pub(super) fn light_pdf(&self, bsdf: &Bsdf, point: Vec3, dir: Vec3, plain: f32) -> f32 {
+        match &self.bounce_aim {
+            Some(aim) if bsdf.is_lambertian() => (1.0 - aim.share()) * plain + aim.share() * aim.pdf(point, dir),
+            _ => plain,
+        }
+    }
+}
+
+/// A light subpath's next direction at a surface with `bsdf` seen from `wo`: from the BSDF, or
+/// with `aim` from the mixture of the BSDF and the cones towards the mirrors and glass (its
+/// weight and density the mixture's). Also whether the direction lies in an aimed cone.
+fn light_bounce(bsdf: &Bsdf, point: Vec3, wo: Vec3, aim: Option<&Aim>, rng: &mut Rng) -> Option<(BsdfSample, bool)> {
+    let Some(aim) = aim else {
+        return bsdf
+            .sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)
+            .map(|s| (s, false));
+    };
+    let wi = if rng.uniform() < aim.share() {
+        aim.sample(point, rng.uniform(), rng.uniform2())?
+    } else {
+        bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)?
+            .wi
+    };
+    let aimed = aim.pdf(point, wi);
+    let pdf = (1.0 - aim.share()) * bsdf.pdf(wo, wi) + aim.share() * aimed;
+    let value = bsdf.eval(wo, wi);
+    if pdf.is_nan() || pdf <= 0.0 || value == Spectrum::ZERO {
+        return None;
+    }
+    let sample = BsdfSample {
+        wi,
+        weight: value * (bsdf.normal().dot(wi).abs() / pdf),
+        pdf,
+        specular: false,
+        transmitted: false,
+        dispersive: false,
+    };
+    Some((sample, aimed > 0.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::aim::Target;
+    use crate::material::{Lobes, SurfaceParams};
+
+    /// A light subpath's bounce off a Lambertian surface with a share aimed at a sphere: every
+    /// weight is f·cos over the mixture's density, the mean weight is the albedo, and the light
+    /// sent into the sphere's cone is the same as without aiming, carried by many more samples.
+    #[test]
+    fn aimed_bounces_carry_the_bsdfs_light() {
+        let n = Vec3::Z;
+        let wo = Vec3::new(0.3, -0.4, 0.866).normalize();
+        let params = SurfaceParams {
+            diffuse: Vec3::splat(0.7),
+            ..SurfaceParams::default()
+        };
+        let bsdf = Bsdf::new(&Lobes::new(&params), n, n, wo, &Wavelengths::Rgb, None, None);
+        assert!(bsdf.is_lambertian());
+        let point = Vec3::ZERO;
+        let target = Target {
+            center: Vec3::new(1.0, 0.5, 0.8),
+            radius: 0.3,
+        };
+        let aim = Aim::new(&[target], 0.3).unwrap();
+        let (axis, cos_max) = target.cone_from(point);
+        let count = 400_000;
+        // (mean weight, mean weight into the cone, share of samples into the cone)
+        let run = |aim: Option<&Aim>, seed: u64| {
+            let mut rng = Rng::new(seed, 0);
+            let (mut all, mut into, mut hits) = (0.0f64, 0.0f64, 0u32);
+            for _ in 0..count {
+                let Some((s, towards)) = light_bounce(&bsdf, point, wo, aim, &mut rng) else {
+                    continue;
+                };
+                let inside = s.wi.dot(axis) >= cos_max;
+                assert_eq!(towards, aim.is_some() && inside, "{s:?}");
+                let plain = bsdf.pdf(wo, s.wi);
+                let pdf = aim.map_or(plain, |a| (1.0 - a.share()) * plain + a.share() * a.pdf(point, s.wi));
+                assert!((s.pdf - pdf).abs() <= 1e-5 * pdf, "{} against {pdf}", s.pdf);
+                let expected = bsdf.eval(wo, s.wi) * (s.wi.z / pdf);
+                assert!((s.weight - expected).length() <= 1e-4 * expected.length(), "{s:?}");
+                all += s.weight.x as f64;
+                if inside {
+                    into += s.weight.x as f64;
+                    hits += 1;
+                }
+            }
+            (all / count as f64, into / count as f64, hits as f64 / count as f64)
+        };
+        let (plain_all, plain_into, plain_hits) = run(None, 1);
+        let (aimed_all, aimed_into, aimed_hits) = run(Some(&aim), 2);
+        assert!((plain_all - 0.7).abs() < 0.005, "{plain_all}");
+        assert!((aimed_all - 0.7).abs() < 0.005, "{aimed_all}");
+        assert!(
+            (aimed_into / plain_into - 1.0).abs() < 0.02,
+            "into the cone: aimed {aimed_into} against {plain_into}"
+        );
+        assert!(aimed_hits > 5.0 * plain_hits, "{aimed_hits} against {plain_hits}");
+    }
+}
