@@ -64,6 +64,19 @@ impl Worker<'_> {
             return Ok(None);
         }
         let start = *self.start.get_or_insert_with(Instant::now);
+        // The integrator's work before its first pass (vcm's pilots) counts in the time, and
+        // sizes the passes.
+        let control = Control {
+            progress: &NoProgress,
+            cancel: &self.cancel,
+        };
+        let session = &mut self.session;
+        if !self.pool.install(|| session.prepare(control)) {
+            if self.stopped.load(Ordering::SeqCst) {
+                self.finish()?;
+            }
+            return Ok(None);
+        }
         // The session's rule for a run's passes (under a time limit vcm's last fills it).
         let share = loop {
             let size = self
@@ -84,10 +97,6 @@ impl Worker<'_> {
             self.next += 1;
         };
         let next_cost = share.unwrap_or_else(|| self.session.pass_cost(self.next));
-        let control = Control {
-            progress: &NoProgress,
-            cancel: &self.cancel,
-        };
         let pass = self.next;
         let session = &mut self.session;
         if !self.pool.install(|| session.render_sized_pass(pass, share, control)) {

@@ -10,6 +10,7 @@
 pub mod budget;
 pub mod kd_tree;
 pub mod kernel;
+pub mod light_step;
 pub mod map;
 pub mod picture;
 pub mod trace;

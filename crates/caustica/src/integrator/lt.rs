@@ -13,10 +13,11 @@
 
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::Progressive;
-use crate::bsdf::{adjoint_correction, Bsdf, Transport};
+use crate::bsdf::{Bsdf, Transport};
 use crate::camera::Camera;
 use crate::light::emission::EmissionPoint;
 use crate::math::{offset_origin, Ray, Vec3};
+use crate::photon::light_step::{continue_light, Roulette};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
@@ -218,17 +219,17 @@ impl<'a> LightTracer<'a> {
             let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance) else {
                 return;
             };
-            // As the photon tracer: Veach's correction for interpolated normals (1 on flat
-            // geometry), then its roulette, so flux stays nearly constant along the path.
-            let correction = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi);
-            let weight = sample.weight * correction.unwrap_or(0.0);
-            let q = weight.max_element().min(1.0);
-            if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+            // As the photon tracer carries flux.
+            if !continue_light(
+                &hit,
+                wo,
+                &sample,
+                Roulette::KeepFlux,
+                (&mut power, &mut dispersed),
+                wl,
+                &mut rng,
+            ) {
                 return;
-            }
-            power *= weight / q;
-            if sample.dispersive {
-                wl.terminate_secondary(&mut power, &mut dispersed);
             }
             ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
         }

@@ -19,8 +19,9 @@
 //! (physical). Both are deterministic whatever the thread count: photon `i` draws from its own
 //! random stream and batches are concatenated in order.
 
+use super::light_step::{continue_light, Roulette};
 use super::{Photon, DIFFUSE, DISPERSED, MAX_BOUNCES_LEFT, REFLECTED, REFRACTED};
-use crate::bsdf::{adjoint_correction, Bsdf, Transport};
+use crate::bsdf::{Bsdf, Transport};
 use crate::light::{distance_attenuation, Light};
 use crate::material::{channel_indices, refraction_geometry};
 use crate::math::{reflect, refract, Ray, Vec3};
@@ -277,19 +278,19 @@ impl PhotonModel for PhysicalModel {
             ));
         }
         let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)?;
-        // Photons carry flux the adjoint way: with an interpolated normal the sample's weight
-        // needs Veach's correction (1 on flat geometry).
-        let correction = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi);
-        let weight = sample.weight * correction.unwrap_or(0.0);
-        // Survive with the probability of the throughput kept, so flux stays nearly constant.
-        let q = weight.max_element().min(1.0);
-        if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+        let mut dispersed = photon.flags & DISPERSED != 0;
+        if !continue_light(
+            hit,
+            wo,
+            &sample,
+            Roulette::KeepFlux,
+            (&mut photon.power, &mut dispersed),
+            &self.wl,
+            rng,
+        ) {
             return None;
         }
-        photon.power *= weight / q;
-        if sample.dispersive && photon.flags & DISPERSED == 0 {
-            let mut terminated = false;
-            self.wl.terminate_secondary(&mut photon.power, &mut terminated);
+        if sample.dispersive {
             photon.flags |= DISPERSED;
         }
         photon.flags |= if !sample.specular {

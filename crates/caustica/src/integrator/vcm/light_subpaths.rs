@@ -98,30 +98,25 @@ impl<'a> Vcm<'a> {
                 // smooth one: no merging here.
                 partial.scatter(f, sample.pdf, bsdf.pdf_reverse(wo, sample.wi), cos_out, false);
             }
-            // Flux, as the photon tracer carries it: Veach's correction for interpolated
-            // normals (1 on flat geometry). Without it a caustic through smooth-shaded glass
-            // came out 1.7% brighter than the photon tracer's.
-            let Some(correction) = adjoint_correction(hit.shading_normal, hit.geometric_normal, wo, sample.wi) else {
-                return;
+            // Flux, as the photon tracer carries it (without Veach's correction a caustic
+            // through smooth-shaded glass came out 1.7% brighter than the photon tracer's),
+            // the roulette keeping the subpath's power near its start; a bounce aimed at a
+            // mirror or glass goes on with the little it carries (the point of aiming it), and a
+            // diffuse bounce after it brings the power back or ends the subpath.
+            let roulette = Roulette::TowardsStart {
+                start,
+                aimed: towards_target,
             };
-            let weight = sample.weight * correction;
-            // The photon tracer's roulette keeps the subpath's power near its start, except
-            // that a bounce towards a mirror or glass where bounces are aimed goes on with the
-            // little it carries (the point of aiming it); a diffuse bounce after it brings the
-            // power back or ends the subpath.
-            let q = if towards_target {
-                1.0
-            } else if sample.specular {
-                weight.max_element().min(1.0)
-            } else {
-                (weight.max_element() * (throughput.max_element() / start).min(1.0)).min(1.0)
-            };
-            if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+            if !continue_light(
+                &hit,
+                wo,
+                &sample,
+                roulette,
+                (&mut throughput, &mut dispersed),
+                wl,
+                &mut rng,
+            ) {
                 return;
-            }
-            throughput *= weight / q;
-            if sample.dispersive {
-                wl.terminate_secondary(&mut throughput, &mut dispersed);
             }
             previous = hit.point;
             ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
