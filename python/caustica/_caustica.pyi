@@ -140,6 +140,8 @@ class Progressive:
     @property
     def fingerprint(self) -> str:
         """What must agree for two runs' sums to merge."""
+    def report(self) -> dict[str, Any]:
+        """The run so far: the fields `caustica render --json` prints but the files and preview."""
 
 class Photons:
     """Stored caustic photons, one row each, in the photon map's order."""

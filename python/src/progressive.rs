@@ -11,7 +11,7 @@ use crate::{wait, InternalError, Outcome};
 use caustica::film::Film;
 use caustica::integrator::config::thread_pool;
 use caustica::integrator::partial::merge_files;
-use caustica::integrator::{PassPlan, RenderSession, Resize};
+use caustica::integrator::{PassPlan, RenderSession, Resize, RunSummary};
 use caustica::progress::{Control, NoProgress};
 use caustica::Error;
 use numpy::PyArray3;
@@ -46,6 +46,23 @@ struct Worker<'a> {
     save_every: f64,
     last_save: Instant,
     finished: bool,
+    /// Seconds spent reading and building the scene.
+    load_seconds: (f64, f64),
+}
+
+impl Worker<'_> {
+    /// The run so far as the library reports it, in JSON.
+    fn report(&self) -> caustica::Result<String> {
+        let render = self.start.map_or(0.0, |s| s.elapsed().as_secs_f64());
+        let summary = RunSummary {
+            complete: self.finished && !self.cancel.load(Ordering::SeqCst),
+            photon_seconds: self.session.photon_seconds(),
+            render_seconds: (render - self.session.photon_seconds()).max(0.0),
+        };
+        let (parse, build) = self.load_seconds;
+        let report = self.session.report(&summary, self.load_seconds, parse + build + render);
+        serde_json::to_string(&report).map_err(|e| Error::InvalidSettings(format!("cannot report the run: {e}")))
+    }
 }
 
 impl Worker<'_> {
@@ -267,6 +284,14 @@ impl Progressive {
         self.integrator
     }
 
+    /// What the run did so far, as a dict: the fields `caustica render --json` prints but the
+    /// files written and the preview (`integrator`, `model`, `width`, `height`, `complete`,
+    /// `seconds`, and the passes and photons a full pass traces, or the course model's photons).
+    fn report<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let text = self.call(py, |w| w.report())?;
+        py.import("json")?.call_method1("loads", (text,))
+    }
+
     /// Everything that must agree for two runs' sums to merge (scene, size, seed, settings).
     #[getter]
     fn fingerprint(&self, py: Python<'_>) -> PyResult<String> {
@@ -362,6 +387,7 @@ pub fn progressive(
                 save_every,
                 last_save: Instant::now(),
                 finished: false,
+                load_seconds: loaded.seconds,
             };
             while let Ok(job) = inbox.recv() {
                 job(&mut worker);

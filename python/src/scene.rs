@@ -41,6 +41,8 @@ pub struct LoadedScene {
     pub name: String,
     /// `info()` as JSON text.
     pub report: String,
+    /// Seconds spent reading and building it.
+    pub seconds: (f64, f64),
 }
 
 impl LoadedScene {
@@ -63,6 +65,7 @@ impl LoadedScene {
             scene_id: loaded.scene_id,
             name,
             report,
+            seconds: (loaded.parse_seconds, loaded.build_seconds),
         })
     }
 }

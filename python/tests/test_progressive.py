@@ -126,3 +126,22 @@ def test_an_interrupted_partial_keeps_the_passes_done(tmp_path, scenes):
     run.cancel()
     assert list(run) == []
     assert np.array_equal(caustica.merge([part]), caustica.render(scenes / "glass_sphere.ray", passes=2, **PPM))
+
+
+def test_the_report_is_what_the_command_line_prints(scenes, tmp_path):
+    """The library's one report: Python's progressive run and `render --json` agree on every
+    field but the times and the files written (vcm's balanced count included)."""
+    import json
+
+    options = dict(model="physical", integrator="vcm", width=32, passes=2)
+    run = caustica.progressive(scenes / "glass_sphere.ray", **options)
+    list(run)
+    ours = run.report()
+    theirs = json.loads(
+        cli("render", scenes / "glass_sphere.ray", "-o", tmp_path / "r.png", "--json", *cli_args(options)).stdout
+    )
+    assert ours["passes"] == 2 and ours["complete"] and ours["photons_per_pass"] > 0
+    assert set(ours["seconds"]) == {"parse", "build", "render", "total"}
+    for key, value in ours.items():
+        if key != "seconds":
+            assert theirs[key] == value, key

@@ -17,6 +17,7 @@ pub mod partial;
 pub mod path;
 pub mod ppm;
 pub mod radius;
+pub mod report;
 pub mod session;
 pub mod specular_chain;
 pub mod tiles;
@@ -24,6 +25,7 @@ pub mod vcm;
 pub mod whitted;
 
 pub use config::{GivenOptions, RenderConfig};
+pub use report::{RunDetail, RunReport, RunSeconds};
 pub use session::{PassPlan, RenderOptions, RenderSession, Resize, RunSummary};
 pub use tiles::{image_size, ImageSettings};
 

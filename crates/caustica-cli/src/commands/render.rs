@@ -1,6 +1,9 @@
 //! `caustica render`: the options become a render session of the library, which this command
 //! runs with progress bars, saving the image (and the partial sums) as it goes.
 
+mod options;
+mod summary;
+
 use super::load_scene;
 use super::shown;
 use crate::cli::RenderArgs;
@@ -9,77 +12,19 @@ use caustica::description::RenderHints;
 use caustica::film::ToneMap;
 use caustica::format::Format;
 use caustica::image_io::{check_writable, ImageFormat};
+use caustica::integrator::config::integrator_note;
 use caustica::integrator::config::thread_pool;
-use caustica::integrator::config::{integrator_note, GivenOptions, Model};
-use caustica::integrator::{Integrator, RenderConfig, RenderSession};
-use caustica::light::Light;
-use caustica::photon::Estimator;
-use caustica::preview::{tev, Preview, PreviewReport, PreviewSettings};
+use caustica::integrator::RenderSession;
+use caustica::preview::{tev, Preview, PreviewSettings};
 use caustica::progress::Control;
-use caustica::scene::Scene;
 use caustica::{Error, Result};
+pub use options::config;
+use options::{check_preview, given};
 use serde_json::json;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::time::{Duration, Instant};
-
-/// The library's render options: the command line's over the scene's own settings (`hints`).
-pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
-    let p = &args.progressive;
-    let defaults = RenderConfig::default();
-    let given = given(args);
-    let asked = RenderConfig {
-        model: p.model.as_deref().map(str::parse::<Model>).transpose()?,
-        integrator: p.integrator.as_deref().map(str::parse).transpose()?,
-        width: args.width.unwrap_or(defaults.width),
-        height: args.height,
-        aa: args.aa,
-        depth: args.depth,
-        seed: args.seed,
-        photons: args.photon.photons.unwrap_or(defaults.photons),
-        light_paths: args.photon.photons.map(|p| p as u64),
-        max_emitted: args.photon.max_emitted,
-        photons_per_light: args.photon.photons_per_light.clone(),
-        no_aim: args.photon.no_aim,
-        k: args.k,
-        radius: args.radius,
-        cone_filter: args.cone_filter,
-        estimator: match args.estimate.as_str() {
-            "nearest" => Estimator::Nearest,
-            _ => Estimator::Kernels,
-        },
-        no_estimate_reuse: args.no_estimate_reuse,
-        passes: p.passes.clone(),
-        time: p.time,
-        footprint: p.footprint,
-        alpha: p.alpha,
-        no_camera_specular: p.no_camera_specular,
-        vertex_connections: p.vertex_connections,
-        spectral: match (p.spectral, p.no_spectral) {
-            (true, _) => Some(true),
-            (_, true) => Some(false),
-            _ => None,
-        },
-        max_memory: args.photon.max_memory,
-        partial: p.partial.clone(),
-    };
-    Ok(asked.over_scene(&given, hints))
-}
-
-/// Which of the options a scene file also sets the command line gave.
-fn given(args: &RenderArgs) -> GivenOptions {
-    let p = &args.progressive;
-    GivenOptions {
-        model_or_integrator: p.model.is_some() || p.integrator.is_some(),
-        width: args.width.is_some(),
-        height: args.height.is_some(),
-        depth: args.depth.is_some(),
-        photons: args.photon.photons.is_some(),
-        radius: args.radius.is_some(),
-        passes: p.passes.is_some(),
-        time: p.time.is_some(),
-    }
-}
+use summary::{physical_notes, preview_json, summary_line};
 
 /// Runs the command; returns the exit code.
 pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
@@ -261,163 +206,27 @@ pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     }
     save(&session)?;
 
-    let total = start.elapsed().as_secs_f64();
-    let complete = summary.complete;
-    let (parse_seconds, build_seconds) = (loaded.parse_seconds, loaded.build_seconds);
-    let ranges: Vec<String> = if progressive {
-        session
-            .accumulator()
-            .passes
-            .iter()
-            .map(|(a, b)| format!("{a}..{b}"))
-            .collect()
-    } else {
-        vec!["0..1".into()]
-    };
-    let photons_per_pass = match session.integrator() {
-        Integrator::Ppm(s) => s.photons_per_pass,
-        Integrator::Gi(s) => s.photons_per_pass,
-        Integrator::Lt(s) => s.photons_per_pass,
-        Integrator::Vcm(s) => s
-            .light_paths_per_pass
-            .or_else(|| session.chosen_paths_per_pass())
-            .unwrap_or_else(|| caustica::integrator::vcm::default_light_paths(width, height)),
-        _ => 0,
-    };
-    let full_passes = session.accumulator().weight;
+    let report = session.report(
+        &summary,
+        (loaded.parse_seconds, loaded.build_seconds),
+        start.elapsed().as_secs_f64(),
+    );
+    let complete = report.complete;
     if args.json {
-        let summary = if progressive {
-            json!({
-                "output": shown(&output),
-                "partial": shown(&options.partial),
-                "integrator": session.integrator().name(),
-                "integrator_why": integrator_why,
-                "model": "physical",
-                "width": width,
-                "camera_fit": camera_fit,
-                "height": height,
-                "passes": passes_done,
-                "pass_ranges": ranges.join(","),
-                "photons_per_pass": photons_per_pass,
-                // Passes resized to a time limit count by their share of a full pass.
-                "full_passes": full_passes,
-                "photons": (full_passes * photons_per_pass as f64).round() as u64,
-                "complete": complete,
-                "seconds": {
-                    "parse": parse_seconds,
-                    "build": build_seconds,
-                    "render": summary.render_seconds,
-                    "total": total,
-                },
-                "peak_memory_bytes": super::peak_memory_bytes(),
-                "preview": preview_json(&preview_report),
-            })
-        } else {
-            let aa = config.aa;
-            json!({
-                "output": shown(&output),
-                "integrator": "whitted",
-                "model": "course",
-                "width": width,
-                "camera_fit": camera_fit,
-                "height": height,
-                "samples_per_pixel": aa * aa,
-                "photons_stored": photon_stats.as_ref().map_or(0, |s| s.stored),
-                "photons_emitted": photon_stats.as_ref().map_or(0, |s| s.emitted),
-                "photons_landed": photon_stats.as_ref().map_or(0, |s| s.landed),
-                "photons_useful_fraction": photon_stats.as_ref().map_or(0.0, |s| s.useful_fraction()),
-                "photons_cap_reached": photon_stats.as_ref().is_some_and(|s| s.cap_reached),
-                "photons_none_reason": photon_stats.as_ref().and_then(|s| s.none).map(|r| r.name()),
-                "complete": complete,
-                "seconds": {
-                    "parse": parse_seconds,
-                    "build": build_seconds,
-                    "photons": summary.photon_seconds,
-                    "render": summary.render_seconds,
-                    "total": total,
-                },
-                "peak_memory_bytes": super::peak_memory_bytes(),
-                "preview": preview_json(&preview_report),
-            })
-        };
-        crate::stdout::println(&summary.to_string())?;
-    } else if !args.quiet {
-        if progressive {
-            let written: Vec<String> = [&output, &options.partial]
-                .into_iter()
-                .flatten()
-                .map(|p| p.display().to_string())
-                .collect();
-            eprintln!(
-                "{} {width}×{height}, {passes_done} {} passes ({}){} — parse {parse_seconds:.2} s, build {build_seconds:.2} s, render {:.2} s, total {total:.2} s{}",
-                written.join(" and "),
-                session.integrator().name(),
-                ranges.join(","),
-                if photons_per_pass > 0 {
-                    format!(", {photons_per_pass} photons a pass")
-                } else {
-                    String::new()
-                },
-                summary.render_seconds,
-                if complete { "" } else { " (interrupted: the passes done are saved)" }
-            );
-        } else {
-            let stored = photon_stats.as_ref().map_or(0, |s| s.stored);
-            eprintln!(
-                "{} {width}×{height} at {} spp, {stored} photons stored — parse {parse_seconds:.2} s, build {build_seconds:.2} s, photons {:.2} s, render {:.2} s, total {total:.2} s{}",
-                output.as_ref().map_or(String::new(), |o| o.display().to_string()),
-                config.aa * config.aa,
-                summary.photon_seconds,
-                summary.render_seconds,
-                if complete { "" } else { " (interrupted: partial image)" }
-            );
+        // A report of plain fields always serialises to an object.
+        let mut value = serde_json::to_value(&report).unwrap_or_default();
+        if let Some(fields) = value.as_object_mut() {
+            fields.insert("output".into(), json!(shown(&output)));
+            if progressive {
+                fields.insert("partial".into(), json!(shown(&options.partial)));
+                fields.insert("integrator_why".into(), json!(integrator_why));
+            }
+            fields.insert("peak_memory_bytes".into(), json!(super::peak_memory_bytes()));
+            fields.insert("preview".into(), preview_json(&preview_report));
         }
+        crate::stdout::println(&value.to_string())?;
+    } else if !args.quiet {
+        eprintln!("{}", summary_line(&report, &output, &options.partial));
     }
     Ok(if complete { 0 } else { crate::EXIT_INTERRUPTED })
-}
-
-/// Refuses preview options that cannot work, before any work.
-fn check_preview(args: &RenderArgs, output: &Option<PathBuf>) -> Result<()> {
-    if args.preview.preview_every.is_some_and(|s| !(s > 0.0 && s <= 3600.0)) {
-        return Err(Error::InvalidSettings(
-            "--preview-every must be a positive number of seconds (at most 3600)".into(),
-        ));
-    }
-    if args.preview.preview && output.is_none() {
-        return Err(Error::InvalidSettings(
-            "--preview rewrites the output image: give one with -o".into(),
-        ));
-    }
-    Ok(())
-}
-
-/// The preview's work in the JSON summary (`null` without one).
-fn preview_json(report: &Option<PreviewReport>) -> serde_json::Value {
-    match report {
-        Some(r) => json!({
-            "updates": r.updates,
-            "busy_seconds": r.busy_seconds,
-            "bytes_sent": r.bytes_sent,
-        }),
-        None => serde_json::Value::Null,
-    }
-}
-
-/// What the physical model reads differently from the course's shading.
-fn physical_notes(scene: &Scene) -> Vec<String> {
-    let mut notes = Vec::new();
-    let attenuated = scene
-        .lights()
-        .iter()
-        .filter(|l| matches!(l, Light::Point { attenuation, .. } if *attenuation != [0.0, 0.0, 1.0]))
-        .count();
-    if attenuated > 0 {
-        notes.push(format!(
-            "the physical model ignores the attenuation coefficients of {attenuated} point light(s): light falls off with the inverse square"
-        ));
-    }
-    if scene.ambient() != caustica::math::Vec3::ZERO {
-        notes.push("the physical model ignores ambient light: indirect light is computed".into());
-    }
-    notes
 }

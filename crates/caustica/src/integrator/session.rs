@@ -237,6 +237,16 @@ impl<'a> RenderSession<'a> {
         (self.accumulator.width, self.accumulator.height)
     }
 
+    /// Seconds spent tracing the course model's caustic photons so far.
+    pub fn photon_seconds(&self) -> f64 {
+        self.photon_seconds
+    }
+
+    /// The scene.
+    pub fn scene(&self) -> &Scene {
+        self.scene
+    }
+
     /// The integrator.
     pub fn integrator(&self) -> &Integrator {
         &self.integrator
