@@ -14,15 +14,19 @@
 //! Every light answers the same questions for every integrator: next-event estimation's sample
 //! towards a point with its density ([`LightSet::sample_light`]), the emission sample of a
 //! photon or light subpath with its densities ([`emission::Emitters`], aimed at the mirrors and
-//! glass by [`aim`], far lights across a [`beam`]), and its power for choosing it. Emissive
-//! objects are sampled by [`area`], the sky by [`environment`], lights with a size by [`soft`].
+//! glass by [`aim`], far lights across a [`beam`]), and its power for choosing it. Each kind
+//! answers in a file of its own: points and spots in `point`, directional lights and suns in
+//! `distant`, emissive objects in [`area`], the sky in [`environment`], lights with a size in
+//! [`soft`].
 
 pub mod aim;
 pub mod area;
 pub mod beam;
 pub mod cube_map;
+mod distant;
 pub mod emission;
 pub mod environment;
+mod point;
 pub mod soft;
 
 pub use area::AreaLight;
@@ -33,7 +37,7 @@ use aim::{camera_targets, Aim};
 use emission::Emitters;
 
 use crate::math::{luminance, Ray, Vec3};
-use crate::sampling::{power_heuristic, sample_uniform_cone, Rng};
+use crate::sampling::{power_heuristic, Rng};
 use crate::scene::{ObjectRef, Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 use std::f32::consts::PI;
@@ -315,6 +319,44 @@ pub struct DirectSample {
     pub cos_light: f32,
 }
 
+/// What next-event estimation asks of one light: the shading point, the path's wavelengths,
+/// and the probability with which the light was taken.
+pub(crate) struct DirectQuery<'a> {
+    /// The scene (for visibility).
+    pub scene: &'a Scene,
+    /// The shading point.
+    pub hit: &'a SurfaceHit,
+    /// The path's wavelengths.
+    pub wl: &'a Wavelengths,
+    /// The probability of taking this light.
+    pub choice: f32,
+}
+
+impl DirectQuery<'_> {
+    /// The sample of a light no ray meets, at `point` (its unit `normal` there, or zero), of
+    /// solid-angle density `pdf` (a point light's: d², so that `value` is its intensity), its
+    /// cosine at the light `cos_light`; `None` when something is in between.
+    pub fn delta(&self, point: Vec3, normal: Vec3, value: Vec3, pdf: f32, cos_light: f32) -> Option<DirectSample> {
+        let to = point - self.hit.point;
+        let distance = to.length();
+        if !(distance > 0.0 && distance.is_finite() && pdf > 0.0) {
+            return None;
+        }
+        let wi = to / distance;
+        self.scene.unoccluded(self.hit, wi, distance).then(|| DirectSample {
+            wi,
+            distance,
+            contribution: self.wl.unbounded(value / pdf) / self.choice,
+            pdf: 0.0,
+            direct_pdf: self.choice * pdf,
+            delta: true,
+            point,
+            normal,
+            cos_light,
+        })
+    }
+}
+
 /// Every light of a scene: the file's lights in file order, then its emissive objects. Under
 /// the physical model lights are chosen in proportion to their power.
 #[derive(Clone, Debug, Default)]
@@ -505,114 +547,25 @@ impl LightSet {
         rng: &mut Rng,
     ) -> Option<DirectSample> {
         let (u_pick, u) = (rng.uniform(), rng.uniform2());
-        let p = hit.point;
-        // A light no ray meets, at `point` (with its `normal`), seen by the solid-angle density
-        // `pdf` (a point light's: d², so that `value` is its intensity).
-        let delta = |point: Vec3, normal: Vec3, value: Vec3, pdf: f32, cos_light: f32| {
-            let to = point - p;
-            let distance = to.length();
-            if !(distance > 0.0 && distance.is_finite() && pdf > 0.0) {
-                return None;
-            }
-            let wi = to / distance;
-            scene.unoccluded(hit, wi, distance).then(|| DirectSample {
-                wi,
-                distance,
-                contribution: wl.unbounded(value / pdf) / p_pick,
-                pdf: 0.0,
-                direct_pdf: p_pick * pdf,
-                delta: true,
-                point,
-                normal,
-                cos_light,
-            })
+        let q = DirectQuery {
+            scene,
+            hit,
+            wl,
+            choice: p_pick,
         };
         match &self.lights[index] {
-            Light::Point { position, color, .. } => {
-                delta(*position, Vec3::ZERO, *color, (*position - p).length_squared(), 1.0)
-            }
-            Light::Spot {
-                position,
-                direction,
-                color,
-                cos_inner,
-                cos_outer,
-                exponent,
-                ..
-            } => {
-                let out = (p - *position).normalize_or_zero();
-                let profile = spot_profile(out.dot(*direction), *cos_inner, *cos_outer, *exponent);
-                if profile <= 0.0 {
-                    return None;
-                }
-                let d2 = (*position - p).length_squared();
-                delta(*position, Vec3::ZERO, *color * profile, d2, 1.0)
-            }
-            Light::Directional { direction, color } => {
-                let wi = -*direction;
-                scene.unoccluded(hit, wi, f32::INFINITY).then(|| DirectSample {
-                    wi,
-                    distance: f32::INFINITY,
-                    contribution: wl.unbounded(*color) / p_pick,
-                    pdf: 0.0,
-                    direct_pdf: p_pick,
-                    delta: true,
-                    point: p + wi,
-                    normal: *direction,
-                    cos_light: 1.0,
-                })
-            }
-            light @ Light::Sun { direction, cos_max, .. } => {
-                let wi = sample_uniform_cone(u, -*direction, *cos_max);
-                let pdf = p_pick * self.sun_pdf(light);
-                scene.unoccluded(hit, wi, f32::INFINITY).then(|| DirectSample {
-                    wi,
-                    distance: f32::INFINITY,
-                    contribution: wl.unbounded(light.sun_radiance()) / pdf,
-                    pdf,
-                    direct_pdf: pdf,
-                    delta: false,
-                    point: p + wi,
-                    normal: -wi,
-                    cos_light: 1.0,
-                })
-            }
-            Light::Environment(env) => {
-                let s = env.sample(u)?;
-                if s.radiance == Vec3::ZERO || !scene.unoccluded(hit, s.wi, f32::INFINITY) {
-                    return None;
-                }
-                let pdf = p_pick * s.pdf;
-                Some(DirectSample {
-                    wi: s.wi,
-                    distance: f32::INFINITY,
-                    contribution: wl.unbounded(s.radiance) / pdf,
-                    pdf,
-                    direct_pdf: pdf,
-                    delta: false,
-                    point: p + s.wi,
-                    normal: -s.wi,
-                    cos_light: 1.0,
-                })
-            }
-            Light::Area(light) => sample_area_direct(scene, light, hit, p_pick, (u_pick, u), wl),
-            // Rays never hit this light, so its sample takes no MIS weight (pdf 0, as a point light).
-            Light::Soft(light) => {
-                let (s, pdf) = light.sample_towards(p, u)?;
-                let to = s.point - p;
-                let cos_light = -s.normal.dot(to) / to.length();
-                if cos_light.is_nan() || cos_light <= 0.0 {
-                    return None;
-                }
-                delta(s.point, s.normal, s.radiance, pdf, cos_light)
-            }
+            light @ (Light::Point { .. } | Light::Spot { .. }) => point::sample_direct(&q, light),
+            light @ (Light::Directional { .. } | Light::Sun { .. }) => distant::sample_direct(&q, light, u),
+            Light::Environment(env) => env.sample_direct(&q, u),
+            Light::Area(light) => light.sample_direct(&q, (u_pick, u)),
+            Light::Soft(light) => light.sample_direct(&q, u),
         }
     }
 
     /// Solid-angle pdf of a sun's uniform cone.
     fn sun_pdf(&self, light: &Light) -> f32 {
         match light {
-            Light::Sun { one_minus_cos, .. } => 1.0 / (2.0 * PI * one_minus_cos),
+            Light::Sun { one_minus_cos, .. } => distant::sun_cone_pdf(*one_minus_cos),
             _ => 0.0,
         }
     }
@@ -736,39 +689,6 @@ pub(crate) fn visible_emission(
         return None;
     }
     Some(scene.emission_towards(&scene.surface(&ray, &isect), -wi, wl))
-}
-
-/// A point on an emissive object for lighting `p`, visibility included.
-fn sample_area_direct(
-    scene: &Scene,
-    light: &AreaLight,
-    hit: &SurfaceHit,
-    p_pick: f32,
-    (u_pick, u): (f32, glam::Vec2),
-    wl: &Wavelengths,
-) -> Option<DirectSample> {
-    let p = hit.point;
-    let drawn = light.sample_towards(scene, p, u_pick, u)?;
-    let sample = drawn.point;
-    let to = sample.point - p;
-    let d = to.length();
-    if d.is_nan() || d <= 0.0 {
-        return None;
-    }
-    let wi = to / d;
-    let le = visible_emission(scene, light, hit, &drawn, wi, d, wl)?;
-    let pdf = p_pick * drawn.pdf_solid;
-    Some(DirectSample {
-        wi,
-        distance: d,
-        contribution: le / pdf,
-        pdf,
-        direct_pdf: pdf,
-        delta: false,
-        point: sample.point,
-        normal: sample.normal,
-        cos_light: sample.normal.dot(wi).abs(),
-    })
 }
 
 #[cfg(test)]

@@ -10,10 +10,14 @@
 //! the faces the material names: both, like the `emissive` term of the course shading, or one
 //! (pbrt's one-sided area lights).
 
+use super::emission::{area_radiance, emitting_side, Emission, EmissionPoint, EmitArgs, Emitters};
+use super::{visible_emission, DirectQuery, DirectSample, Light};
 use crate::description::EmittingFaces;
 use crate::geometry::cone::Cone;
 use crate::geometry::ShapeKind;
+use crate::math::{offset_origin, Frame, Ray};
 use crate::math::{Mat3, Vec2, Vec3};
+use crate::sampling::{sample_cosine_hemisphere, Rng};
 use crate::sampling::{sample_uniform_cone, sample_uniform_disc, sample_uniform_sphere, uniform_cone_pdf};
 use crate::scene::{ObjectRef, Scene};
 use std::f32::consts::PI;
@@ -490,6 +494,108 @@ fn sample_object(kind: &ShapeKind, u_pick: f32, u: Vec2) -> Option<(Vec3, Vec3)>
                     Some((Vec3::new(d.x * r, d.y * r, cone.height), Vec3::Z))
                 }
             }
+        }
+    }
+}
+
+impl AreaLight {
+    /// Next-event estimation's sample: a point on the light for lighting the query's point,
+    /// visibility included.
+    pub(super) fn sample_direct(&self, q: &DirectQuery, (u_pick, u): (f32, Vec2)) -> Option<DirectSample> {
+        let (scene, hit, wl, p_pick, light) = (q.scene, q.hit, q.wl, q.choice, self);
+        let p = hit.point;
+        let drawn = light.sample_towards(scene, p, u_pick, u)?;
+        let sample = drawn.point;
+        let to = sample.point - p;
+        let d = to.length();
+        if d.is_nan() || d <= 0.0 {
+            return None;
+        }
+        let wi = to / d;
+        let le = visible_emission(scene, light, hit, &drawn, wi, d, wl)?;
+        let pdf = p_pick * drawn.pdf_solid;
+        Some(DirectSample {
+            wi,
+            distance: d,
+            contribution: le / pdf,
+            pdf,
+            direct_pdf: pdf,
+            delta: false,
+            point: sample.point,
+            normal: sample.normal,
+            cos_light: sample.normal.dot(wi).abs(),
+        })
+    }
+}
+
+impl Emitters {
+    /// A start from an emissive object: a point by area, a face, a cosine-weighted direction (or, aimed,
+    /// one towards a target from the half of a sphere lamp facing it).
+    pub(super) fn emit_area(&self, light: &Light, args: EmitArgs, rng: &mut Rng) -> Option<Emission> {
+        let EmitArgs {
+            scene,
+            number,
+            pick,
+            u,
+            u_dir,
+            wl,
+        } = args;
+        match light {
+            Light::Area(light) => {
+                let mut sample = light.sample(scene, rng.uniform(), u)?;
+                let (dir, normal) = match self.aimed_lobe(rng) {
+                    Some((aim, u_pick, u_aim)) => {
+                        let dir = match light.sphere() {
+                            Some((center, radius)) => {
+                                let (normal, dir) =
+                                    aim.sample_from_sphere(center, radius, sample.normal, u_pick, u_aim)?;
+                                sample.normal = normal;
+                                sample.point = center + normal * radius;
+                                dir
+                            }
+                            None => aim.sample(sample.point, u_pick, u_aim)?,
+                        };
+                        // Leaves by the face it points out of, if that face emits.
+                        let side = if dir.dot(sample.normal) >= 0.0 { 1.0 } else { -1.0 };
+                        if light.faces.sign().is_some_and(|s| s != side) {
+                            return None;
+                        }
+                        (dir, sample.normal * side)
+                    }
+                    None => {
+                        // A face at random, or the one that emits, then a cosine-weighted
+                        // direction.
+                        let (side, u2) = emitting_side(light, u_dir);
+                        let normal = sample.normal * side;
+                        (
+                            Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2)),
+                            normal,
+                        )
+                    }
+                };
+                let le = area_radiance(light, scene, &sample, wl);
+                let cos = dir.dot(normal);
+                let plain = cos / (PI * light.faces.count());
+                let pdf = pick * self.start_pdf(light, sample.point, sample.normal, dir, plain);
+                let point_pdf = pick * self.point_pdf(light, &sample);
+                (cos > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
+                    throughput: le * (cos / pdf),
+                    emission_pdf: pdf,
+                    cos,
+                    delta: false,
+                    light: number,
+                    normal,
+                    far: false,
+                    origin: (point_pdf > 0.0).then(|| EmissionPoint {
+                        point: sample.point,
+                        normal: sample.normal,
+                        faces: light.faces,
+                        radiance: le / point_pdf,
+                    }),
+                })
+            }
+            _ => None,
         }
     }
 }

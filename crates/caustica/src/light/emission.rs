@@ -23,34 +23,44 @@
 use super::aim::Aim;
 use super::area::{AreaLight, AreaSample};
 use super::beam::Beam;
-use super::{spot_profile, DirectSample, Light, LightSet};
+use super::{DirectSample, Light, LightSet};
 use crate::description::EmittingFaces;
-use crate::math::{offset_origin, Frame, Ray, Vec3};
-use crate::sampling::{
-    sample_cosine_hemisphere, sample_uniform_cone, sample_uniform_sphere, uniform_cone_pdf, uniform_sphere_pdf,
-    Distribution1D, Rng,
-};
+use crate::math::{Ray, Vec3};
+use crate::sampling::{Distribution1D, Rng};
 use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
 use glam::Vec2;
 use std::f32::consts::PI;
 
+/// What one emission sample of a light draws from: the scene, the light's number and the
+/// probability it was taken with, the sample's two random pairs (the point's and the
+/// direction's), and the wavelengths.
+#[derive(Clone, Copy)]
+pub(super) struct EmitArgs<'a> {
+    pub scene: &'a Scene,
+    pub number: usize,
+    pub pick: f32,
+    pub u: Vec2,
+    pub u_dir: Vec2,
+    pub wl: &'a Wavelengths,
+}
+
 /// The lights that start photons and light subpaths, chosen in proportion to their power.
 #[derive(Clone, Debug, Default)]
 pub struct Emitters {
     /// Probability of choosing each light of the scene's set (0: not an emitter here).
-    probability: Vec<f32>,
+    pub(super) probability: Vec<f32>,
     /// Light numbers of the emitters, and their choice distribution.
     numbers: Vec<usize>,
     choice: Option<Distribution1D>,
     /// Where points, spots, emissive objects and lights with a size aim a share of their light.
-    near: Option<Aim>,
+    pub(super) near: Option<Aim>,
     /// Where directional lights, suns and the sky aim a share of theirs.
-    far: Option<Aim>,
+    pub(super) far: Option<Aim>,
     /// Each light's beam, for the directional lights and suns.
-    beams: Vec<Option<Beam>>,
+    pub(super) beams: Vec<Option<Beam>>,
     /// The scene's sphere, for the sky's beams (one per direction).
-    sphere: (Vec3, f32),
+    pub(super) sphere: (Vec3, f32),
 }
 
 /// The start of a light subpath.
@@ -151,7 +161,7 @@ impl Emitters {
 
     /// Solid-angle density of a direction `dir` leaving `from`, whose density without aiming
     /// is `plain`: the mixture of that and the aimed cones.
-    fn direction_pdf(&self, from: Vec3, dir: Vec3, plain: f32) -> f32 {
+    pub(super) fn direction_pdf(&self, from: Vec3, dir: Vec3, plain: f32) -> f32 {
         match &self.near {
             None => plain,
             Some(aim) => (1.0 - aim.share()) * plain + aim.share() * aim.pdf(from, dir),
@@ -160,20 +170,20 @@ impl Emitters {
 
     /// Draws whether this subpath is aimed; if so, the aim and the random numbers its sample
     /// uses.
-    fn aimed_lobe(&self, rng: &mut Rng) -> Option<(&Aim, f32, Vec2)> {
+    pub(super) fn aimed_lobe(&self, rng: &mut Rng) -> Option<(&Aim, f32, Vec2)> {
         let aim = self.near.as_ref()?;
         let (u_lobe, u_pick, u) = (rng.uniform(), rng.uniform(), rng.uniform2());
         (u_lobe < aim.share()).then_some((aim, u_pick, u))
     }
 
     /// Draws whether this subpath is aimed; if so, its direction from `from`.
-    fn aimed(&self, from: Vec3, rng: &mut Rng) -> Option<Option<Vec3>> {
+    pub(super) fn aimed(&self, from: Vec3, rng: &mut Rng) -> Option<Option<Vec3>> {
         self.aimed_lobe(rng).map(|(aim, u_pick, u)| aim.sample(from, u_pick, u))
     }
 
     /// Density (area × solid angle) of leaving emissive object `light` at `point`, of unit
     /// normal `normal`, in `dir`, whose direction density without aiming is `plain`.
-    fn start_pdf(&self, light: &AreaLight, point: Vec3, normal: Vec3, dir: Vec3, plain: f32) -> f32 {
+    pub(super) fn start_pdf(&self, light: &AreaLight, point: Vec3, normal: Vec3, dir: Vec3, plain: f32) -> f32 {
         let area = light.pdf_area(normal);
         match (&self.near, light.sphere()) {
             (None, _) => area * plain,
@@ -186,24 +196,13 @@ impl Emitters {
 
     /// Area density of the start point `sample` on emissive object `light` (before the
     /// choice of light): a sphere lamp's aimed starts lie on the halves facing their targets.
-    fn point_pdf(&self, light: &AreaLight, sample: &AreaSample) -> f32 {
+    pub(super) fn point_pdf(&self, light: &AreaLight, sample: &AreaSample) -> f32 {
         let area = light.pdf_area(sample.normal);
         match (&self.near, light.sphere()) {
             (Some(aim), Some((center, radius))) => {
                 (1.0 - aim.share()) * area + aim.share() * aim.sphere_point_pdf(center, radius, sample.point)
             }
             _ => area,
-        }
-    }
-
-    /// Solid-angle density, without aiming, of a point or spot light's direction `dir`.
-    fn point_plain_pdf(light: &Light, dir: Vec3) -> f32 {
-        match light {
-            Light::Spot {
-                direction, cos_outer, ..
-            } if dir.dot(*direction) < *cos_outer => 0.0,
-            Light::Spot { cos_outer, .. } => uniform_cone_pdf(*cos_outer),
-            _ => uniform_sphere_pdf(),
         }
     }
 
@@ -236,175 +235,21 @@ impl Emitters {
     /// The start of a light subpath from light `number`, taken with probability `pick`.
     fn emit_light(&self, scene: &Scene, number: usize, pick: f32, wl: &Wavelengths, rng: &mut Rng) -> Option<Emission> {
         let (u, u_dir) = (rng.uniform2(), rng.uniform2());
-        match scene.lights().get(number)? {
-            light @ Light::Point { position, color, .. } => {
-                let dir = match self.aimed(*position, rng) {
-                    Some(aimed) => aimed?,
-                    None => sample_uniform_sphere(u),
-                };
-                let pdf = pick * self.direction_pdf(*position, dir, Self::point_plain_pdf(light, dir));
-                (pdf > 0.0).then(|| Emission {
-                    ray: Ray::new(*position, dir),
-                    throughput: wl.unbounded(*color) / pdf,
-                    emission_pdf: pdf,
-                    cos: 1.0,
-                    delta: true,
-                    light: number,
-                    normal: dir,
-                    far: false,
-                    origin: None,
-                })
-            }
-            light @ Light::Spot {
-                position,
-                direction,
-                color,
-                cos_inner,
-                cos_outer,
-                exponent,
-                ..
-            } => {
-                let dir = match self.aimed(*position, rng) {
-                    Some(aimed) => aimed?,
-                    None => sample_uniform_cone(u, *direction, *cos_outer),
-                };
-                let profile = spot_profile(dir.dot(*direction), *cos_inner, *cos_outer, *exponent);
-                let pdf = pick * self.direction_pdf(*position, dir, Self::point_plain_pdf(light, dir));
-                (profile > 0.0 && pdf > 0.0).then(|| Emission {
-                    ray: Ray::new(*position, dir),
-                    throughput: wl.unbounded(*color) * (profile / pdf),
-                    emission_pdf: pdf,
-                    cos: 1.0,
-                    delta: true,
-                    light: number,
-                    normal: dir,
-                    far: false,
-                    origin: None,
-                })
-            }
-            Light::Area(light) => {
-                let mut sample = light.sample(scene, rng.uniform(), u)?;
-                let (dir, normal) = match self.aimed_lobe(rng) {
-                    Some((aim, u_pick, u_aim)) => {
-                        let dir = match light.sphere() {
-                            Some((center, radius)) => {
-                                let (normal, dir) =
-                                    aim.sample_from_sphere(center, radius, sample.normal, u_pick, u_aim)?;
-                                sample.normal = normal;
-                                sample.point = center + normal * radius;
-                                dir
-                            }
-                            None => aim.sample(sample.point, u_pick, u_aim)?,
-                        };
-                        // Leaves by the face it points out of, if that face emits.
-                        let side = if dir.dot(sample.normal) >= 0.0 { 1.0 } else { -1.0 };
-                        if light.faces.sign().is_some_and(|s| s != side) {
-                            return None;
-                        }
-                        (dir, sample.normal * side)
-                    }
-                    None => {
-                        // A face at random, or the one that emits, then a cosine-weighted
-                        // direction.
-                        let (side, u2) = emitting_side(light, u_dir);
-                        let normal = sample.normal * side;
-                        (
-                            Frame::from_normal(normal).to_world(sample_cosine_hemisphere(u2)),
-                            normal,
-                        )
-                    }
-                };
-                let le = area_radiance(light, scene, &sample, wl);
-                let cos = dir.dot(normal);
-                let plain = cos / (PI * light.faces.count());
-                let pdf = pick * self.start_pdf(light, sample.point, sample.normal, dir, plain);
-                let point_pdf = pick * self.point_pdf(light, &sample);
-                (cos > 0.0 && pdf > 0.0).then(|| Emission {
-                    ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
-                    throughput: le * (cos / pdf),
-                    emission_pdf: pdf,
-                    cos,
-                    delta: false,
-                    light: number,
-                    normal,
-                    far: false,
-                    origin: (point_pdf > 0.0).then(|| EmissionPoint {
-                        point: sample.point,
-                        normal: sample.normal,
-                        faces: light.faces,
-                        radiance: le / point_pdf,
-                    }),
-                })
-            }
-            light @ (Light::Directional { .. } | Light::Sun { .. }) => {
-                let beam = self.beams[number].as_ref()?;
-                let (origin, plane_pdf) = beam.sample(rng.uniform(), rng.uniform(), u)?;
-                let (dir, radiance) = match beam.sun {
-                    Some((cos_max, _)) => (
-                        sample_uniform_cone(u_dir, beam.direction, cos_max),
-                        light.sun_radiance(),
-                    ),
-                    None => (beam.direction, light.color()),
-                };
-                let lean = dir.dot(beam.direction);
-                let pdf = pick * beam.direction_pdf() * plane_pdf / lean;
-                (lean > 0.0 && pdf > 0.0).then(|| Emission {
-                    ray: Ray::new(origin, dir),
-                    throughput: wl.unbounded(radiance) / pdf,
-                    emission_pdf: pdf,
-                    cos: 1.0,
-                    delta: beam.sun.is_none(),
-                    light: number,
-                    normal: dir,
-                    far: true,
-                    origin: None,
-                })
-            }
-            Light::Environment(env) => {
-                // A direction by the sky's own sampling, then a start across that beam.
-                let sky = env.sample(u_dir)?;
-                let dir = -sky.wi;
-                let (origin, plane_pdf) = self.sky_beam(dir).sample(rng.uniform(), rng.uniform(), u)?;
-                let pdf = pick * sky.pdf * plane_pdf;
-                (pdf > 0.0).then(|| Emission {
-                    ray: Ray::new(origin, dir),
-                    throughput: wl.unbounded(sky.radiance) / pdf,
-                    emission_pdf: pdf,
-                    cos: 1.0,
-                    delta: false,
-                    light: number,
-                    normal: dir,
-                    far: true,
-                    origin: None,
-                })
-            }
-            Light::Soft(light) => {
-                // A point uniform by area, then a cosine-weighted direction (or an aimed one).
-                let s = light.sample_point(u);
-                let dir = match self.aimed(s.point, rng) {
-                    Some(aimed) => aimed?,
-                    None => Frame::from_normal(s.normal).to_world(sample_cosine_hemisphere(u_dir)),
-                };
-                let cos = dir.dot(s.normal);
-                let pdf = pick * self.direction_pdf(s.point, dir, cos.max(0.0) / PI) / light.area();
-                (cos > 0.0 && pdf > 0.0).then(|| Emission {
-                    ray: Ray::new(s.point, dir),
-                    throughput: wl.unbounded(s.radiance) * (cos / pdf),
-                    emission_pdf: pdf,
-                    cos,
-                    // No ray meets it: camera paths never reach it but by next-event estimation.
-                    delta: true,
-                    light: number,
-                    normal: s.normal,
-                    far: false,
-                    origin: Some(EmissionPoint {
-                        point: s.point,
-                        normal: s.normal,
-                        faces: EmittingFaces::Front,
-                        radiance: wl.unbounded(s.radiance) * (light.area() / pick),
-                    }),
-                })
-            }
+        let light = scene.lights().get(number)?;
+        let args = EmitArgs {
+            scene,
+            number,
+            pick,
+            u,
+            u_dir,
+            wl,
+        };
+        match light {
+            Light::Point { .. } | Light::Spot { .. } => self.emit_point(light, args, rng),
+            Light::Area(_) => self.emit_area(light, args, rng),
+            Light::Directional { .. } | Light::Sun { .. } => self.emit_distant(light, args, rng),
+            Light::Environment(_) => self.emit_sky(light, args, rng),
+            Light::Soft(_) => self.emit_soft(light, args, rng),
         }
     }
 
@@ -457,7 +302,7 @@ impl Emitters {
     }
 
     /// The sky's beam travelling in `dir`.
-    fn sky_beam(&self, dir: Vec3) -> Beam {
+    pub(super) fn sky_beam(&self, dir: Vec3) -> Beam {
         let (targets, share) = self.far.as_ref().map_or((&[][..], 0.0), |a| (a.targets(), a.share()));
         Beam::new(dir, None, self.sphere, targets, share)
     }
@@ -483,7 +328,7 @@ impl Emitters {
         let out = -s.wi;
         match scene.lights().get(number) {
             Some(light @ (Light::Point { .. } | Light::Spot { .. })) => {
-                emit * self.direction_pdf(s.point, out, Self::point_plain_pdf(light, out))
+                emit * self.direction_pdf(s.point, out, super::point::plain_pdf(light, out))
             }
             Some(Light::Area(light)) => self.emission_pdf(number, light, s.point, s.normal, out),
             Some(Light::Directional { .. } | Light::Sun { .. }) => self.beams[number]

@@ -6,7 +6,11 @@
 //! down −z — the default camera's view — and u = 0.75 towards +x. `rotation` turns that frame
 //! into the world's.
 
+use super::emission::{Emission, EmitArgs, Emitters};
+use super::{DirectQuery, DirectSample, Light};
+use crate::math::Ray;
 use crate::math::{luminance, Mat3, Vec2, Vec3};
+use crate::sampling::Rng;
 use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf, Distribution2D};
 use crate::texture::Texture;
 use std::f32::consts::PI;
@@ -220,6 +224,64 @@ pub fn equal_area_to_lat_long(square: &Texture) -> Texture {
         }
     }
     Texture::new(w, h, texels).expect("sizes match")
+}
+
+impl Environment {
+    /// Next-event estimation's sample: a direction by the sky's own sampling, visibility
+    /// included.
+    pub(super) fn sample_direct(&self, q: &DirectQuery, u: Vec2) -> Option<DirectSample> {
+        let s = self.sample(u)?;
+        if s.radiance == Vec3::ZERO || !q.scene.unoccluded(q.hit, s.wi, f32::INFINITY) {
+            return None;
+        }
+        let pdf = q.choice * s.pdf;
+        Some(DirectSample {
+            wi: s.wi,
+            distance: f32::INFINITY,
+            contribution: q.wl.unbounded(s.radiance) / pdf,
+            pdf,
+            direct_pdf: pdf,
+            delta: false,
+            point: q.hit.point + s.wi,
+            normal: -s.wi,
+            cos_light: 1.0,
+        })
+    }
+}
+
+impl Emitters {
+    /// A start from the sky: a direction by its own sampling, then a point across that beam.
+    pub(super) fn emit_sky(&self, light: &Light, args: EmitArgs, rng: &mut Rng) -> Option<Emission> {
+        let EmitArgs {
+            number,
+            pick,
+            u,
+            u_dir,
+            wl,
+            ..
+        } = args;
+        match light {
+            Light::Environment(env) => {
+                // A direction by the sky's own sampling, then a start across that beam.
+                let sky = env.sample(u_dir)?;
+                let dir = -sky.wi;
+                let (origin, plane_pdf) = self.sky_beam(dir).sample(rng.uniform(), rng.uniform(), u)?;
+                let pdf = pick * sky.pdf * plane_pdf;
+                (pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(origin, dir),
+                    throughput: wl.unbounded(sky.radiance) / pdf,
+                    emission_pdf: pdf,
+                    cos: 1.0,
+                    delta: false,
+                    light: number,
+                    normal: dir,
+                    far: true,
+                    origin: None,
+                })
+            }
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]

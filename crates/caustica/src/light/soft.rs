@@ -12,8 +12,13 @@
 //!   face (the side u × v points to). Next-event samples pick a point on the light; photons leave
 //!   from a point on it, cosine-weighted or aimed at the caustic targets.
 
+use super::emission::{Emission, EmissionPoint, EmitArgs, Emitters};
+use super::{DirectQuery, DirectSample, Light};
+use crate::description::EmittingFaces;
+use crate::math::Ray;
 use crate::math::{Frame, Vec2, Vec3};
 use crate::sampling::{mix64, sample_uniform_cone, sample_uniform_disc, sample_uniform_sphere, uniform_cone_pdf};
+use crate::sampling::{sample_cosine_hemisphere, Rng};
 use std::f32::consts::PI;
 
 /// Shadow rays per light for the course model's soft shadows (a 5 × 5 stratified pattern).
@@ -258,6 +263,65 @@ impl Iterator for ShadowTargets {
                 corner, u: eu, v: ev, ..
             } => corner + eu * u.x + ev * u.y,
         })
+    }
+}
+
+impl SoftLight {
+    /// Next-event estimation's sample: a point of the light's lit side seen from the query's
+    /// point. Rays never hit this light, so its sample takes no MIS weight (as a point light's).
+    pub(super) fn sample_direct(&self, q: &DirectQuery, u: Vec2) -> Option<DirectSample> {
+        let (s, pdf) = self.sample_towards(q.hit.point, u)?;
+        let to = s.point - q.hit.point;
+        let cos_light = -s.normal.dot(to) / to.length();
+        if cos_light.is_nan() || cos_light <= 0.0 {
+            return None;
+        }
+        q.delta(s.point, s.normal, s.radiance, pdf, cos_light)
+    }
+}
+
+impl Emitters {
+    /// A start from a light with a size: a point uniform by area, then a cosine-weighted direction
+    /// (or an aimed one).
+    pub(super) fn emit_soft(&self, light: &Light, args: EmitArgs, rng: &mut Rng) -> Option<Emission> {
+        let EmitArgs {
+            number,
+            pick,
+            u,
+            u_dir,
+            wl,
+            ..
+        } = args;
+        match light {
+            Light::Soft(light) => {
+                // A point uniform by area, then a cosine-weighted direction (or an aimed one).
+                let s = light.sample_point(u);
+                let dir = match self.aimed(s.point, rng) {
+                    Some(aimed) => aimed?,
+                    None => Frame::from_normal(s.normal).to_world(sample_cosine_hemisphere(u_dir)),
+                };
+                let cos = dir.dot(s.normal);
+                let pdf = pick * self.direction_pdf(s.point, dir, cos.max(0.0) / PI) / light.area();
+                (cos > 0.0 && pdf > 0.0).then(|| Emission {
+                    ray: Ray::new(s.point, dir),
+                    throughput: wl.unbounded(s.radiance) * (cos / pdf),
+                    emission_pdf: pdf,
+                    cos,
+                    // No ray meets it: camera paths never reach it but by next-event estimation.
+                    delta: true,
+                    light: number,
+                    normal: s.normal,
+                    far: false,
+                    origin: Some(EmissionPoint {
+                        point: s.point,
+                        normal: s.normal,
+                        faces: EmittingFaces::Front,
+                        radiance: wl.unbounded(s.radiance) * (light.area() / pick),
+                    }),
+                })
+            }
+            _ => None,
+        }
     }
 }
 
