@@ -532,14 +532,8 @@ impl Emitters {
     /// A start from an emissive object: a point by area, a face, a cosine-weighted direction (or, aimed,
     /// one towards a target from the half of a sphere lamp facing it).
     pub(super) fn emit_area(&self, light: &Light, args: EmitArgs, rng: &mut Rng) -> Option<Emission> {
-        let EmitArgs {
-            scene,
-            number,
-            pick,
-            u,
-            u_dir,
-            wl,
-        } = args;
+        let scene = args.scene;
+        let (number, pick, u, u_dir, wl) = args.parts();
         match light {
             Light::Area(light) => {
                 let mut sample = light.sample(scene, rng.uniform(), u)?;

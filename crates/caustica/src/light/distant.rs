@@ -59,14 +59,7 @@ impl Emitters {
     /// A start from a directional light or a sun: a point across its beam, a direction along it (a
     /// sun's: in its cone).
     pub(super) fn emit_distant(&self, light: &Light, args: EmitArgs, rng: &mut Rng) -> Option<Emission> {
-        let EmitArgs {
-            number,
-            pick,
-            u,
-            u_dir,
-            wl,
-            ..
-        } = args;
+        let (number, pick, u, u_dir, wl) = args.parts();
         match light {
             light @ (Light::Directional { .. } | Light::Sun { .. }) => {
                 let beam = self.beams[number].as_ref()?;

@@ -45,6 +45,13 @@ pub(super) struct EmitArgs<'a> {
     pub wl: &'a Wavelengths,
 }
 
+impl<'a> EmitArgs<'a> {
+    /// The light's number, its probability, the two random pairs and the wavelengths.
+    pub(super) fn parts(self) -> (usize, f32, Vec2, Vec2, &'a Wavelengths) {
+        (self.number, self.pick, self.u, self.u_dir, self.wl)
+    }
+}
+
 /// The lights that start photons and light subpaths, chosen in proportion to their power.
 #[derive(Clone, Debug, Default)]
 pub struct Emitters {

@@ -252,14 +252,7 @@ impl Environment {
 impl Emitters {
     /// A start from the sky: a direction by its own sampling, then a point across that beam.
     pub(super) fn emit_sky(&self, light: &Light, args: EmitArgs, rng: &mut Rng) -> Option<Emission> {
-        let EmitArgs {
-            number,
-            pick,
-            u,
-            u_dir,
-            wl,
-            ..
-        } = args;
+        let (number, pick, u, u_dir, wl) = args.parts();
         match light {
             Light::Environment(env) => {
                 // A direction by the sky's own sampling, then a start across that beam.

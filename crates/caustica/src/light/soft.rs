@@ -284,14 +284,7 @@ impl Emitters {
     /// A start from a light with a size: a point uniform by area, then a cosine-weighted direction
     /// (or an aimed one).
     pub(super) fn emit_soft(&self, light: &Light, args: EmitArgs, rng: &mut Rng) -> Option<Emission> {
-        let EmitArgs {
-            number,
-            pick,
-            u,
-            u_dir,
-            wl,
-            ..
-        } = args;
+        let (number, pick, u, u_dir, wl) = args.parts();
         match light {
             Light::Soft(light) => {
                 // A point uniform by area, then a cosine-weighted direction (or an aimed one).
