@@ -286,8 +286,9 @@ fn cornell_area_light_gi_matches_the_reference() {
     let (worst, text) = report(&film, &reference, &WALLS);
     eprintln!("gi:\n{text}");
     assert!(worst < 0.02, "{text}");
-    // The lit floor holds the spheres' caustics: measured 1.95–2.02% dark over photon streams,
-    // where ppm reads 0.4% and the path tracer 1.7% bright.
+    // The lit floor holds the spheres' caustics, which gi's shrinking gather radius still blurs
+    // at 64 passes: measured 1.95–2.02% dark over photon streams, 0.5% at 256 passes (ppm
+    // reads 0.4% at 64).
     let (floor, text) = report(&film, &reference, &[FLOOR, SHADOW]);
     eprintln!("gi:\n{text}");
     assert!(floor < 0.03, "{text}");
