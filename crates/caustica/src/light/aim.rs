@@ -30,6 +30,15 @@ impl Target {
         (to / d2.sqrt(), (1.0 - r2 / d2).max(0.0).sqrt())
     }
 
+    /// The sphere of `radius` about (x, y, z), for tests.
+    #[cfg(test)]
+    pub(crate) fn at(x: f32, y: f32, z: f32, radius: f32) -> Target {
+        Target {
+            center: Vec3::new(x, y, z),
+            radius,
+        }
+    }
+
     /// The sphere around a box (slightly enlarged so grazing paths are not lost).
     pub fn around(bounds: &Aabb) -> Target {
         Target {
@@ -277,21 +286,14 @@ mod tests {
     use super::*;
     use crate::sampling::{sample_uniform_sphere, uniform_sphere_pdf, Rng};
 
-    fn target(x: f32, y: f32, z: f32, radius: f32) -> Target {
-        Target {
-            center: Vec3::new(x, y, z),
-            radius,
-        }
-    }
-
     #[test]
     fn aimed_density_integrates_to_one_over_the_sphere() {
         // Two overlapping cones and one apart, seen from the origin.
         let aim = Aim::new(
             &[
-                target(0.0, 0.0, -2.0, 0.5),
-                target(0.3, 0.0, -2.0, 0.4),
-                target(2.0, 1.0, 0.0, 0.3),
+                Target::at(0.0, 0.0, -2.0, 0.5),
+                Target::at(0.3, 0.0, -2.0, 0.4),
+                Target::at(2.0, 1.0, 0.0, 0.3),
             ],
             1.0,
         )
@@ -310,9 +312,9 @@ mod tests {
     fn aimed_samples_follow_their_density() {
         // Apart cones: E[1 / pdf] over the samples is the solid angle they cover, Σ 2π(1 − cos).
         let targets = [
-            target(0.0, 0.0, -2.0, 0.5),
-            target(2.0, 1.0, 0.0, 0.3),
-            target(0.0, 3.0, 0.0, 0.2),
+            Target::at(0.0, 0.0, -2.0, 0.5),
+            Target::at(2.0, 1.0, 0.0, 0.3),
+            Target::at(0.0, 3.0, 0.0, 0.2),
         ];
         let aim = Aim::new(&targets, 1.0).unwrap();
         let from = Vec3::new(0.1, -0.2, 0.3);
@@ -332,7 +334,7 @@ mod tests {
 
     /// A sphere lamp of radius 0.5 at the origin and two targets in different directions.
     fn lamp_aim() -> (Aim, f32) {
-        let aim = Aim::new(&[target(0.0, -3.0, 0.0, 1.0), target(2.5, -2.0, 0.5, 0.8)], 1.0).unwrap();
+        let aim = Aim::new(&[Target::at(0.0, -3.0, 0.0, 1.0), Target::at(2.5, -2.0, 0.5, 0.8)], 1.0).unwrap();
         (aim, 0.5)
     }
 
@@ -396,14 +398,14 @@ mod tests {
 
     #[test]
     fn from_inside_a_target_every_direction_is_aimed() {
-        let aim = Aim::new(&[target(0.0, 0.0, 0.0, 1.0)], 1.0).unwrap();
+        let aim = Aim::new(&[Target::at(0.0, 0.0, 0.0, 1.0)], 1.0).unwrap();
         let pdf = aim.pdf(Vec3::new(0.1, 0.0, 0.0), Vec3::X);
         assert!((pdf - uniform_sphere_pdf()).abs() < 1e-6, "{pdf}");
     }
 
     #[test]
     fn many_targets_become_one_around_them_all() {
-        let targets: Vec<Target> = (0..20).map(|i| target(i as f32, 0.0, -5.0, 0.25)).collect();
+        let targets: Vec<Target> = (0..20).map(|i| Target::at(i as f32, 0.0, -5.0, 0.25)).collect();
         let aim = Aim::new(&targets, 0.5).unwrap();
         assert_eq!(aim.targets.len(), 1);
         let all = aim.targets[0];

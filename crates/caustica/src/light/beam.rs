@@ -137,13 +137,6 @@ mod tests {
     use super::*;
     use crate::sampling::{sample_uniform_cone, Rng};
 
-    fn target(x: f32, y: f32, z: f32, radius: f32) -> Target {
-        Target {
-            center: Vec3::new(x, y, z),
-            radius,
-        }
-    }
-
     /// A sun's beam 3° across, a third aimed at two targets, over a scene of radius 4.
     fn sun_beam() -> Beam {
         let cos_max = (1.5f32).to_radians().cos();
@@ -151,7 +144,7 @@ mod tests {
             Vec3::new(-1.2, -1.5, 0.3).normalize(),
             Some((cos_max, 1.0 - cos_max)),
             (Vec3::ZERO, 4.0),
-            &[target(0.0, 0.5, 0.0, 0.5), target(1.0, 0.3, 1.0, 0.3)],
+            &[Target::at(0.0, 0.5, 0.0, 0.5), Target::at(1.0, 0.3, 1.0, 0.3)],
             1.0 / 3.0,
         )
     }
