@@ -161,18 +161,21 @@ impl Shape {
     /// surface never enters. False when unsure, and for shapes without one.
     #[inline]
     pub fn interior_holds(&self, a: Vec3, b: Vec3) -> bool {
+        self.interior_holds_point(a) && self.interior_holds_point(b)
+    }
+
+    /// Whether `p` lies inside the shape's convex interior, well clear of its surface.
+    #[inline]
+    pub fn interior_holds_point(&self, p: Vec3) -> bool {
         // Well inside: a relative margin far above the transform's rounding.
         const INSIDE: f32 = 1.0 - 1e-4;
-        let inside = |p: Vec3| {
-            let q = self.object_from_world.transform_point3(p);
-            match &self.kind {
-                ShapeKind::Sphere => q.length_squared() < INSIDE * INSIDE,
-                ShapeKind::Box => q.abs().max_element() < 0.5 * INSIDE,
-                ShapeKind::Cone(cone) => cone.interior_holds(q, INSIDE),
-                _ => false,
-            }
-        };
-        inside(a) && inside(b)
+        let q = self.object_from_world.transform_point3(p);
+        match &self.kind {
+            ShapeKind::Sphere => q.length_squared() < INSIDE * INSIDE,
+            ShapeKind::Box => q.abs().max_element() < 0.5 * INSIDE,
+            ShapeKind::Cone(cone) => cone.interior_holds(q, INSIDE),
+            _ => false,
+        }
     }
 
     /// Nearest hit in `(0, t_max)` along the world ray.

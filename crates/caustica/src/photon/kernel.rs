@@ -1,6 +1,7 @@
 //! The course model's default radiance estimate: every photon spread over a kernel of its own
-//! width, the distance to its k-th nearest photon on the same surface (a variable-kernel, or
-//! sample-point, density estimate: Breiman, Meisel & Purcell 1977; Silverman 1986, §5.3).
+//! width, the distance to its k-th nearest photon on the same surface, measured once per
+//! kd-tree leaf (a variable-kernel, or sample-point, density estimate: Breiman, Meisel &
+//! Purcell 1977; Silverman 1986, §5.3).
 //!
 //! ```text
 //! L(x, ωo) ≈ Σ_p f(x, ωo, ωp) Φp K(|x − xp|, rp),   K(d, r) = (1 − d/(c r)) / (π r² (1 − 2/(3c)))
@@ -19,285 +20,143 @@
 
 use super::kd_tree::{KdTree, Neighbor, Reach};
 use super::Photon;
-use crate::math::{Vec3, Vec4};
+use crate::math::Vec3;
 use crate::scene::{Scene, SurfaceHit};
 use rayon::prelude::*;
 use std::f32::consts::PI;
 
-/// Each photon's kernel radius (in tree order): the distance to its k-th nearest photon whose
-/// surface faces within `min_normal_cosine` of its own, or `max_radius` when there are fewer
-/// than k that near.
+/// Each photon's kernel radius (in tree order): about the distance to its k-th nearest photon
+/// whose surface faces within `min_normal_cosine` of its own (`max_radius` at most).
 ///
-/// Computed a leaf at a time: the photon nearest the leaf's centre is searched in the tree, and
-/// its radius bounds its leaf-mates' (the triangle inequality), so one ball query around the leaf
-/// gathers every candidate its photons need. Each result is the tree's own to the bit: a photon
-/// whose k-th neighbour the gathered ball does not surely hold is searched in the tree.
+/// Searched once per leaf and surface, not per photon (exact radii, one search each, were a
+/// tenth of the original's worst case): a representative, the leaf-mate nearest the leaf's
+/// centre (or the first on another surface: normals apart by more than [`SHARE_COSINE`]), is
+/// searched, and each photon's radius is blended from the representatives of its leaf and
+/// the leaves beside it in tree order ([`blended`]). The k-th distance changes by at most the
+/// distance moved (the triangle inequality), so each radius stays within its leaf's size of
+/// its own, and a leaf holds at most 16 of the k photons a kernel spans: a small part of the
+/// radius, where the k-th distance is itself noisy (about 1/(2√k) relative: 5% at k = 100).
 pub(super) fn kernel_radii(
     tree: &KdTree,
     photons: &[Photon],
-    normals: &[Vec3],
     k: usize,
     max_radius: f32,
     min_normal_cosine: f32,
 ) -> Vec<f32> {
     let max2 = max_radius * max_radius;
     let cells = tree.leaf_cells();
-    let per_leaf: Vec<Vec<f32>> = cells
+    let search = |photon: &Photon, neighbors: &mut Vec<Neighbor>| {
+        let (code, normal) = (photon.normal_code(), photon.normal());
+        let same = |q: &Photon| q.normal_code() == code || q.normal().dot(normal) >= min_normal_cosine;
+        let r2 = tree.k_nearest_where(photons, photon.position, k, max2, same, neighbors);
+        r2.sqrt().min(max_radius)
+    };
+    if k < SHARE_MIN_K {
+        return photons
+            .par_iter()
+            .map_init(Vec::new, |neighbors, photon| search(photon, neighbors))
+            .collect();
+    }
+    let reps: Vec<Vec<Rep>> = cells
         .par_iter()
-        .map_init(LeafScratch::default, |scratch, (range, lo, hi)| {
-            leaf_radii(
-                tree,
-                (photons, normals),
-                range.clone(),
-                (*lo, *hi),
-                k,
-                max2,
-                min_normal_cosine,
-                scratch,
-            )
-            .into_iter()
-            .map(|r2| r2.sqrt().min(max_radius))
-            .collect()
+        .map_init(Vec::new, |neighbors, (range, lo, hi)| {
+            let leaf = &photons[range.clone()];
+            let centre = (Vec3::from(*lo) + Vec3::from(*hi)) * 0.5;
+            representatives(leaf, centre, |p| search(p, neighbors))
+        })
+        .collect();
+    let per_leaf: Vec<Vec<f32>> = (0..cells.len())
+        .into_par_iter()
+        .map(|j| {
+            let near = &reps[j.saturating_sub(BLEND_LEAVES)..(j + BLEND_LEAVES + 1).min(reps.len())];
+            photons[cells[j].0.clone()]
+                .iter()
+                .map(|photon| blended(photon, near.iter().flatten(), max_radius))
+                .collect()
         })
         .collect();
     per_leaf.concat()
 }
 
-/// A relative margin far above f32 rounding that keeps every coverage and band test on the safe
-/// side.
-const MARGIN: f32 = 1e-4;
+/// Leaves each side (in tree order, so nearby) whose representatives a photon's radius blends.
+const BLEND_LEAVES: usize = 2;
 
-/// Buffers one thread reuses from leaf to leaf.
-#[derive(Default)]
-struct LeafScratch {
-    neighbors: Vec<Neighbor>,
-    /// Gathered candidates: position, normal code and normal.
-    candidates: Vec<(Vec3, [u8; 2], Vec3)>,
-    /// Their coordinates by axis, padded to whole lanes with far-away points, for the band scan.
-    lanes: [Vec<f32>; 3],
-    /// Which candidates lie on the surface of the normal code `same_code` (1 or 0, padded).
-    same: Vec<f32>,
-    same_code: Option<[u8; 2]>,
-    dist2: Vec<f32>,
+/// A photon searched for its leaf-mates on its surface.
+struct Rep {
+    code: [u8; 2],
+    normal: Vec3,
+    position: Vec3,
+    radius: f32,
 }
 
-/// Candidates the band scan tests at once.
-const LANES: usize = 4;
-
-impl LeafScratch {
-    /// Lays the gathered candidates out for the band scan.
-    fn lay_out(&mut self) {
-        for (axis, lane) in self.lanes.iter_mut().enumerate() {
-            lane.clear();
-            lane.extend(self.candidates.iter().map(|c| c.0[axis]));
-            // Padding no band holds: +inf away (and never NaN).
-            lane.resize(self.candidates.len().div_ceil(LANES) * LANES, f32::INFINITY);
-        }
-        self.same_code = None;
-    }
-
-    /// Marks the candidates on the surface of a photon with `code` and `normal`.
-    fn mark_same(&mut self, code: [u8; 2], normal: Vec3, min_normal_cosine: f32) {
-        if self.same_code == Some(code) {
-            return;
-        }
-        self.same.clear();
-        self.same.extend(self.candidates.iter().map(|&(_, c, n)| {
-            if c == code || n.dot(normal) >= min_normal_cosine {
-                1.0
-            } else {
-                0.0
-            }
-        }));
-        self.same.resize(self.lanes[0].len(), 0.0);
-        self.same_code = Some(code);
+impl Rep {
+    fn shares(&self, code: [u8; 2], normal: Vec3) -> bool {
+        self.code == code || self.normal.dot(normal) >= SHARE_COSINE
     }
 }
 
-/// The squared kernel radii of the photons of one leaf.
-#[allow(clippy::too_many_arguments)]
-fn leaf_radii(
-    tree: &KdTree,
-    (photons, normals): (&[Photon], &[Vec3]),
-    range: std::ops::Range<usize>,
-    (lo, hi): ([f32; 3], [f32; 3]),
-    k: usize,
-    max2: f32,
-    min_normal_cosine: f32,
-    scratch: &mut LeafScratch,
-) -> Vec<f32> {
-    let same_surface = |code: [u8; 2], normal: Vec3, q: &Photon| {
-        q.normal_code() == code || q.normal().dot(normal) >= min_normal_cosine
-    };
-    let tree_search = |photon: &Photon, out: &mut Vec<Neighbor>| {
-        let (code, normal) = (photon.normal_code(), photon.normal());
-        tree.k_nearest_where(
-            photons,
-            photon.position,
-            k,
-            max2,
-            |q| same_surface(code, normal, q),
-            out,
-        )
-    };
-    let leaf = &photons[range];
-    let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
-    let finite = leaf.iter().all(|p| p.position.is_finite());
-    if leaf.len() <= 1 || !finite || !(lo.cmple(hi).all()) || k == 0 {
-        return leaf.iter().map(|p| tree_search(p, &mut scratch.neighbors)).collect();
-    }
-    // The photon nearest the leaf's centre is searched in the tree: its radius bounds its
-    // leaf-mates' (each within it ± their distance) most tightly, so the ball around the leaf
-    // that surely holds every photon's k-th neighbour is the smallest.
-    let centre = (lo + hi) * 0.5;
-    let first = (0..leaf.len())
-        .min_by(|&a, &b| {
-            leaf[a]
-                .position
-                .distance_squared(centre)
-                .total_cmp(&leaf[b].position.distance_squared(centre))
-        })
-        .unwrap_or(0);
-    let r0 = tree_search(&leaf[first], &mut scratch.neighbors).sqrt();
-    let max_radius = max2.sqrt();
-    let x0 = leaf[first].position;
-    let reach = leaf
-        .iter()
-        .map(|p| (p.position - centre).length() + (r0 + p.position.distance(x0)).min(max_radius))
-        .fold(0.0f32, f32::max)
-        * (1.0 + 3.0 * MARGIN);
-    scratch.candidates.clear();
-    tree.for_each_within(photons, centre, reach * reach, |slot, _| {
-        let q = &photons[slot as usize];
-        scratch
-            .candidates
-            .push((q.position, q.normal_code(), normals[slot as usize]));
-    });
-    scratch.lay_out();
-    let mut done: Vec<Option<f32>> = vec![None; leaf.len()];
-    done[first] = Some(r0);
-    let mut radii = vec![0.0; leaf.len()];
-    radii[first] = r0 * r0;
-    for (i, photon) in leaf.iter().enumerate() {
-        if i == first {
-            continue;
-        }
-        // The ball around this photon that the gathered candidates surely cover.
-        let covered = reach - (photon.position - centre).length() - MARGIN * reach;
-        // Each leaf-mate done on the same surface (the same normal code, so the same photons
-        // count for both) bounds this one's radius to its own ± their distance: the band is
-        // where all those bounds meet.
-        let band = (0..leaf.len())
-            .filter_map(|j| {
-                let r = done[j]?;
-                (leaf[j].normal_code() == photon.normal_code()).then(|| {
-                    let e = leaf[j].position.distance(photon.position);
-                    (r - e, r + e)
-                })
-            })
-            .reduce(|(a, b), (c, d)| (a.max(c), b.min(d)));
-        let r2 = band
-            .and_then(|(inner, outer)| band_kth(photon, (inner, outer), covered, k, max2, min_normal_cosine, scratch))
-            .or_else(|| covered_kth(photon, covered, k, max2, min_normal_cosine, scratch));
-        let r2 = r2.unwrap_or_else(|| tree_search(photon, &mut scratch.neighbors));
-        done[i] = Some(r2.sqrt());
-        radii[i] = r2;
-    }
-    radii
-}
-
-/// The k-th squared distance from `photon` among the gathered candidates on its surface, when
-/// it lies between `inner` and `outer`: those nearer are counted and only those between ranked.
-/// `None` when the band does not hold the k-th, or reaches past what the candidates cover.
-#[allow(clippy::too_many_arguments)]
-fn band_kth(
-    photon: &Photon,
-    (inner, outer): (f32, f32),
-    covered: f32,
-    k: usize,
-    max2: f32,
-    min_normal_cosine: f32,
-    scratch: &mut LeafScratch,
-) -> Option<f32> {
-    let outer = outer * (1.0 + MARGIN);
-    if outer.is_nan() || outer >= covered || k == 0 {
-        return None;
-    }
-    let inner = inner * (1.0 - MARGIN);
-    let inner2 = if inner > 0.0 { inner * inner } else { -1.0 };
-    let outer2 = (outer * outer).min(max2);
-    scratch.mark_same(photon.normal_code(), photon.normal(), min_normal_cosine);
-    let [px, py, pz] = photon.position.to_array().map(Vec4::splat);
-    let (inner2, outer2) = (Vec4::splat(inner2), Vec4::splat(outer2));
-    let band = &mut scratch.dist2;
-    band.clear();
-    // Room for a whole chunk past the last in-band candidate: every lane is written.
-    band.resize(scratch.same.len() + LANES, 0.0);
-    let (mut nearer, mut in_band) = (0usize, 0usize);
-    let [xs, ys, zs] = &scratch.lanes;
-    let lanes = xs
-        .chunks_exact(LANES)
-        .zip(ys.chunks_exact(LANES))
-        .zip(zs.chunks_exact(LANES));
-    // Four candidates at a time in glam's Vec4 (vector registers where the target has them),
-    // rounded as `KdTree::dist2` rounds.
-    for (((x, y), z), same) in lanes.zip(scratch.same.chunks_exact(LANES)) {
-        let (dx, dy, dz) = (
-            Vec4::from_slice(x) - px,
-            Vec4::from_slice(y) - py,
-            Vec4::from_slice(z) - pz,
-        );
-        let d2 = dx * dx + dy * dy + dz * dz;
-        let same = Vec4::from_slice(same).cmpeq(Vec4::ONE);
-        nearer += ONES[(same & d2.cmplt(inner2)).bitmask() as usize] as usize;
-        let inside = (same & d2.cmpge(inner2) & d2.cmple(outer2)).bitmask();
-        // Every lane is written and the end moves past those in the band: no branch on which
-        // (a branch per lane mispredicted at about every other chunk).
-        for lane in 0..LANES {
-            band[in_band] = d2[lane];
-            in_band += ((inside >> lane) & 1) as usize;
-        }
-    }
-    if nearer >= k || nearer + in_band < k {
-        return None;
-    }
-    let (_, kth, _) = band[..in_band].select_nth_unstable_by(k - 1 - nearer, f32::total_cmp);
-    Some(*kth)
-}
-
-/// Set bits in each 4-bit mask.
-const ONES: [u8; 16] = [0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4];
-
-/// The k-th squared distance from `photon` among all the gathered candidates on its surface
-/// (`max2` when fewer than k lie within it), or `None` when they may not hold it.
-fn covered_kth(
-    photon: &Photon,
-    covered: f32,
-    k: usize,
-    max2: f32,
-    min_normal_cosine: f32,
-    scratch: &mut LeafScratch,
-) -> Option<f32> {
-    let max_radius = max2.sqrt();
+/// The radius of `photon` from the representatives around it on its surface. Each bounds it
+/// to its own radius ± their distance (the triangle inequality; none above `max_radius`). Where
+/// the bounds meet tightly (within half the nearest one's radius) it is the middle of them, so
+/// widths blend from leaf to leaf: one width shared by a whole leaf left clumps of narrow
+/// kernels as bright spots (1.77 × the mean glow, against 1.33 with each photon's own). Where
+/// they say little (representatives far apart for their radii, or at the cap), it is the
+/// nearest one's radius, kept within the bounds.
+fn blended<'a>(photon: &Photon, reps: impl Iterator<Item = &'a Rep>, max_radius: f32) -> f32 {
     let (code, normal) = (photon.normal_code(), photon.normal());
-    scratch.dist2.clear();
-    for &(position, c, n) in &scratch.candidates {
-        if c == code || n.dot(normal) >= min_normal_cosine {
-            let d2 = KdTree::dist2(position, photon.position);
-            if d2 <= max2 {
-                scratch.dist2.push(d2);
-            }
+    let (mut lo, mut hi) = (0.0f32, max_radius);
+    let mut nearest = (f32::INFINITY, 0.0);
+    for rep in reps.filter(|r| r.shares(code, normal)) {
+        let d = rep.position.distance(photon.position);
+        lo = lo.max(rep.radius - d);
+        hi = hi.min(rep.radius + d);
+        if d < nearest.0 {
+            nearest = (d, rep.radius);
         }
     }
-    let everything = covered > max_radius * (1.0 + MARGIN);
-    if scratch.dist2.len() >= k && k > 0 {
-        let (_, kth, _) = scratch.dist2.select_nth_unstable_by(k - 1, f32::total_cmp);
-        let kth = *kth;
-        (everything || (covered > 0.0 && kth < covered * covered)).then_some(kth)
+    let lo = lo.min(hi);
+    if hi - lo <= 0.5 * nearest.1 {
+        0.5 * (lo + hi)
     } else {
-        everything.then_some(max2)
+        nearest.1.clamp(lo, hi)
     }
 }
+
+/// The leaf's representatives: the photon nearest `centre`, searched, then each photon on no
+/// surface of one found before, searched.
+fn representatives(leaf: &[Photon], centre: Vec3, mut search: impl FnMut(&Photon) -> f32) -> Vec<Rep> {
+    let mut by_centre: Vec<usize> = (0..leaf.len()).collect();
+    by_centre.sort_by(|&a, &b| {
+        let (da, db) = (
+            leaf[a].position.distance_squared(centre),
+            leaf[b].position.distance_squared(centre),
+        );
+        da.total_cmp(&db).then(a.cmp(&b))
+    });
+    let mut reps: Vec<Rep> = Vec::new();
+    for i in by_centre {
+        let photon = &leaf[i];
+        let (code, normal) = (photon.normal_code(), photon.normal());
+        if !reps.iter().any(|r| r.shares(code, normal)) {
+            reps.push(Rep {
+                code,
+                normal,
+                position: photon.position,
+                radius: search(photon),
+            });
+        }
+    }
+    reps
+}
+
+/// Least k for which radii are blended from representatives: a leaf holds up to 16 photons, a
+/// sixth of the k a kernel spans at k = 100 (radii then move by about 3% on average, measured in
+/// the tests), but most of them where k is 10 or 3, so small k searches each photon.
+pub(super) const SHARE_MIN_K: usize = 4 * super::kd_tree::LEAF_MAX;
+
+/// Leaf-mates whose normals are this close share a representative (about 8 degrees: the
+/// neighbours each counts are then the same, far inside any `min_normal_cosine` in use).
+pub(super) const SHARE_COSINE: f32 = 0.99;
 
 /// The kernels over a photon map: each photon's radius with the tree's reach over them, and the
 /// photons' normals and incoming directions decoded once, in tree order (an estimate visits a
@@ -454,6 +313,7 @@ pub(super) fn estimate(
         return (Vec3::ZERO, 0.0);
     }
     let occluders = scene.occluders_near(point, widest, hit.prim);
+    let segments = (!occluders.is_empty()).then(|| scene.segments_from(&occluders, point, n));
     let normalisation = match gather.cone_filter {
         Some(c) => 1.0 - 2.0 / (3.0 * c),
         None => 1.0,
@@ -465,8 +325,9 @@ pub(super) fn estimate(
         if f == Vec3::ZERO {
             continue;
         }
-        if !occluders.is_empty()
-            && !scene.segment_clear_of(&occluders, point, n, photon.position, kernels.normals[nb.slot as usize])
+        if segments
+            .as_ref()
+            .is_some_and(|s| !s.clear_to(photon.position, kernels.normals[nb.slot as usize]))
         {
             continue;
         }
@@ -525,24 +386,50 @@ mod tests {
         p
     }
 
+    /// Each photon's own k-th distance on its surface, from the tree.
+    fn exact_radii(tree: &KdTree, p: &[Photon], k: usize, max_radius: f32) -> Vec<f32> {
+        let mut out = Vec::new();
+        p.iter()
+            .map(|photon| {
+                let (code, normal) = (photon.normal_code(), photon.normal());
+                let same = |q: &Photon| q.normal_code() == code || q.normal().dot(normal) >= 0.7;
+                tree.k_nearest_where(p, photon.position, k, max_radius * max_radius, same, &mut out)
+                    .sqrt()
+                    .min(max_radius)
+            })
+            .collect()
+    }
+
     #[test]
-    fn leaf_batched_radii_are_the_trees_own_to_the_bit() {
+    fn shared_radii_stay_within_a_leaf_of_each_photons_own() {
         for mut p in [photons(20_000), crossing(20_000)] {
             let tree = KdTree::build(&mut p);
+            let cells = tree.leaf_cells();
             for (k, max_radius) in [(1, 0.3), (3, 0.3), (10, 0.05), (100, 0.2), (100, 0.01), (400, 10.0)] {
-                let normals: Vec<Vec3> = p.iter().map(Photon::normal).collect();
-                let batched = kernel_radii(&tree, &p, &normals, k, max_radius, 0.7);
-                let mut out = Vec::new();
-                for (i, photon) in p.iter().enumerate() {
-                    let (code, normal) = (photon.normal_code(), photon.normal());
-                    let same = |q: &Photon| q.normal_code() == code || q.normal().dot(normal) >= 0.7;
-                    let r2 = tree.k_nearest_where(&p, photon.position, k, max_radius * max_radius, same, &mut out);
-                    let expected = r2.sqrt().min(max_radius);
-                    assert_eq!(
-                        batched[i].to_bits(),
-                        expected.to_bits(),
-                        "k {k}, max {max_radius}, photon {i}"
-                    );
+                let shared = kernel_radii(&tree, &p, k, max_radius, 0.7);
+                let exact = exact_radii(&tree, &p, k, max_radius);
+                let mut relative = 0.0f64;
+                for (range, lo, hi) in &cells {
+                    let (lo, hi) = (Vec3::from(*lo), Vec3::from(*hi));
+                    // Each lies where its own leaf's representative bounds it: within the leaf's size.
+                    let size = (hi - lo).length();
+                    for i in range.clone() {
+                        let off = (shared[i] - exact[i]).abs();
+                        assert!(
+                            off <= size * (1.0 + 1e-5) + 1e-6,
+                            "k {k}, photon {i}: {off} past leaf {size}"
+                        );
+                        if exact[i] > 0.0 {
+                            relative += f64::from(off / exact[i]);
+                        }
+                    }
+                }
+                let mean = relative / p.len() as f64;
+                // Measured: 3.2–3.4% at k = 100 and max 0.2, 1.3–3.8% at k = 100 and max 0.01,
+                // 1.3–2.2% at k = 400.
+                assert!(mean < 0.05, "k {k}, max {max_radius}: mean relative change {mean}");
+                if k < SHARE_MIN_K {
+                    assert_eq!(mean, 0.0, "k {k}: each photon searched");
                 }
             }
         }

@@ -163,15 +163,8 @@ impl PhotonMap {
                     KERNEL_REACH * bounds.extent().length()
                 };
                 let max_radius = estimate.max_radius.unwrap_or(map.auto_radius);
+                let radii = kernel::kernel_radii(&map.tree, &map.photons, k, max_radius, estimate.min_normal_cosine);
                 let normals: Vec<Vec3> = map.photons.iter().map(Photon::normal).collect();
-                let radii = kernel::kernel_radii(
-                    &map.tree,
-                    &map.photons,
-                    &normals,
-                    k,
-                    max_radius,
-                    estimate.min_normal_cosine,
-                );
                 map.kernels = Some(Kernels::new(&map.tree, &map.photons, normals, radii));
             }
         }
@@ -359,6 +352,7 @@ impl PhotonMap {
             }
             let r = r2.sqrt();
             let occluders = scene.occluders_near(point, r, hit.prim);
+            let segments = (!occluders.is_empty()).then(|| scene.segments_from(&occluders, point, n));
             let mut sum = Vec3::ZERO;
             // Photons on one surface share a normal code: decode it once.
             let mut normal = (None, Vec3::ZERO);
@@ -379,8 +373,9 @@ impl PhotonMap {
                 if f == Vec3::ZERO {
                     continue;
                 }
-                if !occluders.is_empty()
-                    && !scene.segment_clear_of(&occluders, point, n, photon.position, photon.normal())
+                if segments
+                    .as_ref()
+                    .is_some_and(|s| !s.clear_to(photon.position, normal.1))
                 {
                     continue;
                 }
