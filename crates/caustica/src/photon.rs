@@ -10,7 +10,7 @@
 pub mod budget;
 pub mod kd_tree;
 pub mod kernel;
-pub mod light_step;
+pub mod light_walk;
 pub mod map;
 pub mod picture;
 pub mod trace;

@@ -13,11 +13,11 @@
 
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::Progressive;
-use crate::bsdf::{Bsdf, Transport};
+use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::light::emission::EmissionPoint;
 use crate::math::{offset_origin, Ray, Vec3};
-use crate::photon::light_step::{continue_light, Roulette};
+use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
@@ -197,42 +197,18 @@ impl<'a> LightTracer<'a> {
                 }
             }
         }
-        let mut power = emitted.throughput * share;
-        let mut ray = emitted.ray;
-        let mut dispersed = false;
-        for _ in 0..=self.settings.max_depth {
-            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                return;
-            };
-            let hit = scene.surface(&ray, &isect);
-            let wo = -ray.dir;
-            let bsdf = Bsdf::at(scene, &hit, wo, wl);
-            if bsdf.is_smooth() {
-                let splat = self.connect(&hit, &bsdf, wo, power);
-                if let Some((pixel, value)) = splat {
-                    let rgb = wl.to_rgb(value);
-                    if rgb.is_finite() {
-                        out.push((pixel as u32, rgb));
-                    }
-                }
-            }
-            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance) else {
-                return;
-            };
-            // As the photon tracer carries flux.
-            if !continue_light(
-                &hit,
-                wo,
-                &sample,
-                Roulette::KeepFlux,
-                (&mut power, &mut dispersed),
-                wl,
-                &mut rng,
-            ) {
-                return;
-            }
-            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
-        }
+        // The walk's photons carry flux, as the photon tracer's do.
+        let mut splats = Splats { tracer: self, wl, out };
+        let surfaces = self.settings.max_depth.saturating_add(1);
+        walk_light(
+            scene,
+            emitted.ray,
+            emitted.throughput * share,
+            wl,
+            surfaces,
+            &mut rng,
+            &mut splats,
+        );
     }
 
     /// The pixel a photon of flux `power` arriving at `hit` from `wo` lights, and by how much:
@@ -258,6 +234,27 @@ impl<'a> LightTracer<'a> {
         }
         let g = cos / (s.distance * s.distance);
         Some((s.pixel, power * f * (g * s.importance)))
+    }
+}
+
+/// A light tracer's walk: every smooth surface it meets is joined to the eye and splatted.
+struct Splats<'t, 'a> {
+    tracer: &'t LightTracer<'a>,
+    wl: &'t Wavelengths,
+    out: &'t mut Vec<(u32, Vec3)>,
+}
+
+impl LightVisitor for Splats<'_, '_> {
+    fn visit(&mut self, at: &LightArrival) -> bool {
+        if at.bsdf.is_smooth() {
+            if let Some((pixel, value)) = self.tracer.connect(at.hit, at.bsdf, at.wo, at.throughput) {
+                let rgb = self.wl.to_rgb(value);
+                if rgb.is_finite() {
+                    self.out.push((pixel as u32, rgb));
+                }
+            }
+        }
+        true
     }
 }
 

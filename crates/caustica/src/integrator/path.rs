@@ -4,8 +4,9 @@
 //! It cannot see caustics of point or directional lights (a path can never hit a delta light
 //! after a mirror or through glass); that is what photon mapping is for.
 
+use super::camera_walk::{walk_camera, CameraArrival, CameraVisitor};
 use super::direct::{direct_light, emitted, power_heuristic};
-use crate::bsdf::{Bsdf, Transport};
+use crate::bsdf::{BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -43,68 +44,79 @@ impl Default for PathSettings {
 
 /// Radiance arriving along `ray` (unit direction) at the wavelengths `wl`.
 pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
-    let lights = scene.lights();
-    let mut ray = ray;
-    let mut l = Spectrum::ZERO;
-    let mut beta = wl.grey(1.0);
-    let mut dispersed = false;
-    // The last bounce's pdf and point, for weighting emitters that BSDF sampling hits.
-    let mut specular = true;
-    let mut last_pdf = 0.0f32;
-    let mut last_point = ray.origin;
-    for depth in 0..=settings.max_depth {
-        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-            // The sky and suns, weighted against having sampled them directly.
-            l += beta * lights.escaped_weighted(ray.dir, (!specular).then_some(last_pdf), wl);
-            break;
-        };
-        let hit = scene.surface(&ray, &isect);
-        let wo = -ray.dir;
-        let le = emitted(scene, &hit, wo, wl);
-        if le != Spectrum::ZERO {
-            let weight = if specular {
-                1.0
-            } else {
-                power_heuristic(last_pdf, lights.pdf_direct(last_point, &hit))
-            };
-            l += beta * le * weight;
-        }
-        if depth == settings.max_depth {
-            break;
-        }
-        let bsdf = Bsdf::at(scene, &hit, wo, wl);
-        if bsdf.is_black() {
-            break;
-        }
-        if bsdf.is_smooth() {
-            l += beta * direct_light(scene, &hit, &bsdf, wo, true, wl, rng);
-        }
-        let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
-            break;
-        };
-        if depth == 0 && sample.specular && !settings.specular_camera_paths {
-            break;
-        }
-        beta *= sample.weight;
-        if sample.dispersive {
-            wl.terminate_secondary(&mut beta, &mut dispersed);
-        }
-        specular = sample.specular;
-        last_pdf = sample.pdf;
-        last_point = hit.point;
-        if depth + 1 >= settings.roulette_depth {
-            let q = beta.max_element().min(0.95);
-            if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
-                break;
-            }
-            beta /= q;
-        }
-        ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
-    }
-    if l.is_finite() {
-        l
+    let mut path = PathRadiance {
+        scene,
+        settings,
+        wl,
+        l: Spectrum::ZERO,
+        specular: true,
+        last_pdf: 0.0,
+        last_point: ray.origin,
+    };
+    let surfaces = settings.max_depth.saturating_add(1);
+    walk_camera(scene, ray, wl, (surfaces, settings.roulette_depth), rng, &mut path);
+    if path.l.is_finite() {
+        path.l
     } else {
         Spectrum::ZERO
+    }
+}
+
+/// A path tracer's walk: emission weighted against next-event estimation, which each smooth
+/// vertex makes.
+struct PathRadiance<'p> {
+    scene: &'p Scene,
+    settings: &'p PathSettings,
+    wl: &'p Wavelengths,
+    /// Radiance gathered so far.
+    l: Spectrum,
+    /// The last bounce was specular (or the path just left the eye): emitters it hits count in
+    /// full.
+    specular: bool,
+    /// The last bounce's pdf and point, for weighting emitters that BSDF sampling hits.
+    last_pdf: f32,
+    last_point: Vec3,
+}
+
+impl CameraVisitor for PathRadiance<'_> {
+    fn escaped(&mut self, dir: Vec3, throughput: Spectrum, _length: u32) {
+        // The sky and suns, weighted against having sampled them directly.
+        let lights = self.scene.lights();
+        self.l += throughput * lights.escaped_weighted(dir, (!self.specular).then_some(self.last_pdf), self.wl);
+    }
+
+    fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
+        let (scene, hit, wo) = (self.scene, at.hit, at.wo);
+        let le = emitted(scene, hit, wo, self.wl);
+        if le != Spectrum::ZERO {
+            let weight = if self.specular {
+                1.0
+            } else {
+                power_heuristic(self.last_pdf, scene.lights().pdf_direct(self.last_point, hit))
+            };
+            self.l += at.throughput * le * weight;
+        }
+        // The last surface only shows its emission.
+        if at.length > self.settings.max_depth || at.bsdf.is_black() {
+            return false;
+        }
+        if at.bsdf.is_smooth() {
+            self.l += at.throughput * direct_light(scene, hit, at.bsdf, wo, true, self.wl, rng);
+        }
+        true
+    }
+
+    fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        let sample = at
+            .bsdf
+            .sample(at.wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?;
+        if at.length == 1 && sample.specular && !self.settings.specular_camera_paths {
+            return None;
+        }
+        self.specular = sample.specular;
+        self.last_pdf = sample.pdf;
+        self.last_point = at.hit.point;
+        Some(sample)
     }
 }
 

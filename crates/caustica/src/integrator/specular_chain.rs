@@ -1,6 +1,7 @@
 //! The camera paths of the photon-mapping integrators: a camera ray followed through mirrors,
 //! glass and (for `ppm`) sharp highlights to the smooth surfaces where photons are gathered.
 
+use super::camera_walk::{walk_camera, CameraArrival, CameraVisitor};
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
 use crate::sampling::Rng;
@@ -35,67 +36,107 @@ pub fn camera_chain<S, B>(
     (through_specular, through_glossy): (bool, bool),
     wl: &Wavelengths,
     rng: &mut Rng,
-    mut at_smooth: S,
-    mut beyond: B,
+    at_smooth: S,
+    beyond: B,
 ) -> Spectrum
 where
     S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum,
     B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum,
 {
-    let mut ray = ray;
-    let mut beta = wl.grey(1.0);
-    let mut terminated = false;
-    let mut l = Spectrum::ZERO;
-    let mut path_length = 0.0f32;
-    // Set once the path has gone on through a highlight's glossy lobe: the emitters it meets
-    // from there on were counted by that surface's BSDF sample (straight on) or its caustic
-    // photons (by mirrors and glass). Not by its specular lobes, which no photon reaches.
-    let mut past_highlight = false;
-    for depth in 0..=max_depth {
-        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-            // Only the camera and specular chains get here: the sky counts in full.
-            if !past_highlight {
-                l += beta * scene.lights().escaped(ray.dir, wl);
-            }
-            break;
-        };
-        let hit = scene.surface(&ray, &isect);
-        path_length += isect.t;
-        let wo = -ray.dir;
+    let mut chain = Chain {
+        scene,
+        wl,
+        max_depth,
+        through: (through_specular, through_glossy),
+        at_smooth,
+        beyond,
+        l: Spectrum::ZERO,
+        path_length: 0.0,
+        past_highlight: false,
+        last: false,
+    };
+    // No roulette: a chain ends at its first smooth surface, or after `max_depth` mirrors.
+    walk_camera(scene, ray, wl, (max_depth.saturating_add(1), u32::MAX), rng, &mut chain);
+    chain.l
+}
+
+/// A camera chain on its walk (see [`camera_chain`]).
+struct Chain<'c, S, B> {
+    scene: &'c Scene,
+    wl: &'c Wavelengths,
+    max_depth: u32,
+    /// (through_specular, through_glossy)
+    through: (bool, bool),
+    at_smooth: S,
+    beyond: B,
+    /// Radiance gathered so far.
+    l: Spectrum,
+    path_length: f32,
+    /// Set once the path has gone on through a highlight's glossy lobe: the emitters it meets
+    /// from there on were counted by that surface's BSDF sample (straight on) or its caustic
+    /// photons (by mirrors and glass). Not by its specular lobes, which no photon reaches.
+    past_highlight: bool,
+    /// The surface reached is the chain's last: its sample is drawn, but not followed.
+    last: bool,
+}
+
+impl<S, B> CameraVisitor for Chain<'_, S, B>
+where
+    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum,
+    B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum,
+{
+    fn escaped(&mut self, dir: Vec3, throughput: Spectrum, _length: u32) {
+        // Only the camera and specular chains get here: the sky counts in full.
+        if !self.past_highlight {
+            self.l += throughput * self.scene.lights().escaped(dir, self.wl);
+        }
+    }
+
+    fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
+        let (hit, bsdf, wo) = (at.hit, at.bsdf, at.wo);
+        self.path_length += at.t;
         // Only the camera and specular chains reach here: emission counts in full.
-        if !past_highlight {
-            l += beta * super::direct::emitted(scene, &hit, wo, wl);
+        if !self.past_highlight {
+            self.l += at.throughput * super::direct::emitted(self.scene, hit, wo, self.wl);
         }
-        let bsdf = Bsdf::at(scene, &hit, wo, wl);
         if bsdf.is_black() {
-            break;
+            return false;
         }
-        let last = depth == max_depth || depth == 0 && !through_specular;
-        let goes_on_glossy = through_glossy && through_specular && !last && bsdf.is_sharply_glossy();
+        let depth = at.length - 1;
+        let (through_specular, through_glossy) = self.through;
+        self.last = depth == self.max_depth || depth == 0 && !through_specular;
         if bsdf.is_smooth() {
-            let left = max_depth - depth;
-            l += beta * at_smooth(&hit, &bsdf, wo, path_length, terminated, left, goes_on_glossy, rng);
+            let left = self.max_depth - depth;
+            let goes_on_glossy = self.goes_on_glossy(bsdf, through_glossy && through_specular);
+            self.l += at.throughput
+                * (self.at_smooth)(hit, bsdf, wo, self.path_length, at.dispersed, left, goes_on_glossy, rng);
         }
-        let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
-            break;
-        };
+        true
+    }
+
+    fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        let sample = at
+            .bsdf
+            .sample(at.wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?;
         if !sample.specular {
             // Even at the last depth: light that comes straight from an emitter has scattered
             // at this surface only (the BSDF half of its direct light).
-            l += beta * beyond(&hit, &sample, path_length, terminated, max_depth - depth, rng);
-            if !goes_on_glossy {
-                break;
+            let left = self.max_depth - (at.length - 1);
+            self.l += at.throughput * (self.beyond)(at.hit, &sample, self.path_length, at.dispersed, left, rng);
+            let (through_specular, through_glossy) = self.through;
+            if !self.goes_on_glossy(at.bsdf, through_glossy && through_specular) {
+                return None;
             }
-            past_highlight = true;
+            self.past_highlight = true;
         }
-        if last {
-            break;
-        }
-        beta *= sample.weight;
-        if sample.dispersive {
-            wl.terminate_secondary(&mut beta, &mut terminated);
-        }
-        ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+        (!self.last).then_some(sample)
     }
-    l
+}
+
+impl<S, B> Chain<'_, S, B> {
+    /// Whether the chain goes on through this surface's sharp highlight (`through`: glossy and
+    /// specular chains are asked for), not at its last surface.
+    fn goes_on_glossy(&self, bsdf: &Bsdf, through: bool) -> bool {
+        through && !self.last && bsdf.is_sharply_glossy()
+    }
 }

@@ -1,6 +1,5 @@
-//! Photon paths for both shading models, traced by one loop: a photon leaves a light, meets
-//! surfaces, and at each one its [`PhotonModel`] decides what is stored there and where the
-//! photon goes next.
+//! Photon paths for both shading models: a photon leaves a light, meets surfaces, and at each
+//! one its model decides what is stored there and where the photon goes next.
 //!
 //! - [`CourseModel`] (the course's caustics, Jensen 1996): photons follow mirrors
 //!   (`reflective`) and glass (`transmissive`, `index`, total internal reflection), pick up the
@@ -10,18 +9,19 @@
 //!   power by the probability taken. Photons from a point light are scaled by d²·f(d) for their
 //!   path length d (the course's falloff f, §5), which is exactly 1 when f = 1/d²: caustics then
 //!   fall off the same way as the course's direct light (docs/radiometry.md).
-//! - [`PhysicalModel`]: photons scatter by the same BSDF the camera paths use and are stored
+//! - [`PhysicalPhotons`]: photons scatter by the same BSDF the camera paths use and are stored
 //!   wherever they meet a smooth (diffuse or glossy) surface, their history in their flags;
-//!   Russian roulette keeps each photon's flux nearly constant.
+//!   Russian roulette keeps each photon's flux nearly constant. They walk the light side's one
+//!   walk ([`walk_light`]), as the light tracer's paths and vcm's light subpaths do.
 //!
 //! Two drivers emit: [`super::budget::trace_photons`] stores a budget of caustic photons shared
 //! between the lights (course), [`trace_count`] emits a fixed number from lights chosen by power
 //! (physical). Both are deterministic whatever the thread count: photon `i` draws from its own
 //! random stream and batches are concatenated in order.
 
-use super::light_step::{continue_light, Roulette};
+use super::light_walk::{walk_light, LightArrival, LightVisitor, Roulette};
 use super::{Photon, DIFFUSE, DISPERSED, MAX_BOUNCES_LEFT, REFLECTED, REFRACTED};
-use crate::bsdf::{Bsdf, Transport};
+use crate::bsdf::{BsdfSample, Transport};
 use crate::light::{distance_attenuation, Light};
 use crate::material::{channel_indices, refraction_geometry};
 use crate::math::{reflect, refract, Ray, Vec3};
@@ -61,8 +61,13 @@ pub fn trace_count(
                 let mut rng = Rng::new(seed, (stream << 40) ^ i);
                 if let Some(emitted) = lights.emit(scene, wl, &mut rng) {
                     let flux = emitted.throughput * scale;
-                    let model = PhysicalModel { wl: *wl, max_bounces };
-                    trace_path(scene, &model, emitted.ray, flux, max_bounces, &mut rng, out);
+                    let mut photons = PhysicalPhotons {
+                        max_bounces,
+                        flags: 0,
+                        out,
+                    };
+                    let surfaces = max_bounces.saturating_add(1);
+                    walk_light(scene, emitted.ray, flux, wl, surfaces, &mut rng, &mut photons);
                 }
             });
             photons
@@ -99,25 +104,10 @@ pub struct PhotonState {
     pub bounces: u32,
 }
 
-/// What a shading model does with a photon at a surface.
-pub trait PhotonModel: Sync {
-    /// At `hit` in `scene`, reached along `ray`: pushes what is stored there to `out`, updates the photon's
-    /// power and flags, and returns the unit direction it leaves in (`None`: absorbed).
-    fn interact(
-        &self,
-        scene: &Scene,
-        hit: &SurfaceHit,
-        ray: &Ray,
-        photon: &mut PhotonState,
-        rng: &mut Rng,
-        out: &mut Vec<Photon>,
-    ) -> Option<Vec3>;
-}
-
-/// Follows one photon from `ray` carrying `power`; pushes what it stores to `out`.
-pub fn trace_path<M: PhotonModel>(
+/// Follows one course photon from `ray` carrying `power`; pushes what it stores to `out`.
+pub fn trace_path(
     scene: &Scene,
-    model: &M,
+    model: &CourseModel,
     mut ray: Ray,
     power: Spectrum,
     max_bounces: u32,
@@ -155,7 +145,10 @@ pub struct CourseModel<'a> {
     pub internal_reflection: bool,
 }
 
-impl PhotonModel for CourseModel<'_> {
+impl CourseModel<'_> {
+    /// At `hit` in `scene`, reached along `ray`: pushes what is stored there to `out`, updates
+    /// the photon's power and flags, and returns the unit direction it leaves in (`None`:
+    /// absorbed).
     fn interact(
         &self,
         scene: &Scene,
@@ -244,62 +237,50 @@ pub fn falloff_scale(light: &Light, path_length: f32) -> f32 {
     }
 }
 
-/// Photons under the physical model at the wavelengths `wl`: every smooth surface stores them.
-pub struct PhysicalModel {
-    /// The wavelengths (or RGB channels) the photons carry.
-    pub wl: Wavelengths,
+/// Photons under the physical model: every smooth surface a light walk meets stores one, with
+/// the walk's history in its flags.
+pub struct PhysicalPhotons<'o> {
     /// The bounces a photon may make (`--depth`): what it has left is stored with it.
     pub max_bounces: u32,
+    /// [`REFLECTED`], [`REFRACTED`], [`DIFFUSE`] and [`DISPERSED`] so far.
+    pub flags: u8,
+    /// Where the photons go.
+    pub out: &'o mut Vec<Photon>,
 }
 
-impl PhotonModel for PhysicalModel {
-    fn interact(
-        &self,
-        scene: &Scene,
-        hit: &SurfaceHit,
-        ray: &Ray,
-        photon: &mut PhotonState,
-        rng: &mut Rng,
-        out: &mut Vec<Photon>,
-    ) -> Option<Vec3> {
-        let wo = -ray.dir;
-        let bsdf = Bsdf::at(scene, hit, wo, &self.wl);
-        if bsdf.is_smooth() {
+impl LightVisitor for PhysicalPhotons<'_> {
+    fn visit(&mut self, at: &LightArrival) -> bool {
+        if at.bsdf.is_smooth() {
             let left = self
                 .max_bounces
-                .saturating_sub(photon.bounces)
+                .saturating_sub(at.length - 1)
                 .min(MAX_BOUNCES_LEFT as u32) as u8;
-            out.push(Photon::with_spectrum(
-                hit.point,
-                photon.power,
-                ray.dir,
-                bsdf.normal(),
-                photon.flags | left << 4,
+            self.out.push(Photon::with_spectrum(
+                at.hit.point,
+                at.throughput,
+                -at.wo,
+                at.bsdf.normal(),
+                self.flags | left << 4,
             ));
         }
-        let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Importance)?;
-        let mut dispersed = photon.flags & DISPERSED != 0;
-        if !continue_light(
-            hit,
-            wo,
-            &sample,
-            Roulette::KeepFlux,
-            (&mut photon.power, &mut dispersed),
-            &self.wl,
-            rng,
-        ) {
-            return None;
-        }
+        true
+    }
+
+    fn bounce(&mut self, at: &LightArrival, rng: &mut Rng) -> Option<(BsdfSample, Roulette)> {
+        let sample = at
+            .bsdf
+            .sample(at.wo, rng.uniform(), rng.uniform2(), Transport::Importance)?;
+        // Recorded now: they matter only to photons stored after the bounce survives.
         if sample.dispersive {
-            photon.flags |= DISPERSED;
+            self.flags |= DISPERSED;
         }
-        photon.flags |= if !sample.specular {
+        self.flags |= if !sample.specular {
             DIFFUSE
         } else if sample.transmitted {
             REFRACTED
         } else {
             REFLECTED
         };
-        Some(sample.wi)
+        Some((sample, Roulette::KeepFlux))
     }
 }

@@ -4,6 +4,156 @@
 
 use super::*;
 
+/// One camera subpath on its walk: its MIS sums, the variants merging at the first vertex
+/// needs, and the radiance gathered.
+struct CameraSubpath<'v, 'a> {
+    vcm: &'v Vcm<'a>,
+    pass: &'v PassData,
+    /// The light subpath this pixel connects to.
+    own: usize,
+    wl: &'v Wavelengths,
+    work: &'v mut CameraWork,
+    l: Spectrum,
+    partial: Partial,
+    /// The vertex before (the eye at first).
+    previous: Vec3,
+    /// The last bounce's density, for the sky and suns (None: seen directly or by a mirror).
+    last_pdf: Option<f32>,
+    /// The sums as they would be without merging at the first vertex, taken if the second
+    /// turns out to be a mirror or glass (the eye then sees a caustic there), and the sums
+    /// with it, kept along the mirrors and glass that follow: light that reached them from
+    /// a diffuse surface (not a direct caustic) is merged at the first vertex again.
+    without_first_merge: Partial,
+    with_first_merge: Option<Partial>,
+    /// The sums without merging at the last vertex, for an emitter hit next (light reaches
+    /// that vertex first).
+    without_last_merge: Partial,
+    /// Whether the path scattered off a smooth lobe before: merging is a strategy at the
+    /// first vertex where it does (the delta lobes of coated glass, as mirrors and glass,
+    /// pass the merge on to the next vertex).
+    smooth_before: bool,
+    /// Whether the first vertex lies where caustics are focused.
+    first_focused: bool,
+}
+
+impl CameraVisitor for CameraSubpath<'_, '_> {
+    fn escaped(&mut self, dir: Vec3, throughput: Spectrum, length: u32) {
+        let seen = self.vcm.escaped(
+            dir,
+            self.previous,
+            self.last_pdf,
+            &self.without_last_merge,
+            length,
+            self.wl,
+        );
+        self.l += throughput * seen;
+    }
+
+    fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
+        let (vcm, f, wl) = (self.vcm, &self.pass.factors, self.wl);
+        let (hit, bsdf, wo, length) = (at.hit, at.bsdf, at.wo, at.length);
+        let d2 = (hit.point - self.previous).length_squared();
+        let previous = self.previous;
+        self.previous = hit.point;
+        let cos_in = bsdf.normal().dot(wo).abs();
+        self.partial.arrive(d2, cos_in);
+        let le = vcm.scene.emission_towards(hit, wo, wl);
+        if le != Spectrum::ZERO {
+            self.without_last_merge.arrive(d2, cos_in);
+            let weight = vcm.emitter_weight(hit, &self.without_last_merge, previous, wo, d2, length);
+            self.l += at.throughput * le * weight;
+        }
+        if length == 2 && !bsdf.is_smooth() && self.first_focused {
+            self.without_first_merge.arrive(d2, cos_in);
+            self.with_first_merge = Some(self.partial);
+            self.partial = self.without_first_merge;
+        } else if let Some(mut with) = self.with_first_merge {
+            with.arrive(d2, cos_in);
+            self.with_first_merge = Some(with);
+            if bsdf.is_smooth() {
+                self.partial = with;
+                self.with_first_merge = None;
+            }
+        }
+        if !vcm.settings.connections && length > 1 {
+            // The sum's first term stands for a connection that makes this vertex (for an
+            // emitter, next-event estimation, counted above).
+            self.partial.vcm = 0.0;
+        }
+        if length >= vcm.max_length || bsdf.is_black() {
+            return false;
+        }
+        if length == 1 {
+            self.first_focused = vcm.focus.contains(hit.point);
+        }
+        if bsdf.is_smooth() {
+            let merges_here = !self.smooth_before;
+            let v = CameraVertex {
+                hit,
+                bsdf,
+                wo,
+                throughput: at.throughput,
+                partial: self.partial,
+                length,
+                dispersed: at.dispersed,
+            };
+            self.l += vcm.direct(&v, f, wl, rng, self.work);
+            let paths = &self.pass.paths;
+            let own = self.own;
+            if vcm.settings.connections && own + 1 < paths.ends.len() {
+                let (start, end) = (paths.ends[own] as usize, paths.ends[own + 1] as usize);
+                for z in &paths.vertices[start..end] {
+                    self.l += vcm.connect(&v, z, f, wl, merges_here);
+                }
+            }
+            if merges_here && f.merge > 0.0 {
+                let merged = vcm.merge(&v, self.pass, self.work);
+                self.work.merged += merged;
+                self.l += merged;
+            }
+        }
+        true
+    }
+
+    fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        let (f, bsdf, wo, length) = (&self.pass.factors, at.bsdf, at.wo, at.length);
+        let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?;
+        let merges_here = bsdf.is_smooth() && !self.smooth_before;
+        let cos_out = bsdf.normal().dot(sample.wi).abs();
+        self.smooth_before |= !sample.specular;
+        if sample.specular {
+            self.partial.scatter_specular(cos_out);
+            if let Some(with) = self.with_first_merge.as_mut() {
+                with.scatter_specular(cos_out);
+            }
+            self.without_last_merge = self.partial;
+            if length == 1 {
+                self.without_first_merge = self.partial;
+            }
+            self.last_pdf = None;
+        } else {
+            let reverse = self
+                .vcm
+                .light_pdf(bsdf, at.hit.point, wo, bsdf.pdf_reverse(wo, sample.wi));
+            self.without_last_merge = self.partial;
+            self.without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
+            if length == 1 {
+                self.without_first_merge = self.without_last_merge;
+                // An emitter hit next is direct light at the first vertex: no light tracing
+                // there either (its term is the sum's first at the eye's first vertex).
+                self.without_last_merge = Partial {
+                    vcm: 0.0,
+                    ..self.partial
+                };
+                self.without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
+            }
+            self.partial.scatter(f, sample.pdf, reverse, cos_out, merges_here);
+            self.last_pdf = Some(sample.pdf);
+        }
+        Some(sample)
+    }
+}
+
 impl<'a> Vcm<'a> {
     /// Radiance along the camera ray `ray`, joined to the pass's light subpaths (`own`: the
     /// one this pixel connects to).
@@ -16,143 +166,36 @@ impl<'a> Vcm<'a> {
         rng: &mut Rng,
         work: &mut CameraWork,
     ) -> Spectrum {
-        let f = &pass.factors;
-        let scene = self.scene;
         let camera_pdf = self.sensor.importance(ray.dir);
         if camera_pdf <= 0.0 {
             return Spectrum::ZERO;
         }
-        let mut partial = Partial::camera(f, camera_pdf);
-        let mut ray = ray;
-        let mut throughput = wl.grey(1.0);
-        let mut l = Spectrum::ZERO;
-        let mut previous = ray.origin;
-        let mut dispersed = false;
-        // The last bounce's density, for the sky and suns (None: seen directly or by a mirror).
-        let mut last_pdf: Option<f32> = None;
-        // The sums as they would be without merging at the first vertex, taken if the second
-        // turns out to be a mirror or glass (the eye then sees a caustic there), and the sums
-        // with it, kept along the mirrors and glass that follow: light that reached them from
-        // a diffuse surface (not a direct caustic) is merged at the first vertex again.
-        let mut without_first_merge = Partial::default();
-        let mut with_first_merge: Option<Partial> = None;
-        // The sums without merging at the last vertex, for an emitter hit next (light reaches
-        // that vertex first).
-        let mut without_last_merge = Partial::default();
-        // Whether the path scattered off a smooth lobe before: merging is a strategy at the
-        // first vertex where it does (the delta lobes of coated glass, as mirrors and glass,
-        // pass the merge on to the next vertex).
-        let mut smooth_before = false;
-        // Whether the first vertex lies where caustics are focused.
-        let mut first_focused = false;
-        for length in 1..=self.max_length {
-            work.rays += 1;
-            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                l += throughput * self.escaped(ray.dir, previous, last_pdf, &without_last_merge, length, wl);
-                break;
-            };
-            let hit = scene.surface(&ray, &isect);
-            let wo = -ray.dir;
-            let d2 = (hit.point - previous).length_squared();
-            let bsdf = Bsdf::at(scene, &hit, wo, wl);
-            let cos_in = bsdf.normal().dot(wo).abs();
-            partial.arrive(d2, cos_in);
-            let le = scene.emission_towards(&hit, wo, wl);
-            if le != Spectrum::ZERO {
-                without_last_merge.arrive(d2, cos_in);
-                l += throughput * le * self.emitter_weight(&hit, &without_last_merge, previous, wo, d2, length);
-            }
-            if length == 2 && !bsdf.is_smooth() && first_focused {
-                without_first_merge.arrive(d2, cos_in);
-                with_first_merge = Some(partial);
-                partial = without_first_merge;
-            } else if let Some(mut with) = with_first_merge {
-                with.arrive(d2, cos_in);
-                with_first_merge = Some(with);
-                if bsdf.is_smooth() {
-                    partial = with;
-                    with_first_merge = None;
-                }
-            }
-            if !self.settings.connections && length > 1 {
-                // The sum's first term stands for a connection that makes this vertex (for an
-                // emitter, next-event estimation, counted above).
-                partial.vcm = 0.0;
-            }
-            if length >= self.max_length || bsdf.is_black() {
-                break;
-            }
-            let merges_here = bsdf.is_smooth() && !smooth_before;
-            if length == 1 {
-                first_focused = self.focus.contains(hit.point);
-            }
-            if bsdf.is_smooth() {
-                let v = CameraVertex {
-                    hit: &hit,
-                    bsdf: &bsdf,
-                    wo,
-                    throughput,
-                    partial,
-                    length,
-                    dispersed,
-                };
-                l += self.direct(&v, f, wl, rng, work);
-                let paths = &pass.paths;
-                if self.settings.connections && own + 1 < paths.ends.len() {
-                    let (start, end) = (paths.ends[own] as usize, paths.ends[own + 1] as usize);
-                    for z in &paths.vertices[start..end] {
-                        l += self.connect(&v, z, f, wl, merges_here);
-                    }
-                }
-                if merges_here && f.merge > 0.0 {
-                    let merged = self.merge(&v, pass, work);
-                    work.merged += merged;
-                    l += merged;
-                }
-            }
-            let Some(sample) = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance) else {
-                break;
-            };
-            let cos_out = bsdf.normal().dot(sample.wi).abs();
-            smooth_before |= !sample.specular;
-            if sample.specular {
-                partial.scatter_specular(cos_out);
-                if let Some(with) = with_first_merge.as_mut() {
-                    with.scatter_specular(cos_out);
-                }
-                without_last_merge = partial;
-                if length == 1 {
-                    without_first_merge = partial;
-                }
-                last_pdf = None;
-            } else {
-                let reverse = self.light_pdf(&bsdf, hit.point, wo, bsdf.pdf_reverse(wo, sample.wi));
-                without_last_merge = partial;
-                without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
-                if length == 1 {
-                    without_first_merge = without_last_merge;
-                    // An emitter hit next is direct light at the first vertex: no light tracing
-                    // there either (its term is the sum's first at the eye's first vertex).
-                    without_last_merge = Partial { vcm: 0.0, ..partial };
-                    without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
-                }
-                partial.scatter(f, sample.pdf, reverse, cos_out, merges_here);
-                last_pdf = Some(sample.pdf);
-            }
-            throughput *= sample.weight;
-            if sample.dispersive {
-                wl.terminate_secondary(&mut throughput, &mut dispersed);
-            }
-            if length >= ROULETTE_DEPTH {
-                let q = throughput.max_element().min(0.95);
-                if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
-                    break;
-                }
-                throughput /= q;
-            }
-            previous = hit.point;
-            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
-        }
+        let mut subpath = CameraSubpath {
+            vcm: self,
+            pass,
+            own,
+            wl,
+            work,
+            l: Spectrum::ZERO,
+            partial: Partial::camera(&pass.factors, camera_pdf),
+            previous: ray.origin,
+            last_pdf: None,
+            without_first_merge: Partial::default(),
+            with_first_merge: None,
+            without_last_merge: Partial::default(),
+            smooth_before: false,
+            first_focused: false,
+        };
+        let rays = walk_camera(
+            self.scene,
+            ray,
+            wl,
+            (self.max_length, ROULETTE_DEPTH),
+            rng,
+            &mut subpath,
+        );
+        let l = subpath.l;
+        work.rays += rays;
         if l.is_finite() {
             l
         } else {

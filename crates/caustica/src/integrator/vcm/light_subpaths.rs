@@ -9,118 +9,35 @@ impl<'a> Vcm<'a> {
     /// to the eye.
     /// (The pilot run, `to_eye` false, only stores.)
     fn trace_light(&self, pass: u64, index: u64, f: &Factors, wl: &Wavelengths, to_eye: bool, out: &mut LightPaths) {
-        let connected = self.settings.connections && index < self.pixels() as u64;
         let scene = self.scene;
         let mut rng = Rng::new(self.seed ^ LIGHT_SEED, (pass << 40) ^ index);
         let Some(emission) = self.emitters.emit(scene, wl, &mut rng) else {
             return;
         };
-        let mut throughput = emission.throughput;
-        let start = throughput.max_element();
-        let mut partial = Partial::default();
-        let mut ray = emission.ray;
-        let mut previous = emission.ray.origin;
-        let mut dispersed = false;
-        // Only mirrors and glass so far.
-        let mut all_specular = true;
-        for length in 1..self.max_length {
-            out.rays += 1;
-            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                return;
-            };
-            let hit = scene.surface(&ray, &isect);
-            let wo = -ray.dir;
-            let bsdf = Bsdf::at(scene, &hit, wo, wl);
-            if length == 1 {
-                // Next-event estimation's density of the light point depends on where it is
-                // seen from (a sphere is sampled by its cone).
-                let direct = self.emitters.direct_pdf(scene, &emission, hit.point);
-                partial = Partial::light(f, emission.emission_pdf, direct, emission.cos, emission.delta);
-            }
-            // A far light's densities are across its beam: no distance to its first vertex.
-            let d2 = if length == 1 && emission.far {
-                1.0
-            } else {
-                (hit.point - previous).length_squared()
-            };
-            partial.arrive(d2, bsdf.normal().dot(wo).abs());
-            if !self.settings.connections && length > 1 {
-                // The sum's first term stands for a connection that makes this vertex.
-                partial.vcm = 0.0;
-            }
-            let direct_caustic = length > 1 && all_specular;
-            if bsdf.is_smooth() {
-                let vertex = LightVertex {
-                    hit,
-                    wo,
-                    throughput,
-                    partial,
-                    length,
-                    dispersed,
-                    direct_caustic,
-                };
-                if to_eye {
-                    // Direct light is not traced to the eye (see trace_to_eye).
-                    out.rays += u64::from(length > 1);
-                    self.trace_to_eye(&vertex, &bsdf, f, wl, &mut out.splats);
-                }
-                // Light reaching a vertex first is never merged (see the module's notes).
-                if length > 1 {
-                    out.merge_points.push(hit.point);
-                    out.merge_vertices.push(MergeVertex {
-                        wo,
-                        normal: hit.geometric_normal,
-                        throughput,
-                        partial,
-                        length,
-                        dispersed,
-                        direct_caustic,
-                    });
-                }
-                if connected {
-                    out.vertices.push(vertex);
-                }
-            }
-            all_specular &= !bsdf.is_smooth();
-            // A further vertex must still reach the eye within the longest path.
-            if length + 2 > self.max_length {
-                return;
-            }
-            let aim = self.bounce_aim.as_ref().filter(|_| bsdf.is_lambertian());
-            let Some((sample, towards_target)) = light_bounce(&bsdf, hit.point, wo, aim, &mut rng) else {
-                return;
-            };
-            let cos_out = bsdf.normal().dot(sample.wi).abs();
-            if sample.specular {
-                partial.scatter_specular(cos_out);
-            } else {
-                // A light vertex with a smooth vertex after it is never the camera path's first
-                // smooth one: no merging here.
-                partial.scatter(f, sample.pdf, bsdf.pdf_reverse(wo, sample.wi), cos_out, false);
-            }
-            // Flux, as the photon tracer carries it (without Veach's correction a caustic
-            // through smooth-shaded glass came out 1.7% brighter than the photon tracer's),
-            // the roulette keeping the subpath's power near its start; a bounce aimed at a
-            // mirror or glass goes on with the little it carries (the point of aiming it), and a
-            // diffuse bounce after it brings the power back or ends the subpath.
-            let roulette = Roulette::TowardsStart {
-                start,
-                aimed: towards_target,
-            };
-            if !continue_light(
-                &hit,
-                wo,
-                &sample,
-                roulette,
-                (&mut throughput, &mut dispersed),
-                wl,
-                &mut rng,
-            ) {
-                return;
-            }
-            previous = hit.point;
-            ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
-        }
+        let mut subpath = Subpath {
+            vcm: self,
+            f,
+            wl,
+            emission: &emission,
+            to_eye,
+            connected: self.settings.connections && index < self.pixels() as u64,
+            out,
+            partial: Partial::default(),
+            previous: emission.ray.origin,
+            start: emission.throughput.max_element(),
+            all_specular: true,
+        };
+        let surfaces = self.max_length.saturating_sub(1);
+        let rays = walk_light(
+            scene,
+            emission.ray,
+            emission.throughput,
+            wl,
+            surfaces,
+            &mut rng,
+            &mut subpath,
+        );
+        out.rays += rays;
     }
 
     /// Light tracing: the light vertex seen by the eye, splatted onto its pixel.
@@ -207,6 +124,113 @@ impl<'a> Vcm<'a> {
             Some(aim) if bsdf.is_lambertian() => (1.0 - aim.share()) * plain + aim.share() * aim.pdf(point, dir),
             _ => plain,
         }
+    }
+}
+
+/// One light subpath on its walk: its MIS sums so far, and where its vertices go.
+struct Subpath<'v, 'a> {
+    vcm: &'v Vcm<'a>,
+    f: &'v Factors,
+    wl: &'v Wavelengths,
+    emission: &'v Emission,
+    /// Joined to the eye (light tracing): not in the pilot that only stores.
+    to_eye: bool,
+    /// Its vertices are kept for a pixel's connections.
+    connected: bool,
+    out: &'v mut LightPaths,
+    partial: Partial,
+    /// The vertex before (the light's point at first).
+    previous: Vec3,
+    /// The throughput's largest channel as it left the light (the roulette's reference).
+    start: f32,
+    /// Only mirrors and glass so far.
+    all_specular: bool,
+}
+
+impl LightVisitor for Subpath<'_, '_> {
+    fn visit(&mut self, at: &LightArrival) -> bool {
+        let (vcm, f, emission) = (self.vcm, self.f, self.emission);
+        let (hit, wo, bsdf, length) = (*at.hit, at.wo, at.bsdf, at.length);
+        if length == 1 {
+            // Next-event estimation's density of the light point depends on where it is
+            // seen from (a sphere is sampled by its cone).
+            let direct = vcm.emitters.direct_pdf(vcm.scene, emission, hit.point);
+            self.partial = Partial::light(f, emission.emission_pdf, direct, emission.cos, emission.delta);
+        }
+        // A far light's densities are across its beam: no distance to its first vertex.
+        let d2 = if length == 1 && emission.far {
+            1.0
+        } else {
+            (hit.point - self.previous).length_squared()
+        };
+        self.previous = hit.point;
+        let partial = &mut self.partial;
+        partial.arrive(d2, bsdf.normal().dot(wo).abs());
+        if !vcm.settings.connections && length > 1 {
+            // The sum's first term stands for a connection that makes this vertex.
+            partial.vcm = 0.0;
+        }
+        let direct_caustic = length > 1 && self.all_specular;
+        if bsdf.is_smooth() {
+            let vertex = LightVertex {
+                hit,
+                wo,
+                throughput: at.throughput,
+                partial: *partial,
+                length,
+                dispersed: at.dispersed,
+                direct_caustic,
+            };
+            if self.to_eye {
+                // Direct light is not traced to the eye (see trace_to_eye).
+                self.out.rays += u64::from(length > 1);
+                vcm.trace_to_eye(&vertex, bsdf, f, self.wl, &mut self.out.splats);
+            }
+            // Light reaching a vertex first is never merged (see the module's notes).
+            if length > 1 {
+                self.out.merge_points.push(hit.point);
+                self.out.merge_vertices.push(MergeVertex {
+                    wo,
+                    normal: hit.geometric_normal,
+                    throughput: at.throughput,
+                    partial: *partial,
+                    length,
+                    dispersed: at.dispersed,
+                    direct_caustic,
+                });
+            }
+            if self.connected {
+                self.out.vertices.push(vertex);
+            }
+        }
+        self.all_specular &= !bsdf.is_smooth();
+        // A further vertex must still reach the eye within the longest path.
+        length + 2 <= vcm.max_length
+    }
+
+    fn bounce(&mut self, at: &LightArrival, rng: &mut Rng) -> Option<(BsdfSample, Roulette)> {
+        let (bsdf, wo) = (at.bsdf, at.wo);
+        let aim = self.vcm.bounce_aim.as_ref().filter(|_| bsdf.is_lambertian());
+        let (sample, towards_target) = light_bounce(bsdf, at.hit.point, wo, aim, rng)?;
+        let cos_out = bsdf.normal().dot(sample.wi).abs();
+        if sample.specular {
+            self.partial.scatter_specular(cos_out);
+        } else {
+            // A light vertex with a smooth vertex after it is never the camera path's first
+            // smooth one: no merging here.
+            let reverse = bsdf.pdf_reverse(wo, sample.wi);
+            self.partial.scatter(self.f, sample.pdf, reverse, cos_out, false);
+        }
+        // Flux, as the photon tracer carries it (without Veach's correction a caustic
+        // through smooth-shaded glass came out 1.7% brighter than the photon tracer's),
+        // the roulette keeping the subpath's power near its start; a bounce aimed at a
+        // mirror or glass goes on with the little it carries (the point of aiming it), and a
+        // diffuse bounce after it brings the power back or ends the subpath.
+        let roulette = Roulette::TowardsStart {
+            start: self.start,
+            aimed: towards_target,
+        };
+        Some((sample, roulette))
     }
 }
 

@@ -1,0 +1,193 @@
+//! The one random walk on the camera side: the path tracer, the photon-mapping integrators'
+//! camera chains (`ppm`'s visible points, `gi`'s final gather) and vcm's camera subpaths all
+//! follow a camera ray through [`walk_camera`], which finds each surface, makes its BSDF, hands
+//! the vertex to the walk's [`CameraVisitor`] (emission, next-event estimation, photons,
+//! connections, merging), lets the visitor draw the bounce, and carries the throughput on
+//! through [`continue_camera`]: the spectral hero's termination at a dispersive surface,
+//! Russian roulette and the depth, written once. The light side's walk is
+//! [`crate::photon::light_walk`].
+
+use crate::bsdf::{Bsdf, BsdfSample, Transport};
+use crate::math::{Ray, Vec3};
+use crate::sampling::Rng;
+use crate::scene::{Scene, SurfaceHit};
+use crate::spectrum::{Spectrum, Wavelengths};
+
+/// A surface a camera walk has reached, as its visitor sees it.
+pub struct CameraArrival<'a> {
+    /// The surface point.
+    pub hit: &'a SurfaceHit,
+    /// Its BSDF, seen from `wo`.
+    pub bsdf: &'a Bsdf,
+    /// Unit direction back along the arriving ray.
+    pub wo: Vec3,
+    /// The ray's parameter at the hit.
+    pub t: f32,
+    /// The path's throughput on arrival.
+    pub throughput: Spectrum,
+    /// Only the hero wavelength is left (a dispersive surface was passed).
+    pub dispersed: bool,
+    /// Surfaces met so far, this one included (1 at the first).
+    pub length: u32,
+}
+
+/// What a camera walk's user does at each vertex, where the path leaves the scene, and how it
+/// bounces.
+pub trait CameraVisitor {
+    /// The path left the scene along `dir` after `length - 1` surfaces, carrying `throughput`.
+    fn escaped(&mut self, dir: Vec3, throughput: Spectrum, length: u32);
+
+    /// At each surface reached: emission, next-event estimation, gathers. `false` ends the walk.
+    fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool;
+
+    /// The bounce at `at`: by default the BSDF's own sample. `None` ends the walk.
+    fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        at.bsdf
+            .sample(at.wo, rng.uniform(), rng.uniform2(), Transport::Radiance)
+    }
+}
+
+/// Follows the camera ray `ray` at the wavelengths `wl` through at most `max_surfaces`
+/// surfaces, handing each to `visitor`; Russian roulette from the `roulette_from`-th surface's
+/// bounce on (`u32::MAX`: never). Returns the rays traced (surfaces found and the last miss).
+pub fn walk_camera(
+    scene: &Scene,
+    mut ray: Ray,
+    wl: &Wavelengths,
+    (max_surfaces, roulette_from): (u32, u32),
+    rng: &mut Rng,
+    visitor: &mut impl CameraVisitor,
+) -> u64 {
+    let mut throughput = wl.grey(1.0);
+    let mut dispersed = false;
+    let mut rays = 0;
+    for length in 1..=max_surfaces {
+        rays += 1;
+        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+            visitor.escaped(ray.dir, throughput, length);
+            break;
+        };
+        let hit = scene.surface(&ray, &isect);
+        let wo = -ray.dir;
+        let bsdf = Bsdf::at(scene, &hit, wo, wl);
+        let at = CameraArrival {
+            hit: &hit,
+            bsdf: &bsdf,
+            wo,
+            t: isect.t,
+            throughput,
+            dispersed,
+            length,
+        };
+        if !visitor.visit(&at, rng) {
+            break;
+        }
+        let Some(sample) = visitor.bounce(&at, rng) else {
+            break;
+        };
+        let roulette = length >= roulette_from;
+        if !continue_camera(&sample, roulette, (&mut throughput, &mut dispersed), wl, rng) {
+            break;
+        }
+        ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+    }
+    rays
+}
+
+/// Carries a camera path's `(throughput, dispersed)` through the bounce `sample`, or ends the
+/// path (`false`): the sample's weight, at a dispersive surface only the hero wavelength
+/// onwards, and with `roulette` a survival chance of the throughput's largest channel (at most
+/// 0.95).
+pub fn continue_camera(
+    sample: &BsdfSample,
+    roulette: bool,
+    (throughput, dispersed): (&mut Spectrum, &mut bool),
+    wl: &Wavelengths,
+    rng: &mut Rng,
+) -> bool {
+    *throughput *= sample.weight;
+    if sample.dispersive {
+        wl.terminate_secondary(throughput, dispersed);
+    }
+    if roulette {
+        let q = throughput.max_element().min(0.95);
+        if q.is_nan() || q <= 0.0 || rng.uniform() >= q {
+            return false;
+        }
+        *throughput /= q;
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor};
+    use crate::scene::build::test_scene;
+
+    /// Every arrival's length and throughput, and the escapes.
+    #[derive(Default)]
+    struct Record {
+        arrivals: Vec<(u32, f32)>,
+        escaped: u32,
+    }
+
+    impl CameraVisitor for Record {
+        fn escaped(&mut self, _dir: Vec3, _throughput: Spectrum, _length: u32) {
+            self.escaped += 1;
+        }
+        fn visit(&mut self, at: &CameraArrival, _rng: &mut Rng) -> bool {
+            self.arrivals.push((at.length, at.throughput.x));
+            true
+        }
+    }
+
+    impl LightVisitor for Record {
+        fn visit(&mut self, at: &LightArrival) -> bool {
+            self.arrivals.push((at.length, at.throughput.x));
+            true
+        }
+    }
+
+    /// Inside a grey sphere (albedo 0.5) every ray meets a surface. Without roulette a walk
+    /// goes to its depth, one ray a surface, halving its throughput at each bounce; with
+    /// roulette from the first bounce each survival (one in two) restores it to 1, so a camera
+    /// walk makes 2 visits on average; a light walk's roulette keeps its flux the same way.
+    #[test]
+    fn walks_go_to_their_depth_and_their_roulettes_keep_the_mean() {
+        let scene = test_scene("scale(3, 3, 3, sphere { material = { diffuse = (0.5, 0.5, 0.5); } })");
+        let wl = Wavelengths::Rgb;
+        let ray = |rng: &mut Rng| Ray::new(Vec3::ZERO, Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, 1.0));
+        let mut rng = Rng::new(1, 0);
+        let mut record = Record::default();
+        let rays = walk_camera(&scene, ray(&mut rng), &wl, (7, u32::MAX), &mut rng, &mut record);
+        assert_eq!(rays, 7);
+        assert_eq!(record.escaped, 0);
+        for (i, &(length, throughput)) in record.arrivals.iter().enumerate() {
+            assert_eq!(length, i as u32 + 1);
+            let expected = 0.5f32.powi(i as i32);
+            assert!(
+                (throughput - expected).abs() <= 1e-5 * expected,
+                "{throughput} at {length}"
+            );
+        }
+        assert_eq!(record.arrivals.len(), 7);
+
+        let (walks, mut visits, mut camera) = (20_000, 0usize, Record::default());
+        let mut light = Record::default();
+        for _ in 0..walks {
+            walk_camera(&scene, ray(&mut rng), &wl, (1000, 1), &mut rng, &mut camera);
+            walk_light(&scene, ray(&mut rng), wl.grey(1.0), &wl, 1000, &mut rng, &mut light);
+        }
+        for (name, record) in [("camera", &camera), ("light", &light)] {
+            visits += record.arrivals.len();
+            let mean = record.arrivals.len() as f64 / walks as f64;
+            assert!((mean - 2.0).abs() < 0.05, "{name}: {mean} visits a walk");
+            assert!(
+                record.arrivals.iter().all(|&(_, t)| (t - 1.0).abs() < 1e-5),
+                "{name}: the roulette restores the throughput"
+            );
+        }
+        assert!(visits > 70_000, "{visits}");
+    }
+}
