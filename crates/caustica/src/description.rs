@@ -330,6 +330,10 @@ pub struct MaterialDesc {
     pub alpha: Option<Alpha>,
     /// Which faces of the surface send out its `emissive` light.
     pub emitting_faces: EmittingFaces,
+    /// Absorption inside a solid glass, per unit of length (RGB, ≥ 0): light crossing a
+    /// length d inside keeps exp(−σ d) (Beer–Lambert; glTF's `KHR_materials_volume`
+    /// attenuation). `None`: clear.
+    pub absorption: Option<Vec3>,
 }
 
 /// The faces of a surface that emit. A face is named by the geometric normal: a triangle's
@@ -531,6 +535,7 @@ impl Default for MaterialDesc {
             metallic_roughness: None,
             alpha: None,
             emitting_faces: EmittingFaces::Both,
+            absorption: None,
         }
     }
 }

@@ -81,6 +81,8 @@ pub struct Material {
     pub alpha: Option<crate::description::Alpha<Channel>>,
     /// Which faces send out `emissive`.
     pub emitting_faces: crate::description::EmittingFaces,
+    /// Absorption per unit of length inside a solid glass ([`crate::description::MaterialDesc::absorption`]).
+    pub absorption: Option<Vec3>,
 }
 
 /// A material's constant colours as fitted smooth spectra (for spectral transport); `None`

@@ -419,6 +419,21 @@ impl Scene {
         }
     }
 
+    /// What a path that crosses the surface at `hit` in direction `dir` travels through next:
+    /// the glass's absorption per unit of length when `dir` goes in (against the outward
+    /// geometric normal) and the glass absorbs, else nothing (clear glass, or out into the
+    /// air: glass nested in glass is not tracked).
+    #[inline]
+    pub fn absorption_beyond(&self, hit: &SurfaceHit, dir: Vec3) -> Option<Vec3> {
+        if dir.dot(hit.geometric_normal) >= 0.0 {
+            return None;
+        }
+        match hit.material {
+            MaterialRef::One(id) => self.materials[id as usize].absorption,
+            MaterialRef::Blend { .. } => None,
+        }
+    }
+
     /// The radiance a surface point emits towards `wo` at the wavelengths `wl`: zero out of a
     /// face that does not emit.
     #[inline]
@@ -903,6 +918,17 @@ fn segment_ray(a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> Option<(Ray,
 mod tests {
     use super::*;
 
+    /// A fixed stream of numbers in [−1, 1) (xorshift).
+    fn uniform_pm1() -> impl FnMut() -> f32 {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        }
+    }
+
     /// Shapes and a mesh in one scene: the closest hit and the hits visited by `any_hit` are
     /// those of testing every primitive, whichever hierarchy holds it.
     #[test]
@@ -916,13 +942,7 @@ mod tests {
                         material = { diffuse = (1,1,1); } }",
         );
         assert!(!scene.shapes().is_empty() && scene.triangles().len() >= 7);
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut f = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut f = uniform_pm1();
         let prims = scene.primitive_count() as u32;
         let mut hits = 0;
         for _ in 0..4000 {
@@ -964,13 +984,7 @@ mod tests {
              translate(0, 0, -0.5, scale(8, 8, 1, box { material = { diffuse = (1,1,1); } }))
              translate(2.5, 0, 1, scale(0.4, 0.4, 0.4, sphere { material = { diffuse = (1,1,1); } }))",
         );
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut f = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-        };
+        let mut f = uniform_pm1();
         let ring = &scene.shapes[0];
         let (mut blocked, mut held) = (0, 0);
         for _ in 0..20_000 {

@@ -38,7 +38,11 @@ const READ_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_specular",
     "KHR_materials_dispersion",
+    "KHR_texture_transform",
 ];
+
+/// Extensions of images caustica cannot decode: each such image gets its own warning.
+const IMAGE_EXTENSIONS: &[&str] = &["KHR_texture_basisu", "EXT_texture_webp"];
 
 /// Reads a glTF or GLB file's bytes.
 pub fn read(path: &Path, bytes: Vec<u8>, dir: &Path, progress: &dyn Progress) -> Result<SceneSource> {
@@ -362,6 +366,23 @@ impl Reader<'_, '_> {
 
     fn read(&mut self, blob: Option<&[u8]>) -> Result<SceneDescription, ParseError> {
         self.desc.hints.physical = true;
+        // Every extension the file uses and caustica does not render is said (sheen, clearcoat,
+        // iridescence, anisotropy, …): the picture may differ from the author's there.
+        let unread: Vec<(usize, String)> = self
+            .root
+            .extensions_used
+            .iter()
+            .enumerate()
+            .filter(|(_, name)| !READ_EXTENSIONS.contains(&name.as_str()) && !IMAGE_EXTENSIONS.contains(&name.as_str()))
+            .map(|(i, name)| (i, name.clone()))
+            .collect();
+        for (i, name) in unread {
+            self.warn_once(
+                &format!("extension {name}"),
+                &format!("extensionsUsed[{i}]"),
+                format!("{name} is not rendered: the file renders without it"),
+            );
+        }
         for (i, buffer) in self.root.buffers.iter().enumerate() {
             let path = format!("buffers[{i}]");
             let data = match &buffer.uri {
@@ -932,22 +953,29 @@ impl Reader<'_, '_> {
                 _ => Vec3::ONE,
             };
             let thickness = ext.volume.as_ref().map(|v| v.thickness_factor.0);
-            if let Some(v) = &ext.volume {
-                if v.attenuation_distance.0.is_finite() {
-                    self.warn_once(
-                        "attenuation",
-                        &path,
-                        "volume attenuation is not rendered: the glass is clear",
-                    );
-                }
-            }
+            // Beer–Lambert inside: the colour light keeps after attenuationDistance (world units).
+            let absorption = ext.volume.as_ref().and_then(|v| {
+                let distance = v.attenuation_distance.0;
+                (distance.is_finite() && distance > 0.0).then(|| {
+                    let colour = Vec3::from(v.attenuation_color.0).clamp(Vec3::splat(1e-6), Vec3::ONE);
+                    -Vec3::new(colour.x.ln(), colour.y.ln(), colour.z.ln()) / distance
+                })
+            });
             // Solid glass where the file says so (a volume of some thickness) or, without the
             // volume extension, where the mesh is closed: Blender exports glass that way.
             let solid = match thickness {
                 Some(t) => t > 0.0,
                 None => closed,
             };
+            if absorption.is_some() && !solid {
+                self.warn_once(
+                    "attenuation",
+                    &path,
+                    "volume attenuation is not rendered in thin glass (a thickness of 0): it is clear",
+                );
+            }
             if solid {
+                desc.absorption = absorption;
                 if thickness.is_none() {
                     self.warn_once(
                         "solidglass",

@@ -4,11 +4,12 @@
 //! the vertex to the walk's [`CameraVisitor`] (emission, next-event estimation, photons,
 //! connections, merging), lets the visitor draw the bounce, and carries the throughput on
 //! through [`continue_camera`]: the spectral hero's termination at a dispersive surface,
-//! Russian roulette and the depth, written once. The light side's walk is
+//! Russian roulette, absorption inside glass and the depth, written once. The light side's walk is
 //! [`crate::photon::light_walk`].
 
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
+use crate::photon::light_walk::Passage;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -60,21 +61,21 @@ pub fn walk_camera(
 ) -> u64 {
     let mut throughput = wl.grey(1.0);
     let mut dispersed = false;
+    let mut passage = Passage::default();
     let mut rays = 0;
     for length in 1..=max_surfaces {
         rays += 1;
-        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+        let Some((hit, t)) = passage.next(scene, &ray, &mut throughput, wl) else {
             visitor.escaped(ray.dir, throughput, length);
             break;
         };
-        let hit = scene.surface(&ray, &isect);
         let wo = -ray.dir;
         let bsdf = Bsdf::at(scene, &hit, wo, wl);
         let at = CameraArrival {
             hit: &hit,
             bsdf: &bsdf,
             wo,
-            t: isect.t,
+            t,
             throughput,
             dispersed,
             length,
@@ -89,6 +90,7 @@ pub fn walk_camera(
         if !continue_camera(&sample, roulette, (&mut throughput, &mut dispersed), wl, rng) {
             break;
         }
+        passage.cross(scene, &hit, &sample);
         ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
     }
     rays

@@ -4,7 +4,8 @@
 //! keep it for connections and merging), lets the visitor draw the bounce (the BSDF's sample,
 //! or vcm's mixture aimed at mirrors and glass), and carries the throughput on through
 //! [`continue_light`]: Veach's correction for interpolated normals, Russian roulette, the
-//! spectral hero's termination at a dispersive surface and the depth, written once. (The course
+//! spectral hero's termination at a dispersive surface, absorption inside glass and the depth,
+//! written once. (The course
 //! model's caustic photons follow the course's own Phong rules, not a BSDF: their loop is
 //! [`super::trace::trace_path`].)
 
@@ -45,6 +46,52 @@ pub trait LightVisitor {
     }
 }
 
+/// What a path keeps of its light after a length `distance` inside a glass absorbing `sigma`
+/// per unit of length, at the wavelengths `wl` (Beer–Lambert: exp(−σ d), nothing past an
+/// endless length).
+#[inline]
+pub fn transmittance(sigma: Vec3, distance: f32, wl: &Wavelengths) -> Spectrum {
+    let kept = Vec3::select(sigma.cmpgt(Vec3::ZERO), (-sigma * distance).exp(), Vec3::ONE);
+    wl.reflectance(kept)
+}
+
+/// What both walks carry from surface to surface: the glass they are inside, whose absorption
+/// each segment pays.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Passage {
+    absorbing: Option<Vec3>,
+}
+
+impl Passage {
+    /// The next surface along `ray` (`None`: the ray leaves the scene), the throughput
+    /// attenuated by the glass on the way, at the wavelengths `wl`.
+    #[inline]
+    pub fn next(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        throughput: &mut Spectrum,
+        wl: &Wavelengths,
+    ) -> Option<(SurfaceHit, f32)> {
+        let isect = scene.intersect(ray, f32::INFINITY);
+        if let Some(sigma) = self.absorbing {
+            let distance = isect.as_ref().map_or(f32::INFINITY, |i| i.t * ray.dir.length());
+            *throughput *= transmittance(sigma, distance, wl);
+        }
+        let isect = isect?;
+        Some((scene.surface(ray, &isect), isect.t))
+    }
+
+    /// After a bounce at `hit` that goes on along `sample`: through the surface, the walk is
+    /// inside its glass or out of it.
+    #[inline]
+    pub fn cross(&mut self, scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample) {
+        if sample.transmitted {
+            self.absorbing = scene.absorption_beyond(hit, sample.wi);
+        }
+    }
+}
+
 /// Follows light from `ray` carrying `throughput` at the wavelengths `wl` through at most
 /// `max_surfaces` surfaces, handing each to `visitor`. Returns the rays traced (surfaces found
 /// and the last ray's miss).
@@ -58,13 +105,13 @@ pub fn walk_light(
     visitor: &mut impl LightVisitor,
 ) -> u64 {
     let mut dispersed = false;
+    let mut passage = Passage::default();
     let mut rays = 0;
     for length in 1..=max_surfaces {
         rays += 1;
-        let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
+        let Some((hit, _)) = passage.next(scene, &ray, &mut throughput, wl) else {
             break;
         };
-        let hit = scene.surface(&ray, &isect);
         let wo = -ray.dir;
         let bsdf = Bsdf::at(scene, &hit, wo, wl);
         let at = LightArrival {
@@ -84,6 +131,7 @@ pub fn walk_light(
         if !continue_light(&hit, wo, &sample, roulette, (&mut throughput, &mut dispersed), wl, rng) {
             break;
         }
+        passage.cross(scene, &hit, &sample);
         ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
     }
     rays

@@ -506,6 +506,7 @@ impl Builder {
                 None => None,
             },
             emitting_faces: desc.emitting_faces,
+            absorption: desc.absorption.filter(|a| a.cmpgt(Vec3::ZERO).any()),
         };
         let key = MaterialKey(
             [

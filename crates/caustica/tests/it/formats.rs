@@ -537,3 +537,67 @@ fn gltf_not_finite_attributes_are_repaired_not_refused() {
     let normal = scene.surface(&ray, &hit).shading_normal;
     assert!((normal - Vec3::Z).length() < 1e-5, "recomputed normal: {normal}");
 }
+
+/// glTF's volume attenuation is read as Beer–Lambert absorption inside the solid glass: light
+/// keeps `attenuationColor` after `attenuationDistance`, so σ = −ln(colour) / distance.
+#[test]
+fn gltf_volume_attenuation_is_absorption_inside_the_glass() {
+    let text = gltf_file(&meshes()).replace(
+        "\"KHR_materials_volume\":{\"thicknessFactor\":0.8}",
+        "\"KHR_materials_volume\":{\"thicknessFactor\":0.8,\"attenuationColor\":[0.5,0.8,1.0],\"attenuationDistance\":2.0}",
+    );
+    assert!(text.contains("attenuationDistance"));
+    let dir = std::env::temp_dir().join(format!("caustica-attenuation-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("amber.gltf");
+    std::fs::write(&path, text).unwrap();
+    let scene = caustica::loader::load(&path, &caustica::loader::LoadSettings::default()).unwrap();
+    assert!(
+        !scene.warnings().iter().any(|w| w.contains("attenuation")),
+        "{:?}",
+        scene.warnings()
+    );
+    let absorbing: Vec<Vec3> = scene.materials().iter().filter_map(|m| m.absorption).collect();
+    assert_eq!(absorbing.len(), 1, "one absorbing glass");
+    let expected = Vec3::new(-(0.5f32.ln()), -(0.8f32.ln()), 0.0) / 2.0;
+    assert!(
+        (absorbing[0] - expected).abs().max_element() < 1e-6,
+        "{} against {expected}",
+        absorbing[0]
+    );
+}
+
+/// Every extension a glTF uses that caustica does not render gets a warning naming it, once,
+/// located at its place in `extensionsUsed`; those it reads get none.
+#[test]
+fn gltf_extensions_not_rendered_are_said() {
+    let text = gltf_file(&meshes()).replace(
+        "\"extensionsUsed\":[",
+        "\"extensionsUsed\":[\"KHR_materials_sheen\",\"KHR_materials_clearcoat\",",
+    );
+    let dir = std::env::temp_dir().join(format!("caustica-extensions-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("sheen.gltf");
+    std::fs::write(&path, text).unwrap();
+    let scene = caustica::loader::load(&path, &caustica::loader::LoadSettings::default()).unwrap();
+    let warnings = scene.warnings();
+    for name in ["KHR_materials_sheen", "KHR_materials_clearcoat"] {
+        let said: Vec<_> = warnings.iter().filter(|w| w.contains(name)).collect();
+        assert_eq!(said.len(), 1, "{name}: {warnings:?}");
+        assert!(
+            said[0].contains("not rendered") && said[0].contains(":1:"),
+            "{}",
+            said[0]
+        );
+    }
+    for read in [
+        "KHR_materials_transmission",
+        "KHR_materials_volume",
+        "KHR_lights_punctual",
+    ] {
+        assert!(
+            !warnings.iter().any(|w| w.contains(&format!("{read} is not"))),
+            "{warnings:?}"
+        );
+    }
+}

@@ -8,6 +8,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod absorption;
 mod area_light_faces;
 mod camera_fit;
 mod caustic_scenes;

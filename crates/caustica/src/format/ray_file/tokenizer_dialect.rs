@@ -55,6 +55,7 @@ const MATERIAL_FIELDS: &[&str] = &[
     "shininess",
     "index",
     "abbe",
+    "absorption",
     "name",
 ];
 const CAMERA_FIELDS: &[&str] = &[
@@ -971,6 +972,20 @@ impl<'a> Parser<'a> {
                     self.cur.eat(Tok::Semicolon);
                     material.abbe = Some(value);
                 }
+                "absorption" => {
+                    self.key_equals()?;
+                    let (value, span) =
+                        self.tuple::<3>("(the absorption per unit of length inside the glass) for `absorption`")?;
+                    let value = Vec3::from(value);
+                    if !(value.cmpge(Vec3::ZERO).all() && value.is_finite()) {
+                        return Err(ParseError::new(
+                            format!("`absorption` is per unit of length, each value zero or more, not {value}"),
+                            span,
+                        ));
+                    }
+                    self.cur.eat(Tok::Semicolon);
+                    material.absorption = Some(value);
+                }
                 _ if COLOUR_FIELDS.contains(&key) || key == "shininess" || key == "index" => {
                     self.key_equals()?;
                     let value = if self.cur.at_word("map") {
@@ -985,7 +1000,7 @@ impl<'a> Parser<'a> {
                 }
                 _ if self.skip_extension_field("material")? => {}
                 _ => {
-                    let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `abbe`, `name`";
+                    let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `abbe`, `absorption`, `name`";
                     return Err(self.bad_word(&format!("a material field ({list}) or `}}`"), MATERIAL_FIELDS));
                 }
             }

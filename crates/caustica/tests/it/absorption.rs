@@ -1,0 +1,74 @@
+//! Beer–Lambert absorption inside glass, on both walks: light crossing a slab of thickness d
+//! that absorbs σ per unit of length keeps exp(−σ d) of what clear glass lets through (the
+//! Fresnel factors are the same for both and cancel; light reflected twice inside, R² = 0.16% of
+//! it, moves the ratio by less than that).
+
+use crate::common::{render_integrator, scene};
+use caustica::math::Vec3;
+use caustica::scene::Scene;
+
+const THICKNESS: f32 = 0.5;
+const SIGMA: Vec3 = Vec3::new(1.0, 0.3, 0.0);
+
+/// `objects` with a 0.8-wide slab of glass at `at`, absorbing `sigma` (or clear).
+fn with_slab(objects: &str, at: Vec3, sigma: Option<Vec3>) -> Scene {
+    let absorption = sigma.map_or(String::new(), |s| format!("absorption = ({}, {}, {});", s.x, s.y, s.z));
+    scene(&format!(
+        "SBT-raytracer 1.0
+         {objects}
+         translate({}, {}, {}, scale(0.8, 0.8, {THICKNESS}, box {{ material = {{ transmissive = (1, 1, 1); index = 1.5; {absorption} }} }}))",
+        at.x, at.y, at.z
+    ))
+}
+
+/// The clear slab's ratio to the absorbing one's, channel by channel, against exp(−σ d).
+fn check(name: &str, clear: Vec3, absorbing: Vec3, tolerance: f32) {
+    let expected = (-SIGMA * THICKNESS).exp();
+    let ratio = absorbing / clear;
+    eprintln!("{name}: {ratio} against {expected}");
+    assert!(
+        clear.min_element() > 0.0,
+        "{name}: nothing through the clear slab {clear}"
+    );
+    assert!(
+        (ratio - expected).abs().max_element() <= tolerance * expected.max_element(),
+        "{name}: the slab kept {ratio}, want {expected}"
+    );
+}
+
+/// The camera's side: a lamp seen through the slab, by path, ppm and vcm (their camera walks go
+/// through glass to an emitter).
+#[test]
+fn an_emitter_seen_through_absorbing_glass_keeps_exp_minus_sigma_d() {
+    let objects = "camera { position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 8; }
+         translate(0, 0, -1, scale(4, 4, 1, square { material = { emissive = (1, 1, 1); diffuse = (0, 0, 0); } }))";
+    let at = Vec3::new(0.0, 0.0, 0.5);
+    let (clear, absorbing) = (with_slab(objects, at, None), with_slab(objects, at, Some(SIGMA)));
+    for integrator in ["path", "ppm", "vcm"] {
+        let mean = |scene: &Scene| render_integrator(scene, integrator, 16, 4, 20_000, 3).region_mean((4, 12), (4, 12));
+        check(integrator, mean(&clear), mean(&absorbing), 0.01);
+    }
+}
+
+/// The light's side: a point light's caustic through the slab onto a floor, by lt, ppm and vcm
+/// (their photons and light subpaths cross the glass); the camera sees that floor past the slab.
+#[test]
+fn light_through_absorbing_glass_keeps_exp_minus_sigma_d() {
+    // The camera looks at the floor under the slab past its side (its ray there clears the
+    // slab's bottom edge by 0.6).
+    let objects = "camera { position = (0, -6, 2); viewdir = (0, 8, -2); updir = (0, 0, 1); fov = 20; }
+         point_light { position = (0, 2, 3); color = (1, 1, 1); constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
+         scale(20, 20, 1, square { material = { diffuse = (0.5, 0.5, 0.5); } })";
+    let at = Vec3::new(0.0, 2.0, 0.5);
+    let (clear, absorbing) = (with_slab(objects, at, None), with_slab(objects, at, Some(SIGMA)));
+    const SIZE: usize = 48;
+    let camera = clear.camera().fitted(SIZE, SIZE);
+    let (sx, sy) = camera.project(Vec3::new(0.0, 2.0, 0.0)).unwrap();
+    let (x, y) = ((sx * SIZE as f32) as usize, ((1.0 - sy) * SIZE as f32) as usize);
+    for integrator in ["lt", "ppm", "vcm"] {
+        let mean = |scene: &Scene| {
+            render_integrator(scene, integrator, SIZE, 4, 200_000, 5).region_mean((y - 1, y + 1), (x - 1, x + 1))
+        };
+        check(integrator, mean(&clear), mean(&absorbing), 0.03);
+    }
+}
