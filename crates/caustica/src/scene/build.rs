@@ -527,12 +527,13 @@ impl Builder {
             .chain([material.abbe.map_or(0, f32::to_bits)])
             .chain(
                 format!(
-                    "{:?} {:?} {:?} {:?} {:?}",
+                    "{:?} {:?} {:?} {:?} {:?} {:?}",
                     material.physical,
                     material.normal_map,
                     material.metallic_roughness,
                     material.alpha,
-                    material.emitting_faces
+                    material.emitting_faces,
+                    material.absorption
                 )
                 .bytes()
                 .map(u32::from),

@@ -4,6 +4,7 @@
 //! it, moves the ratio by less than that).
 
 use crate::common::{render_integrator, scene};
+use caustica::material::Channel;
 use caustica::math::Vec3;
 use caustica::scene::Scene;
 
@@ -71,4 +72,19 @@ fn light_through_absorbing_glass_keeps_exp_minus_sigma_d() {
         };
         check(integrator, mean(&clear), mean(&absorbing), 0.03);
     }
+}
+
+/// An absorbing glass and a clear one alike in every other value stay two materials (the
+/// scene's materials are shared by their values, absorption among them).
+#[test]
+fn absorbing_and_clear_glass_stay_apart() {
+    let clear_ball = "translate(2, 0, 0, sphere { material = { transmissive = (1, 1, 1); index = 1.5; } })";
+    let scene = with_slab(clear_ball, Vec3::ZERO, Some(SIGMA));
+    let glass: Vec<_> = scene
+        .materials()
+        .iter()
+        .filter(|m| matches!(m.index, Channel::Constant(i) if i.x > 1.0))
+        .collect();
+    assert_eq!(glass.len(), 2, "two glasses");
+    assert_eq!(glass.iter().filter(|m| m.absorption == Some(SIGMA)).count(), 1);
 }
