@@ -41,8 +41,9 @@ const READ_EXTENSIONS: &[&str] = &[
     "KHR_texture_transform",
 ];
 
-/// Extensions of images caustica cannot decode: each such image gets its own warning.
-const IMAGE_EXTENSIONS: &[&str] = &["KHR_texture_basisu", "EXT_texture_webp"];
+/// Extensions that need no warning when unread: images caustica cannot decode (each such
+/// image gets its own warning) and metadata, which changes nothing in the picture.
+const UNSAID_EXTENSIONS: &[&str] = &["KHR_texture_basisu", "EXT_texture_webp", "KHR_xmp", "KHR_xmp_json_ld"];
 
 /// Reads a glTF or GLB file's bytes.
 pub fn read(path: &Path, bytes: Vec<u8>, dir: &Path, progress: &dyn Progress) -> Result<SceneSource> {
@@ -373,7 +374,9 @@ impl Reader<'_, '_> {
             .extensions_used
             .iter()
             .enumerate()
-            .filter(|(_, name)| !READ_EXTENSIONS.contains(&name.as_str()) && !IMAGE_EXTENSIONS.contains(&name.as_str()))
+            .filter(|(_, name)| {
+                !READ_EXTENSIONS.contains(&name.as_str()) && !UNSAID_EXTENSIONS.contains(&name.as_str())
+            })
             .map(|(i, name)| (i, name.clone()))
             .collect();
         for (i, name) in unread {
