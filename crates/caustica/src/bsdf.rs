@@ -26,7 +26,11 @@
 //!   coat both ways (reciprocal, and never more than the coat lets through);
 //! - Lambertian transmission to the far side;
 //! - a thin-walled dielectric: Fresnel reflection of the sheet's two faces, 2R/(1 + R), and the
-//!   rest straight through.
+//!   rest straight through;
+//! - a rough dielectric (frosted glass): GGX reflection and refraction ([`rough_dielectric`]),
+//!   a smooth lobe on both sides of the surface.
+
+mod rough_dielectric;
 
 use crate::material::{Lobes, MaterialRef, MaterialSpectra, PhysicalMaterial, SurfaceParams};
 use crate::math::{reflect, Frame, Vec3, Vec4};
@@ -75,6 +79,12 @@ pub struct Bsdf {
     diffuse_transmission: Spectrum,
     /// The dielectric is a thin sheet: it passes light straight through.
     thin: bool,
+    /// GGX α of a rough dielectric ([`rough_dielectric`]); 0 for a smooth one.
+    rough: f32,
+    /// A rough dielectric's index at the d line and Abbe number (0: not dispersive), for the
+    /// index at each wavelength.
+    index_d: f32,
+    abbe: f32,
     /// The outside's diffuse, glossy and mirror lobes' albedo bound ([`Lobes::reflection_bound`]).
     reflection_bound: f32,
     /// The wavelengths, for colours computed per direction (a conductor's Fresnel reflectance).
@@ -228,6 +238,9 @@ impl Bsdf {
             microfacet: None,
             diffuse_transmission: Spectrum::ZERO,
             thin: false,
+            rough: 0.0,
+            index_d: lobes.index,
+            abbe: 0.0,
             reflection_bound: lobes.reflection_bound,
             wl: *wl,
         }
@@ -317,6 +330,29 @@ impl Bsdf {
                 b.thin = true;
                 b.pick[3] = 1.0;
             }
+            PhysicalMaterial::RoughDielectric {
+                eta,
+                roughness,
+                tint,
+                abbe,
+            } => {
+                let eta = if eta > 0.0 { eta } else { 1.0 };
+                b.transmission = wl.reflectance(clamp01(tint));
+                b.index_d = eta;
+                b.index = eta;
+                if let (Some(v), Some(lambda)) = (abbe, wl.hero()) {
+                    b.index = cauchy_index(eta, v, lambda);
+                    b.abbe = v;
+                }
+                if roughness < SMOOTH_ALPHA {
+                    // A smooth interface: the hero alone follows a dispersive refraction.
+                    b.dispersive = b.abbe > 0.0;
+                    b.abbe = 0.0;
+                } else {
+                    b.rough = roughness.min(1.0);
+                }
+                b.pick[3] = 1.0;
+            }
         }
         let sum: f32 = b.pick.iter().sum();
         if sum > 0.0 {
@@ -329,7 +365,7 @@ impl Bsdf {
     /// are stored.
     #[inline]
     pub fn is_smooth(&self) -> bool {
-        self.pick[0] > 0.0 || self.pick[1] > 0.0 || self.pick[4] > 0.0 || self.pick[5] > 0.0
+        self.pick[0] > 0.0 || self.pick[1] > 0.0 || self.pick[4] > 0.0 || self.pick[5] > 0.0 || self.rough > 0.0
     }
 
     /// Whether every smooth lobe is narrow: a Phong lobe of exponent at least
@@ -341,14 +377,15 @@ impl Bsdf {
         let no_diffuse = self.pick[0] == 0.0 && self.pick[5] == 0.0;
         let phong_sharp = self.pick[1] == 0.0 || self.exponent >= SHARP_EXPONENT;
         let ggx_sharp = self.pick[4] == 0.0 || self.microfacet.is_some_and(|m| m.alpha <= SHARP_ALPHA);
-        no_diffuse && phong_sharp && ggx_sharp && self.is_smooth()
+        let glass_sharp = self.rough <= SHARP_ALPHA;
+        no_diffuse && phong_sharp && ggx_sharp && glass_sharp && self.is_smooth()
     }
 
     /// Whether light arriving on the far side reaches `wo` through a smooth lobe (diffuse
-    /// transmission): photons on both faces count at such a point.
+    /// transmission, rough glass): photons on both faces count at such a point.
     #[inline]
     pub fn transmits_smoothly(&self) -> bool {
-        self.pick[5] > 0.0
+        self.pick[5] > 0.0 || self.rough > 0.0
     }
 
     /// Whether light can leave the surface at all.
@@ -363,8 +400,20 @@ impl Bsdf {
         self.frame.z
     }
 
-    /// The smooth lobes' f(wo, wi) (delta lobes are never hit by a given direction).
+    /// The smooth lobes' f(wo, wi) for radiance (delta lobes are never hit by a given
+    /// direction).
+    #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Spectrum {
+        self.eval_in(wo, wi, Transport::Radiance)
+    }
+
+    /// The smooth lobes' f(wo, wi) for the transport `mode`: a walk from a light evaluates the
+    /// adjoint, which differs where rough glass refracts (by η²).
+    #[inline]
+    pub fn eval_in(&self, wo: Vec3, wi: Vec3, mode: Transport) -> Spectrum {
+        if self.rough > 0.0 {
+            return self.rough_eval(wo, wi, mode);
+        }
         let n = self.frame.z;
         let cos_i = n.dot(wi);
         if cos_i < 0.0 && self.ng.dot(wi) < 0.0 {
@@ -416,6 +465,9 @@ impl Bsdf {
 
     /// Solid-angle pdf with which [`Bsdf::sample`] draws `wi` through its smooth lobes.
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.rough > 0.0 {
+            return self.rough_pdf(wo, wi, false);
+        }
         let n = self.frame.z;
         let cos_i = n.dot(wi);
         if cos_i < 0.0 && self.ng.dot(wi) < 0.0 {
@@ -442,6 +494,9 @@ impl Bsdf {
     /// and chosen with fixed probabilities, so reflection swaps the arguments; transmission
     /// is Lambertian either way.
     pub fn pdf_reverse(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.rough > 0.0 {
+            return self.rough_pdf(wo, wi, true);
+        }
         if self.ng.dot(wi) < 0.0 {
             return self.pick[5] * self.frame.z.dot(wo).abs() / PI;
         }
@@ -482,6 +537,9 @@ impl Bsdf {
         }
         if self.thin {
             return self.sample_thin(wo, (x - p_mirror) / p_dielectric);
+        }
+        if self.rough > 0.0 {
+            return self.sample_rough(wo, (x - p_mirror) / p_dielectric, u, mode);
         }
         // The dielectric: reflect with probability F, else refract.
         let x = ((x - p_mirror) / p_dielectric).clamp(0.0, 1.0);
@@ -579,6 +637,74 @@ impl Bsdf {
         None
     }
 
+    /// The relative index of a rough dielectric from `wo`'s side, at the hero wavelength.
+    #[inline]
+    fn rough_interface(&self, index: f32) -> rough_dielectric::Interface {
+        rough_dielectric::Interface::new(self.rough, if self.outside { index } else { 1.0 / index })
+    }
+
+    /// Whether `wi` leaves on the side the shading normal says: reflection above both normals,
+    /// transmission below both (light never leaks through the geometric surface).
+    #[inline]
+    fn sides_agree(&self, wi: Vec3) -> bool {
+        (self.frame.z.dot(wi) > 0.0) == (self.ng.dot(wi) > 0.0)
+    }
+
+    /// A rough dielectric's f: each wavelength refracts by its own index where the glass is
+    /// dispersive, so every wavelength follows any direction (no hero termination).
+    fn rough_eval(&self, wo: Vec3, wi: Vec3, mode: Transport) -> Spectrum {
+        if !self.sides_agree(wi) {
+            return Spectrum::ZERO;
+        }
+        let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        let f = match self.wl {
+            Wavelengths::Sampled { lambda, .. } if self.abbe > 0.0 => Vec4::from_array(lambda.map(|l| {
+                self.rough_interface(cauchy_index(self.index_d, self.abbe, l))
+                    .eval(lo, li, mode)
+            })),
+            _ => self.wl.grey(self.rough_interface(self.index).eval(lo, li, mode)),
+        };
+        if li.z < 0.0 {
+            f * self.transmission
+        } else {
+            f
+        }
+    }
+
+    /// The density of drawing `wi` from `wo` (`reverse`: of drawing `wo` had the walk arrived
+    /// from `wi`, seen from `wi`'s side, where the relative index is inverted).
+    fn rough_pdf(&self, wo: Vec3, wi: Vec3, reverse: bool) -> f32 {
+        if !self.sides_agree(wi) {
+            return 0.0;
+        }
+        let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        match (reverse, li.z < 0.0) {
+            (false, _) => self.rough_interface(self.index).pdf(lo, li),
+            (true, false) => self.rough_interface(self.index).pdf(li, lo),
+            // Seen from the far side the relative index is inverted.
+            (true, true) => self.rough_interface(1.0 / self.index).pdf(-li, -lo),
+        }
+    }
+
+    /// Reflection or refraction off a visible microfacet of a rough dielectric (`x` in [0, 1)
+    /// makes Fresnel's choice).
+    fn sample_rough(&self, wo: Vec3, x: f32, u: glam::Vec2, mode: Transport) -> Option<BsdfSample> {
+        let li = self.rough_interface(self.index).sample(self.frame.to_local(wo), x, u)?;
+        let wi = self.frame.to_world(li);
+        let pdf = self.rough_pdf(wo, wi, false);
+        if pdf.is_nan() || pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            weight: self.rough_eval(wo, wi, mode) * (li.z.abs() / pdf),
+            pdf,
+            specular: false,
+            transmitted: li.z < 0.0,
+            dispersive: false,
+        })
+    }
+
     /// A thin dielectric sheet: reflect with the two faces' reflectance 2R/(1 + R), else pass
     /// straight through (`x` in [0, 1)).
     fn sample_thin(&self, wo: Vec3, x: f32) -> Option<BsdfSample> {
@@ -637,8 +763,7 @@ impl Bsdf {
     }
 }
 
-/// Below this GGX α a surface is a perfect mirror.
-pub const SMOOTH_ALPHA: f32 = 1e-3;
+pub use crate::description::SMOOTH_ALPHA;
 
 /// From this Phong exponent on, a lobe is sharp ([`Bsdf::is_sharply_glossy`]): its peak f is
 /// 16 times a white Lambertian surface's.

@@ -392,6 +392,9 @@ pub struct Alpha<P = Param> {
     pub cutoff: Option<f32>,
 }
 
+/// Below this GGX α a surface is smooth: a perfect mirror, or glass that refracts by Snell's law.
+pub const SMOOTH_ALPHA: f32 = 1e-3;
+
 /// A physically based material beyond the course fields' reading, generic over how a colour is
 /// given (`Param` in the description, a scene channel once built). Roughness is the GGX α.
 #[derive(Clone, Debug, PartialEq)]
@@ -437,6 +440,19 @@ pub enum PhysicalMaterial<P = Param> {
         /// Colour of the light that passes.
         tint: P,
     },
+    /// A rough dielectric interface (frosted glass): GGX microfacet reflection and refraction
+    /// (Walter et al. 2007) between outside and an inside of index `eta`.
+    RoughDielectric {
+        /// Index of the inside.
+        eta: f32,
+        /// GGX α (at least 1e-3; below, the interface is smooth).
+        roughness: f32,
+        /// Colour of the light that crosses.
+        tint: P,
+        /// Abbe number: the index depends on the wavelength (Cauchy's law) under spectral
+        /// transport.
+        abbe: Option<f32>,
+    },
 }
 
 impl<P> PhysicalMaterial<P> {
@@ -475,6 +491,17 @@ impl<P> PhysicalMaterial<P> {
             PhysicalMaterial::ThinDielectric { eta, tint } => PhysicalMaterial::ThinDielectric {
                 eta: *eta,
                 tint: f(tint)?,
+            },
+            PhysicalMaterial::RoughDielectric {
+                eta,
+                roughness,
+                tint,
+                abbe,
+            } => PhysicalMaterial::RoughDielectric {
+                eta: *eta,
+                roughness: *roughness,
+                tint: f(tint)?,
+                abbe: *abbe,
             },
         })
     }
@@ -544,7 +571,8 @@ impl Default for MaterialDesc {
 /// each point metalness is the texture's blue times `metallic`, roughness its green times
 /// `roughness` (GGX α = roughness²); a point at least half metal is a conductor of the base
 /// colour's reflectance, the rest the base colour under a clear coat of index `coat` (or bare
-/// Lambert without one).
+/// Lambert without one), or, for solid glass (`glass`), a dielectric tinted by the base colour:
+/// rough where the roughness says so, else smooth.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MetallicRoughness<P = Param> {
     /// The base colour.
@@ -557,6 +585,8 @@ pub struct MetallicRoughness<P = Param> {
     pub roughness: f32,
     /// The dielectric's coat index (`None`: no specular layer).
     pub coat: Option<f32>,
+    /// Solid glass's index and Abbe number, where the material transmits.
+    pub glass: Option<(f32, Option<f32>)>,
 }
 
 impl MetallicRoughness<Param> {
@@ -568,6 +598,7 @@ impl MetallicRoughness<Param> {
             metallic: self.metallic,
             roughness: self.roughness,
             coat: self.coat,
+            glass: self.glass,
         })
     }
 }

@@ -553,13 +553,23 @@ impl LightSet {
             wl,
             choice: p_pick,
         };
-        match &self.lights[index] {
+        let sample = match &self.lights[index] {
             light @ (Light::Point { .. } | Light::Spot { .. }) => point::sample_direct(&q, light),
             light @ (Light::Directional { .. } | Light::Sun { .. }) => distant::sample_direct(&q, light, u),
             Light::Environment(env) => env.sample_direct(&q, u),
             Light::Area(light) => light.sample_direct(&q, (u_pick, u)),
             Light::Soft(light) => light.sample_direct(&q, u),
+        };
+        if !scene.absorbs() {
+            return sample;
         }
+        // Through rough glass to a light inside it (a lamp in a frosted globe).
+        sample.map(|mut s| {
+            if let Some(kept) = scene.absorbed_towards(hit, s.wi, s.distance, wl) {
+                s.contribution *= kept;
+            }
+            s
+        })
     }
 
     /// Solid-angle pdf of a sun's uniform cone.

@@ -298,6 +298,14 @@ impl Material {
                     reflectance: Some(base),
                     roughness: alpha,
                 })
+            } else if let Some((eta, abbe)) = mr.glass {
+                // Smooth glass is the course fields' dielectric.
+                (alpha >= crate::description::SMOOTH_ALPHA).then_some(PhysicalMaterial::RoughDielectric {
+                    eta,
+                    roughness: alpha,
+                    tint: base,
+                    abbe,
+                })
             } else {
                 mr.coat.map(|eta| PhysicalMaterial::CoatedDiffuse {
                     reflectance: base,

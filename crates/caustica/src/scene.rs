@@ -155,6 +155,8 @@ pub struct Scene {
     materials: Vec<Material>,
     /// Each material's fitted spectra, made the first time spectral transport asks.
     material_spectra: Vec<OnceLock<MaterialSpectra>>,
+    /// Whether some material absorbs inside ([`Scene::absorption_beyond`]).
+    absorbs: bool,
     /// Each untextured material's lobes, worked out once (`None`: textured).
     material_lobes: Vec<Option<Lobes>>,
     textures: Vec<Texture>,
@@ -243,6 +245,15 @@ impl SurfaceHit {
     }
 }
 
+/// What a path keeps of its light after a length `distance` inside a glass absorbing `sigma`
+/// per unit of length, at the wavelengths `wl` (Beer–Lambert: exp(−σ d), nothing past an
+/// endless length).
+#[inline]
+pub fn transmittance(sigma: Vec3, distance: f32, wl: &Wavelengths) -> Spectrum {
+    let kept = Vec3::select(sigma.cmpgt(Vec3::ZERO), (-sigma * distance).exp(), Vec3::ONE);
+    wl.reflectance(kept)
+}
+
 impl Scene {
     /// Assembles a scene: builds its hierarchies, then finds its emissive objects.
     pub(crate) fn assemble(parts: SceneParts, progress: &dyn Progress) -> Scene {
@@ -271,6 +282,7 @@ impl Scene {
             lights: LightSet::default(),
             ambient,
             material_spectra: materials.iter().map(|_| OnceLock::new()).collect(),
+            absorbs: materials.iter().any(|m| m.absorption.is_some()),
             material_lobes: materials
                 .iter()
                 .map(|m| (!m.is_textured()).then(|| Lobes::new(&m.eval(&[], Vec2::ZERO))))
@@ -432,6 +444,20 @@ impl Scene {
             MaterialRef::One(id) => self.materials[id as usize].absorption,
             MaterialRef::Blend { .. } => None,
         }
+    }
+
+    /// What light keeps along a segment of length `distance` from `hit` towards `dir` (unit)
+    /// where that runs inside the hit's absorbing glass (`None`: it does not).
+    #[inline]
+    pub fn absorbed_towards(&self, hit: &SurfaceHit, dir: Vec3, distance: f32, wl: &Wavelengths) -> Option<Spectrum> {
+        self.absorption_beyond(hit, dir)
+            .map(|sigma| transmittance(sigma, distance, wl))
+    }
+
+    /// Whether some material absorbs inside: without, no walk asks where it is.
+    #[inline]
+    pub fn absorbs(&self) -> bool {
+        self.absorbs
     }
 
     /// The radiance a surface point emits towards `wo` at the wavelengths `wl`: zero out of a

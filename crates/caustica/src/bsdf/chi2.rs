@@ -14,6 +14,9 @@ const PHI_BINS: usize = 48;
 const SAMPLES: usize = 1_000_000;
 /// Quadrature points per bin and axis (midpoint rule) for the expected counts.
 const QUADRATURE: usize = 12;
+/// The same for rough glass, whose density ends sharply: refraction through microfacets seen
+/// edge-on sends light to a thin band (|wi·z| = |wo·z|/η) at the end of the transmitted lobe.
+const FINE_QUADRATURE: usize = 64;
 /// Bins expecting fewer samples than this are pooled into one.
 const MIN_EXPECTED: f64 = 5.0;
 /// The largest Wilson–Hilferty z-score of the χ² statistic accepted: p ≈ 3·10⁻⁵ for one test,
@@ -40,18 +43,18 @@ fn observed(mut sampler: impl FnMut(&mut Rng) -> Option<Vec3>, seed: u64) -> Vec
 }
 
 /// `pdf` integrated over each bin, times the sample count.
-fn expected(pdf: impl Fn(Vec3) -> f32) -> Vec<f64> {
+fn expected(pdf: impl Fn(Vec3) -> f32, quadrature: usize) -> Vec<f64> {
     let (dz, dphi) = (2.0 / Z_BINS as f64, 2.0 * std::f64::consts::PI / PHI_BINS as f64);
-    let area = dz * dphi / (QUADRATURE * QUADRATURE) as f64;
+    let area = dz * dphi / (quadrature * quadrature) as f64;
     let mut out = vec![0.0; Z_BINS * PHI_BINS];
     for (i, e) in out.iter_mut().enumerate() {
         let (zi, pi) = (i / PHI_BINS, i % PHI_BINS);
         let mut sum = 0.0f64;
-        for a in 0..QUADRATURE {
-            let z = -1.0 + (zi as f64 + (a as f64 + 0.5) / QUADRATURE as f64) * dz;
+        for a in 0..quadrature {
+            let z = -1.0 + (zi as f64 + (a as f64 + 0.5) / quadrature as f64) * dz;
             let s = (1.0 - z * z).max(0.0).sqrt();
-            for b in 0..QUADRATURE {
-                let phi = (pi as f64 + (b as f64 + 0.5) / QUADRATURE as f64) * dphi;
+            for b in 0..quadrature {
+                let phi = (pi as f64 + (b as f64 + 0.5) / quadrature as f64) * dphi;
                 let d = Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32);
                 sum += pdf(d) as f64;
             }
@@ -90,11 +93,15 @@ fn chi2_z(observed: &[f64], expected: &[f64]) -> (f64, usize) {
 }
 
 fn assert_samples_match_pdf(name: &str, bsdf: &Bsdf, wo: Vec3, seed: u64) {
+    assert_samples_match_pdf_by(name, bsdf, wo, seed, QUADRATURE);
+}
+
+fn assert_samples_match_pdf_by(name: &str, bsdf: &Bsdf, wo: Vec3, seed: u64, quadrature: usize) {
     let sampler = |rng: &mut Rng| {
         let s = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?;
         (!s.specular).then_some(s.wi)
     };
-    let (z, bins) = chi2_z(&observed(sampler, seed), &expected(|d| bsdf.pdf(wo, d)));
+    let (z, bins) = chi2_z(&observed(sampler, seed), &expected(|d| bsdf.pdf(wo, d), quadrature));
     assert!(
         z < MAX_Z,
         "{name}: sampling disagrees with pdf, χ² z-score {z:.2} over {bins} bins"
@@ -174,6 +181,34 @@ fn physical_lobes_sample_their_density() {
     }
 }
 
+/// Rough glass from outside and from inside (where much is reflected totally): reflection and
+/// refraction through visible normals, both halves of the sphere.
+#[test]
+fn rough_glass_samples_its_density() {
+    let glass = |alpha| PhysicalMaterial::RoughDielectric {
+        eta: 1.5,
+        roughness: alpha,
+        tint: Vec3::ONE,
+        abbe: None,
+    };
+    for (i, (alpha, theta)) in [
+        (0.1f32, 0.5f32),
+        (0.3, 0.9),
+        (0.6, 0.0),
+        (0.6, 1.2),
+        (0.3, 2.6),
+        (0.6, 2.0),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let wo = at(theta);
+        let bsdf = Bsdf::physical(&glass(alpha), Vec3::Z, Vec3::Z, wo, &Wavelengths::Rgb);
+        let name = format!("rough glass α {alpha}, θo {theta}");
+        assert_samples_match_pdf_by(&name, &bsdf, wo, 40 + i as u64, FINE_QUADRATURE);
+    }
+}
+
 /// The test has the power to fail: a Phong lobe 10% wider than its pdf says, or a GGX sampler
 /// of the wrong roughness, is rejected.
 #[test]
@@ -181,7 +216,7 @@ fn a_sampler_of_another_distribution_is_rejected() {
     let wo = at(0.4);
     let (drawn, stated) = (phong(0.0, 0.9, 20.0, wo), phong(0.0, 0.9, 22.0, wo));
     let sampler = |rng: &mut Rng| Some(drawn.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?.wi);
-    let (z, _) = chi2_z(&observed(sampler, 3), &expected(|d| stated.pdf(wo, d)));
+    let (z, _) = chi2_z(&observed(sampler, 3), &expected(|d| stated.pdf(wo, d), QUADRATURE));
     assert!(z > MAX_Z, "Phong n 20 against n 22 passed: z {z:.2}");
     let ggx = |alpha| {
         let m = PhysicalMaterial::Conductor {
@@ -194,6 +229,20 @@ fn a_sampler_of_another_distribution_is_rejected() {
     };
     let (drawn, stated) = (ggx(0.3), ggx(0.33));
     let sampler = |rng: &mut Rng| Some(drawn.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?.wi);
-    let (z, _) = chi2_z(&observed(sampler, 4), &expected(|d| stated.pdf(wo, d)));
+    let (z, _) = chi2_z(&observed(sampler, 4), &expected(|d| stated.pdf(wo, d), QUADRATURE));
     assert!(z > MAX_Z, "GGX α 0.3 against α 0.33 passed: z {z:.2}");
+    // Rough glass refracting by another index than its pdf states.
+    let glass = |eta| {
+        let m = PhysicalMaterial::RoughDielectric {
+            eta,
+            roughness: 0.3,
+            tint: Vec3::ONE,
+            abbe: None,
+        };
+        Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &Wavelengths::Rgb)
+    };
+    let (drawn, stated) = (glass(1.5), glass(1.55));
+    let sampler = |rng: &mut Rng| Some(drawn.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?.wi);
+    let (z, _) = chi2_z(&observed(sampler, 5), &expected(|d| stated.pdf(wo, d), FINE_QUADRATURE));
+    assert!(z > MAX_Z, "rough glass of η 1.5 against η 1.55 passed: z {z:.2}");
 }

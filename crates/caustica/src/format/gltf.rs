@@ -11,6 +11,7 @@ use super::{SceneSource, SourceFiles};
 use crate::description::{
     repair_vertex_attributes, Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc,
     MetallicRoughness, NormalMap, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
+    SMOOTH_ALPHA,
 };
 use crate::error::{Error, ParseError, Result, Span};
 use crate::progress::Progress;
@@ -846,9 +847,9 @@ impl Reader<'_, '_> {
             ),
             None => Param::Constant(base_factor),
         };
-        // Linear data: blue is metalness, green roughness. Glass keeps its factors.
+        // Linear data: blue is metalness, green roughness.
         let mr_texture = match &pbr.metallic_roughness_texture {
-            Some(info) if transmission < 0.5 => {
+            Some(info) => {
                 let mrpath = format!("{path}.pbrMetallicRoughness.metallicRoughnessTexture");
                 let transform = info.extensions.as_ref().and_then(|e| e.texture_transform.as_ref());
                 self.image_map(info.index.value(), info.tex_coord, transform, &mrpath)
@@ -857,16 +858,10 @@ impl Reader<'_, '_> {
                         Param::Texture(Box::new(map))
                     })
             }
-            Some(_) => {
-                self.warn_once(
-                    "mrtexture",
-                    &format!("{path}.pbrMetallicRoughness.metallicRoughnessTexture"),
-                    "the metallic-roughness texture of a transmissive material is not read: the factors are used",
-                );
-                None
-            }
             None => None,
         };
+        // Glass with the texture decides metal or glass, and how rough, point by point.
+        let glass_textured = transmission >= 0.5 && mr_texture.is_some();
         let normal_map = match &m.normal_texture {
             Some(n) => {
                 let npath = format!("{path}.normalTexture");
@@ -912,7 +907,7 @@ impl Reader<'_, '_> {
             name: m.name.clone(),
             ..MaterialDesc::default()
         };
-        if let Some(texture) = mr_texture {
+        if let Some(texture) = mr_texture.clone().filter(|_| !glass_textured) {
             desc.diffuse = base.clone();
             desc.metallic_roughness = Some(MetallicRoughness {
                 base,
@@ -920,6 +915,7 @@ impl Reader<'_, '_> {
                 metallic,
                 roughness,
                 coat: (specular > 0.0).then_some(ior),
+                glass: None,
             });
             return Ok(desc);
         }
@@ -930,7 +926,7 @@ impl Reader<'_, '_> {
                 "metallic and transmission between 0 and 1 are read as the nearer of the two ends",
             );
         }
-        if metallic >= 0.5 {
+        if metallic >= 0.5 && !glass_textured {
             desc.physical = Some(PhysicalMaterial::Conductor {
                 eta: Vec3::ONE,
                 k: Vec3::ZERO,
@@ -948,13 +944,8 @@ impl Reader<'_, '_> {
                 desc.shininess = Param::grey((2.0 / (alpha * alpha) - 2.0).clamp(1.0, 10_000.0));
             }
         } else if transmission >= 0.5 {
-            if alpha >= 1e-3 {
-                self.warn_once("roughglass", &path, "rough transmission is rendered smooth");
-            }
-            let tint = match &base {
-                Param::Constant(c) => *c,
-                _ => Vec3::ONE,
-            };
+            // The base colour tints the light that crosses, texture and all.
+            let tint = base.clone();
             let thickness = ext.volume.as_ref().map(|v| v.thickness_factor.0);
             // Beer–Lambert inside: the colour light keeps after attenuationDistance (world units).
             let absorption = ext.volume.as_ref().and_then(|v| {
@@ -986,17 +977,41 @@ impl Reader<'_, '_> {
                         "transmission without KHR_materials_volume on a closed mesh is read as solid glass",
                     );
                 }
-                desc.transmissive = Param::Constant(tint);
+                desc.transmissive = tint.clone();
                 desc.index = Param::grey(ior);
                 if dispersion > 0.0 {
                     desc.abbe = Some(20.0 / dispersion);
                 }
+                if let Some(texture) = mr_texture {
+                    desc.metallic_roughness = Some(MetallicRoughness {
+                        base,
+                        texture,
+                        metallic,
+                        roughness,
+                        coat: None,
+                        glass: Some((ior, desc.abbe)),
+                    });
+                } else if alpha >= SMOOTH_ALPHA {
+                    desc.physical = Some(PhysicalMaterial::RoughDielectric {
+                        eta: ior,
+                        roughness: alpha,
+                        tint: tint.clone(),
+                        abbe: desc.abbe,
+                    });
+                }
             } else {
-                desc.transmissive = Param::Constant(tint);
+                if alpha >= SMOOTH_ALPHA || glass_textured {
+                    self.warn_once(
+                        "roughglass",
+                        &path,
+                        "thin-walled transmission is rendered smooth, whatever its roughness and metalness say",
+                    );
+                }
+                desc.transmissive = tint.clone();
                 desc.index = Param::grey(1.0);
                 desc.physical = Some(PhysicalMaterial::ThinDielectric {
                     eta: ior,
-                    tint: Param::Constant(tint),
+                    tint: tint.clone(),
                 });
             }
         } else {

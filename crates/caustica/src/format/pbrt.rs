@@ -22,7 +22,7 @@ use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
     Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, NormalMap, ObjectDesc,
-    Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
+    Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
@@ -889,15 +889,20 @@ impl<'f> Reader<'f> {
                 if kind == "glass" {
                     self.v3_tints(params, span, &["Kr", "Kt"])?;
                 }
-                if alpha >= 1e-3 {
-                    self.warn("rough glass is rendered smooth", span.clone());
-                }
                 let mut m = MaterialDesc {
                     transmissive: Param::grey(1.0),
                     index: Param::grey(index),
                     abbe,
                     ..MaterialDesc::default()
                 };
+                if alpha >= SMOOTH_ALPHA && kind != "thindielectric" {
+                    m.physical = Some(PhysicalMaterial::RoughDielectric {
+                        eta: index,
+                        roughness: alpha,
+                        tint: Param::grey(1.0),
+                        abbe,
+                    });
+                }
                 if kind == "thindielectric" {
                     m.index = Param::grey(1.0);
                     m.physical = Some(PhysicalMaterial::ThinDielectric {

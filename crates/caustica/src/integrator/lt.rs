@@ -13,7 +13,7 @@
 
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::Progressive;
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, Transport};
 use crate::camera::Camera;
 use crate::light::emission::EmissionPoint;
 use crate::math::{offset_origin, Ray, Vec3};
@@ -219,7 +219,7 @@ impl<'a> LightTracer<'a> {
     /// becomes |ωe·ng| |wo·ns| / |wo·ng|.
     fn connect(&self, hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3, power: Spectrum) -> Option<(usize, Spectrum)> {
         let s = self.sensor.sample(hit.point)?;
-        let f = bsdf.eval(wo, s.to_eye);
+        let f = bsdf.eval_in(wo, s.to_eye, Transport::Importance);
         if f == Spectrum::ZERO {
             return None;
         }

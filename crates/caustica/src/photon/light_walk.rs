@@ -46,20 +46,16 @@ pub trait LightVisitor {
     }
 }
 
-/// What a path keeps of its light after a length `distance` inside a glass absorbing `sigma`
-/// per unit of length, at the wavelengths `wl` (Beer–Lambert: exp(−σ d), nothing past an
-/// endless length).
-#[inline]
-pub fn transmittance(sigma: Vec3, distance: f32, wl: &Wavelengths) -> Spectrum {
-    let kept = Vec3::select(sigma.cmpgt(Vec3::ZERO), (-sigma * distance).exp(), Vec3::ONE);
-    wl.reflectance(kept)
-}
+pub use crate::scene::transmittance;
 
 /// What both walks carry from surface to surface: the glass they are inside, whose absorption
-/// each segment pays.
+/// each segment pays. A walk starts where it is (a lamp inside a glass ball, a camera in a
+/// block of glass): its first segment is inside a glass if it meets that glass from within.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Passage {
     absorbing: Option<Vec3>,
+    /// Whether the first segment has been traced (from then on, crossings decide).
+    started: bool,
 }
 
 impl Passage {
@@ -67,19 +63,45 @@ impl Passage {
     /// attenuated by the glass on the way, at the wavelengths `wl`.
     #[inline]
     pub fn next(
-        &self,
+        &mut self,
         scene: &Scene,
         ray: &Ray,
         throughput: &mut Spectrum,
         wl: &Wavelengths,
     ) -> Option<(SurfaceHit, f32)> {
         let isect = scene.intersect(ray, f32::INFINITY);
+        if !self.started {
+            self.started = true;
+            if scene.absorbs() {
+                return self.first(scene, ray, isect, throughput, wl);
+            }
+        }
         if let Some(sigma) = self.absorbing {
             let distance = isect.as_ref().map_or(f32::INFINITY, |i| i.t * ray.dir.length());
             *throughput *= transmittance(sigma, distance, wl);
         }
         let isect = isect?;
         Some((scene.surface(ray, &isect), isect.t))
+    }
+
+    /// The walk's first segment in a scene with absorbing glass: inside a glass if it meets
+    /// that glass from within.
+    #[cold]
+    fn first(
+        &mut self,
+        scene: &Scene,
+        ray: &Ray,
+        isect: Option<crate::scene::Intersection>,
+        throughput: &mut Spectrum,
+        wl: &Wavelengths,
+    ) -> Option<(SurfaceHit, f32)> {
+        let isect = isect?;
+        let hit = scene.surface(ray, &isect);
+        self.absorbing = scene.absorption_beyond(&hit, -ray.dir);
+        if let Some(sigma) = self.absorbing {
+            *throughput *= transmittance(sigma, isect.t * ray.dir.length(), wl);
+        }
+        Some((hit, isect.t))
     }
 
     /// After a bounce at `hit` that goes on along `sample`: through the surface, the walk is

@@ -88,3 +88,76 @@ fn absorbing_and_clear_glass_stay_apart() {
     assert_eq!(glass.len(), 2, "two glasses");
     assert_eq!(glass.iter().filter(|m| m.absorption == Some(SIGMA)).count(), 1);
 }
+
+/// A point light at the centre of a ball of rough absorbing glass (GGX α 0.3, radius 1): the
+/// light reaches the surface after exactly one radius inside, so the glowing ball keeps
+/// exp(−σ·1) of the clear ball's light, less a little for what the rough surface reflects back
+/// inside and crosses again. Next-event estimation from the surface to the light, and vcm's
+/// connections between vertices on the inside, run through the glass and must pay for it as the
+/// walks do: path, lt and vcm agree.
+#[test]
+fn a_lamp_inside_rough_absorbing_glass_keeps_exp_minus_sigma_r() {
+    use caustica::description::PhysicalMaterial;
+    use caustica::format::{read_text, ReadOptions};
+    use caustica::progress::NoProgress;
+    use caustica::scene::build::{build, BuildSettings};
+    let sigma = Vec3::new(0.5, 0.1, 0.0);
+    let ball = |absorbing: bool| {
+        let text = format!(
+            "SBT-raytracer 1.0
+             camera {{ position = (0, 0, 5); viewdir = (0, 0, -1); updir = (0, 1, 0); fov = 26; }}
+             point_light {{ position = (0, 0, 0); color = (1, 1, 1); constant_attenuation_coeff = 1; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 0; }}
+             sphere {{ material = {{ transmissive = (1, 1, 1); index = 1.5; {} }} }}",
+            if absorbing { "absorption = (0.5, 0.1, 0);" } else { "" }
+        );
+        let path = std::path::Path::new("ball.ray");
+        let mut source = read_text(
+            path,
+            text,
+            std::path::Path::new("."),
+            &ReadOptions::default(),
+            &NoProgress,
+        )
+        .unwrap();
+        for object in &mut source.description.objects {
+            object.material.physical = Some(PhysicalMaterial::RoughDielectric {
+                eta: 1.5,
+                roughness: 0.3,
+                tint: caustica::description::Param::grey(1.0),
+                abbe: None,
+            });
+        }
+        build(&source.description, &BuildSettings::default()).unwrap()
+    };
+    let (clear, absorbing) = (ball(false), ball(true));
+    let expected = (-sigma).exp();
+    let mut seen = Vec::new();
+    for (integrator, passes, photons) in [("path", 64, 0), ("lt", 8, 40_000), ("vcm", 8, 20_000)] {
+        let mean = |scene: &Scene| {
+            let config = caustica::integrator::RenderConfig {
+                integrator: Some(integrator.parse().unwrap()),
+                model: Some(caustica::integrator::config::Model::Physical),
+                width: 24,
+                height: Some(24),
+                passes: Some(passes.to_string()),
+                photons,
+                light_paths: Some(photons as u64),
+                seed: 7,
+                ..caustica::integrator::RenderConfig::default()
+            };
+            crate::common::render_with(scene, &config).region_mean((6, 17), (6, 17))
+        };
+        let (c, a) = (mean(&clear), mean(&absorbing));
+        let ratio = a / c;
+        eprintln!("{integrator}: clear {c}, absorbing {a}, ratio {ratio} against exp(−σr) {expected}");
+        assert!(c.min_element() > 0.0, "{integrator}: the clear ball is dark");
+        assert!(
+            (ratio - expected).abs().max_element() < 0.05,
+            "{integrator}: kept {ratio}, want about {expected}"
+        );
+        seen.push(a);
+    }
+    for a in &seen[1..] {
+        assert!(((*a - seen[0]) / seen[0]).abs().max_element() < 0.04, "{seen:?}");
+    }
+}

@@ -25,6 +25,7 @@ mod light_tracing;
 mod lights;
 mod photon_budget;
 mod physical;
+mod rough_glass;
 mod shadow_acne;
 mod spectral;
 mod textures;

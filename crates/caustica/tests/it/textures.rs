@@ -495,6 +495,73 @@ fn a_metallic_roughness_texture_decides_metal_and_roughness_point_by_point() {
     }
 }
 
+/// On solid glass (transmission with a volume) the metallic-roughness texture decides metal,
+/// rough glass or smooth glass point by point, the glass tinted by the base colour; without a
+/// texture the roughness factor makes the whole glass rough.
+#[test]
+fn a_metallic_roughness_texture_on_glass_makes_it_rough_or_metal_point_by_point() {
+    use caustica::description::PhysicalMaterial;
+    let dir = folder("rough-glass");
+    let image = png(3, 1, &[[0, 128, 0], [0, 0, 255], [0, 2, 0]]);
+    let glass = r#""extensions":{"KHR_materials_transmission":{"transmissionFactor":1},"KHR_materials_ior":{"ior":1.4},
+"KHR_materials_volume":{"thicknessFactor":1}}"#;
+    let material = format!(
+        r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[0.9,0.6,0.2,1],"metallicFactor":1,"roughnessFactor":1,
+"metallicRoughnessTexture":{{"index":0}}}},{glass}}}"#
+    );
+    let sampler = r#"{"magFilter":9728,"wrapS":10497,"wrapT":10497}"#;
+    let path = quad_gltf(&dir, &image, Holder::File, &material, sampler);
+    let scene = load(&path, &LoadSettings::default()).unwrap();
+    assert!(
+        scene
+            .warnings()
+            .iter()
+            .all(|w| !w.contains("metallic") && !w.contains("rough")),
+        "{:?}",
+        scene.warnings()
+    );
+    let m = scene
+        .materials()
+        .iter()
+        .find(|m| m.metallic_roughness.is_some())
+        .unwrap();
+    let base = Vec3::new(0.9, 0.6, 0.2);
+    match m.physical_at(scene.textures(), Vec2::new(1.0 / 6.0, 0.5)) {
+        Some(PhysicalMaterial::RoughDielectric {
+            eta, roughness, tint, ..
+        }) => {
+            assert_eq!((eta, tint), (1.4, base));
+            assert!((roughness - (128.0f32 / 255.0).powi(2)).abs() < 1e-6, "{roughness}");
+        }
+        other => panic!("a rough glass point: {other:?}"),
+    }
+    assert!(matches!(
+        m.physical_at(scene.textures(), Vec2::new(0.5, 0.5)),
+        Some(PhysicalMaterial::Conductor { reflectance: Some(r), .. }) if r == base
+    ));
+    assert_eq!(
+        m.physical_at(scene.textures(), Vec2::new(5.0 / 6.0, 0.5)),
+        None,
+        "smooth glass: the course dielectric"
+    );
+    assert_eq!(m.eval(scene.textures(), Vec2::new(5.0 / 6.0, 0.5)).transmissive, base);
+    // Without the texture, roughnessFactor 0.5 makes it all rough glass of α 0.25.
+    let plain = format!(r#"{{"pbrMetallicRoughness":{{"metallicFactor":0,"roughnessFactor":0.5}},{glass}}}"#);
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, &plain, sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    let rough = scene
+        .materials()
+        .iter()
+        .find_map(|m| match m.physical_at(scene.textures(), Vec2::ZERO) {
+            Some(PhysicalMaterial::RoughDielectric { roughness, .. }) => Some(roughness),
+            _ => None,
+        });
+    assert_eq!(rough, Some(0.25));
+}
+
 /// glTF's `alphaMode`: MASK cuts holes where the base colour's alpha times its factor is below
 /// `alphaCutoff` — for camera rays, shadow rays and every other query alike — and BLEND lets a
 /// ray through with the chance 1 − coverage.

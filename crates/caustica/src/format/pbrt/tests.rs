@@ -406,3 +406,39 @@ fn one_sided_lights_face_pbrt_front() {
         "no light"
     );
 }
+
+/// Rough glass: pbrt-v4's `dielectric` and pbrt-v3's `glass` with roughness become GGX glass
+/// (α remapped as √roughness unless `remaproughness` is false), keeping their course reading
+/// and dispersion; smooth glass and thin glass stay as they were.
+#[test]
+fn rough_dielectrics_become_ggx_glass() {
+    let desc = scene(
+        "Material \"dielectric\" \"float eta\" 1.4 \"float roughness\" 0.09\nShape \"sphere\"\n\
+         Material \"dielectric\" \"spectrum eta\" \"glass-BK7\" \"float roughness\" 0.2 \"bool remaproughness\" false\nShape \"sphere\"\n\
+         Material \"glass\" \"float index\" 1.6 \"float uroughness\" 0.04 \"float vroughness\" 0.04\nShape \"sphere\"\n\
+         Material \"dielectric\" \"float eta\" 1.5\nShape \"sphere\"\n\
+         Material \"thindielectric\" \"float eta\" 1.5\nShape \"sphere\"",
+    );
+    let m: Vec<&MaterialDesc> = desc.objects.iter().map(|o| &o.material).collect();
+    let rough = |i: usize| match &m[i].physical {
+        Some(PhysicalMaterial::RoughDielectric {
+            eta, roughness, abbe, ..
+        }) => (*eta, *roughness, *abbe),
+        other => panic!("{i}: {other:?}"),
+    };
+    let (eta, alpha, abbe) = rough(0);
+    assert!(eta == 1.4 && (alpha - 0.3).abs() < 1e-6 && abbe.is_none());
+    let (eta, alpha, abbe) = rough(1);
+    assert!((eta - 1.5168).abs() < 1e-4 && alpha == 0.2 && abbe == Some(64.17));
+    let (eta, alpha, _) = rough(2);
+    assert!(eta == 1.6 && (alpha - 0.2).abs() < 1e-6);
+    for material in &m[..3] {
+        assert_eq!(
+            material.transmissive,
+            Param::grey(1.0),
+            "the course reading stays glass"
+        );
+    }
+    assert_eq!(m[3].physical, None);
+    assert!(matches!(m[4].physical, Some(PhysicalMaterial::ThinDielectric { .. })));
+}

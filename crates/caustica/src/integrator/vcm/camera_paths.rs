@@ -365,7 +365,7 @@ impl<'a> Vcm<'a> {
             return Spectrum::ZERO;
         }
         let light_bsdf = Bsdf::at(self.scene, &z.hit, z.wo, wl);
-        let light_f = light_bsdf.eval(z.wo, -dir);
+        let light_f = light_bsdf.eval_in(z.wo, -dir, Transport::Importance);
         if light_f == Spectrum::ZERO {
             return Spectrum::ZERO;
         }
@@ -387,7 +387,17 @@ impl<'a> Vcm<'a> {
             return Spectrum::ZERO;
         }
         let g = cos_camera * cos_light / d2;
-        v.throughput * camera_f * light_f * z.throughput * (g * weight * both_dispersed(v.dispersed, z.dispersed))
+        // Two vertices inside one rough glass: the connection pays its absorption.
+        let inside = self
+            .scene
+            .absorbed_towards(v.hit, dir, d2.sqrt(), wl)
+            .unwrap_or(Spectrum::ONE);
+        v.throughput
+            * camera_f
+            * light_f
+            * z.throughput
+            * inside
+            * (g * weight * both_dispersed(v.dispersed, z.dispersed))
     }
 }
 

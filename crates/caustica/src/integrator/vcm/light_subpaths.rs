@@ -49,7 +49,7 @@ impl<'a> Vcm<'a> {
         let Some(s) = self.sensor.sample(v.hit.point) else {
             return;
         };
-        let value = bsdf.eval(v.wo, s.to_eye);
+        let value = bsdf.eval_in(v.wo, s.to_eye, Transport::Importance);
         if value == Spectrum::ZERO {
             return;
         }
@@ -251,7 +251,7 @@ fn light_bounce(bsdf: &Bsdf, point: Vec3, wo: Vec3, aim: Option<&Aim>, rng: &mut
     };
     let aimed = aim.pdf(point, wi);
     let pdf = (1.0 - aim.share()) * bsdf.pdf(wo, wi) + aim.share() * aimed;
-    let value = bsdf.eval(wo, wi);
+    let value = bsdf.eval_in(wo, wi, Transport::Importance);
     if pdf.is_nan() || pdf <= 0.0 || value == Spectrum::ZERO {
         return None;
     }
