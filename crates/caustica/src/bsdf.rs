@@ -32,6 +32,7 @@
 
 mod rough_dielectric;
 
+use crate::description::ClearCoat;
 use crate::material::{Lobes, MaterialRef, MaterialSpectra, PhysicalMaterial, SurfaceParams};
 use crate::math::{reflect, Frame, Vec3, Vec4};
 use crate::sampling::sample_cosine_hemisphere;
@@ -85,6 +86,10 @@ pub struct Bsdf {
     /// index at each wavelength.
     index_d: f32,
     abbe: f32,
+    /// A clear coat over the other lobes (weight 0: none); a smooth one is part of `mirror`.
+    clear: ClearCoat,
+    /// The chance of drawing a rough coat's GGX lobe (the picks share the rest).
+    p_coat: f32,
     /// The outside's diffuse, glossy and mirror lobes' albedo bound ([`Lobes::reflection_bound`]).
     reflection_bound: f32,
     /// The wavelengths, for colours computed per direction (a conductor's Fresnel reflectance).
@@ -156,6 +161,25 @@ impl Bsdf {
     /// for light at wavelengths `wl`.
     #[inline]
     pub fn at(scene: &Scene, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Bsdf {
+        if scene.has_clearcoats() {
+            return Bsdf::coated_at(scene, hit, wo, wl);
+        }
+        Bsdf::uncoated(scene, hit, wo, wl)
+    }
+
+    /// [`Bsdf::at`] in a scene with clear coats.
+    #[inline(never)]
+    fn coated_at(scene: &Scene, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Bsdf {
+        let b = Bsdf::uncoated(scene, hit, wo, wl);
+        match scene.clearcoat(hit) {
+            Some(coat) => b.with_clearcoat(coat, wo),
+            None => b,
+        }
+    }
+
+    /// The lobes at a surface point without its clear coat.
+    #[inline(always)]
+    fn uncoated(scene: &Scene, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Bsdf {
         if let Some(physical) = scene.physical(hit) {
             return Bsdf::physical(&physical, hit.shading_normal, hit.geometric_normal, wo, wl);
         }
@@ -241,6 +265,8 @@ impl Bsdf {
             rough: 0.0,
             index_d: lobes.index,
             abbe: 0.0,
+            clear: NO_COAT,
+            p_coat: 0.0,
             reflection_bound: lobes.reflection_bound,
             wl: *wl,
         }
@@ -361,11 +387,71 @@ impl Bsdf {
         b
     }
 
+    /// These lobes under a clear coat seen from `wo` (glass takes none: its coat would be
+    /// another interface). The coat reflects weight·F(θo) (a mirror when smooth, drawn with that
+    /// chance; a GGX lobe drawn with at least 4% of it when rough); the lobes under it lose
+    /// what the coat reflects on the way in and on the way out.
+    pub fn with_clearcoat(mut self, coat: ClearCoat, wo: Vec3) -> Bsdf {
+        self.add_clearcoat(coat, wo);
+        self
+    }
+
+    /// [`Bsdf::with_clearcoat`] in place.
+    pub fn add_clearcoat(&mut self, coat: ClearCoat, wo: Vec3) {
+        if coat.weight <= 0.0 || self.pick[3] > 0.0 || self.rough > 0.0 {
+            return;
+        }
+        let coat = ClearCoat {
+            weight: coat.weight.min(1.0),
+            eta: coat.eta.max(1.0),
+            alpha: coat.alpha.min(1.0),
+        };
+        let f = coat.weight * fresnel_dielectric(self.frame.z.dot(wo).clamp(0.0, 1.0), coat.eta);
+        self.mirror *= (1.0 - f) * (1.0 - f);
+        self.clear = coat;
+        let base: f32 = self.pick.iter().sum();
+        let smooth = coat.alpha < SMOOTH_ALPHA;
+        let p = match (base > 0.0, smooth) {
+            (false, _) => 1.0,
+            (true, true) => f,
+            (true, false) => f.max(0.04 * coat.weight),
+        };
+        if base > 0.0 {
+            self.pick.iter_mut().for_each(|x| *x *= (1.0 - p) / base);
+        }
+        if smooth {
+            self.mirror += self.wl.grey(f);
+            self.pick[2] += p;
+        } else {
+            self.p_coat = p;
+        }
+    }
+
+    /// The rough coat's GGX lobe.
+    #[inline]
+    fn coat_lobe(&self) -> Microfacet {
+        Microfacet {
+            alpha: self.clear.alpha,
+            fresnel: Fresnel::Dielectric(self.clear.eta),
+        }
+    }
+
+    /// The share of the light under the coat that crosses it at cosine `cos` (1 without one).
+    #[inline]
+    fn through_coat(&self, cos: f32) -> f32 {
+        1.0 - self.clear.weight * fresnel_dielectric(cos.clamp(0.0, 1.0), self.clear.eta)
+    }
+
     /// Whether the surface has a smooth (non-delta) lobe: where light is sampled and photons
     /// are stored.
     #[inline]
     pub fn is_smooth(&self) -> bool {
-        self.pick[0] > 0.0 || self.pick[1] > 0.0 || self.pick[4] > 0.0 || self.pick[5] > 0.0 || self.rough > 0.0
+        self.pick[0] > 0.0
+            || self.pick[1] > 0.0
+            || self.pick[4] > 0.0
+            || self.pick[5] > 0.0
+            || self.rough > 0.0
+            || self.p_coat > 0.0
     }
 
     /// Whether every smooth lobe is narrow: a Phong lobe of exponent at least
@@ -378,7 +464,8 @@ impl Bsdf {
         let phong_sharp = self.pick[1] == 0.0 || self.exponent >= SHARP_EXPONENT;
         let ggx_sharp = self.pick[4] == 0.0 || self.microfacet.is_some_and(|m| m.alpha <= SHARP_ALPHA);
         let glass_sharp = self.rough <= SHARP_ALPHA;
-        no_diffuse && phong_sharp && ggx_sharp && glass_sharp && self.is_smooth()
+        let coat_sharp = self.p_coat == 0.0 || self.clear.alpha <= SHARP_ALPHA;
+        no_diffuse && phong_sharp && ggx_sharp && glass_sharp && coat_sharp && self.is_smooth()
     }
 
     /// Whether light arriving on the far side reaches `wo` through a smooth lobe (diffuse
@@ -391,7 +478,7 @@ impl Bsdf {
     /// Whether light can leave the surface at all.
     #[inline]
     pub fn is_black(&self) -> bool {
-        self.pick.iter().all(|&p| p == 0.0)
+        self.pick.iter().all(|&p| p == 0.0) && self.p_coat == 0.0
     }
 
     /// The shading normal on the side of `wo`.
@@ -417,7 +504,12 @@ impl Bsdf {
         let n = self.frame.z;
         let cos_i = n.dot(wi);
         if cos_i < 0.0 && self.ng.dot(wi) < 0.0 {
-            return self.diffuse_transmission * (1.0 / PI);
+            let f = self.diffuse_transmission * (1.0 / PI);
+            return if self.clear.weight > 0.0 {
+                f * self.through_coat(n.dot(wo))
+            } else {
+                f
+            };
         }
         if cos_i <= 0.0 || self.ng.dot(wi) <= 0.0 {
             return Spectrum::ZERO;
@@ -432,6 +524,21 @@ impl Bsdf {
                 f += self.glossy * ((self.exponent + 2.0) / (2.0 * PI) * cos_a.powf(self.exponent));
             }
         }
+        if self.clear.weight > 0.0 {
+            return self.under_coat(f, wo, wi);
+        }
+        f
+    }
+
+    /// `f` of the lobes under the clear coat, seen through it both ways, plus a rough coat's own
+    /// reflection.
+    #[inline(never)]
+    fn under_coat(&self, f: Spectrum, wo: Vec3, wi: Vec3) -> Spectrum {
+        let n = self.frame.z;
+        let f = f * (self.through_coat(n.dot(wo)) * self.through_coat(n.dot(wi)));
+        if self.p_coat > 0.0 {
+            return f + self.coat_lobe().eval(n, wo, wi, &self.wl) * self.clear.weight;
+        }
         f
     }
 
@@ -439,7 +546,7 @@ impl Bsdf {
     #[inline]
     pub fn is_lambertian(&self) -> bool {
         let only_diffuse = self.pick[0] > 0.0 && self.pick[1..].iter().all(|&p| p == 0.0);
-        only_diffuse && self.coat <= 0.0 && self.microfacet.is_none()
+        only_diffuse && self.coat <= 0.0 && self.microfacet.is_none() && self.clear.weight == 0.0
     }
 
     /// A purely Lambertian reflection seen from `wo`, for asking about many light directions
@@ -486,6 +593,9 @@ impl Bsdf {
                 pdf += self.pick[1] * (self.exponent + 1.0) / (2.0 * PI) * cos_a.powf(self.exponent);
             }
         }
+        if self.p_coat > 0.0 {
+            pdf += self.p_coat * self.coat_lobe().pdf(n, wo, wi);
+        }
         pdf
     }
 
@@ -508,6 +618,16 @@ impl Bsdf {
         let n = self.frame.z;
         let [p_diffuse, p_glossy, p_mirror, p_dielectric, _, _] = self.pick;
         let mut x = u_lobe;
+        if self.p_coat > 0.0 {
+            if x < self.p_coat {
+                let wi = self.coat_lobe().sample(&self.frame, wo, u)?;
+                if n.dot(wi) <= 0.0 || self.ng.dot(wi) <= 0.0 {
+                    return None;
+                }
+                return self.smooth_sample(wo, wi);
+            }
+            x -= self.p_coat;
+        }
         if x < p_diffuse + p_glossy {
             let wi = if x < p_diffuse {
                 self.frame.to_world(sample_cosine_hemisphere(u))
@@ -764,6 +884,13 @@ impl Bsdf {
 }
 
 pub use crate::description::SMOOTH_ALPHA;
+
+/// No clear coat.
+const NO_COAT: ClearCoat = ClearCoat {
+    weight: 0.0,
+    eta: 1.0,
+    alpha: 0.0,
+};
 
 /// From this Phong exponent on, a lobe is sharp ([`Bsdf::is_sharply_glossy`]): its peak f is
 /// 16 times a white Lambertian surface's.
@@ -1114,18 +1241,25 @@ mod tests {
     /// ∫ f·|cos θi| dωi of the smooth lobes over the upper hemisphere by the midpoint rule in θ
     /// and φ (an independent check on the sampled albedo; delta lobes are not included).
     fn smooth_albedo_by_quadrature(bsdf: &Bsdf, wo: Vec3) -> f64 {
-        let (nt, np) = (1500, 360);
-        let (dt, dp) = (
-            std::f64::consts::FRAC_PI_2 / nt as f64,
-            2.0 * std::f64::consts::PI / np as f64,
-        );
+        albedo_by_quadrature(bsdf, wo, false, Transport::Radiance)
+    }
+
+    /// ∫ f·|cos θi| dωi for transport `mode` over the upper hemisphere (or the whole sphere) by
+    /// the midpoint rule in θ and φ.
+    pub(super) fn albedo_by_quadrature(bsdf: &Bsdf, wo: Vec3, whole_sphere: bool, mode: Transport) -> f64 {
+        let (nt, np, theta_max) = if whole_sphere {
+            (3000, 720, std::f64::consts::PI)
+        } else {
+            (1500, 360, std::f64::consts::FRAC_PI_2)
+        };
+        let (dt, dp) = (theta_max / nt as f64, 2.0 * std::f64::consts::PI / np as f64);
         let mut sum = 0.0f64;
         for i in 0..nt {
             let t = (i as f64 + 0.5) * dt;
             for j in 0..np {
                 let p = (j as f64 + 0.5) * dp;
                 let wi = Vec3::new((t.sin() * p.cos()) as f32, (t.sin() * p.sin()) as f32, t.cos() as f32);
-                sum += bsdf.eval(wo, wi).x as f64 * t.cos() * t.sin() * dt * dp;
+                sum += bsdf.eval_in(wo, wi, mode).x as f64 * t.cos().abs() * t.sin() * dt * dp;
             }
         }
         sum
@@ -1265,6 +1399,79 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A clear coat: a smooth one over a black base reflects its Fresnel share alone (4% at
+    /// normal incidence); over Lambert ρ the albedo is F(θo) + (1 − F(θo))·ρ·(1 − F̄), F̄ the
+    /// coat's cosine-weighted mean reflectance (what crosses the coat in and out); a rough
+    /// coat over a metal samples what it evaluates, is reciprocal and never gains energy.
+    #[test]
+    fn a_clear_coat_reflects_its_share_and_passes_the_rest_both_ways() {
+        let smooth = ClearCoat {
+            weight: 1.0,
+            eta: 1.5,
+            alpha: 0.0,
+        };
+        let lambert = |r: f32, wo: Vec3| {
+            let m = PhysicalMaterial::DiffuseTransmission {
+                reflectance: Vec3::splat(r),
+                transmittance: Vec3::ZERO,
+            };
+            Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &RGB)
+        };
+        let black = lambert(0.0, Vec3::Z).with_clearcoat(smooth, Vec3::Z);
+        assert!((albedo(&black, Vec3::Z, 3) - 0.04).abs() < 1e-4);
+        // F̄ by the midpoint rule over μ² (cosine-weighted).
+        let n = 4096;
+        let mean_f = (0..n)
+            .map(|j| fresnel_dielectric(((j as f32 + 0.5) / n as f32).sqrt(), 1.5) as f64)
+            .sum::<f64>()
+            / n as f64;
+        for (theta, rho, weight) in [(0.0f32, 0.8f32, 1.0f32), (1.0, 0.5, 1.0), (0.5, 0.8, 0.5)] {
+            let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
+            let coat = ClearCoat { weight, ..smooth };
+            let bsdf = lambert(rho, wo).with_clearcoat(coat, wo);
+            let f = weight as f64 * fresnel_dielectric(theta.cos(), 1.5) as f64;
+            let want = f + (1.0 - f) * rho as f64 * (1.0 - weight as f64 * mean_f);
+            let q = smooth_albedo_by_quadrature(&bsdf, wo) + f;
+            let sampled = albedo(&bsdf, wo, 5);
+            assert!(
+                (q - want).abs() < 2e-3,
+                "θ {theta} ρ {rho} c {weight}: quadrature {q}, want {want}"
+            );
+            assert!(
+                (sampled - want).abs() < 0.01,
+                "θ {theta}: sampled {sampled}, want {want}"
+            );
+        }
+        let rough = ClearCoat { alpha: 0.2, ..smooth };
+        for theta in [0.0f32, 0.8, 1.3] {
+            let wo = Vec3::new(theta.sin(), 0.0, theta.cos());
+            let bsdf = Bsdf::physical(&conductor(0.9, 0.4), Vec3::Z, Vec3::Z, wo, &RGB).with_clearcoat(rough, wo);
+            let (a, q) = (albedo(&bsdf, wo, 7), smooth_albedo_by_quadrature(&bsdf, wo));
+            assert!(
+                (a - q).abs() < 0.01 && q <= 1.0,
+                "θ {theta}: sampled {a}, quadrature {q}"
+            );
+            let wi = Vec3::new(-0.3, 0.4, 0.866).normalize();
+            let (f1, f2) = (bsdf.eval(wo, wi), bsdf.eval(wi, wo));
+            assert!((f1 - f2).length() <= 1e-4 * (1.0 + f1.length()), "{f1:?} vs {f2:?}");
+        }
+        // Glass takes no coat.
+        let glass = Bsdf::new(
+            &Lobes::new(&SurfaceParams {
+                transmissive: Vec3::ONE,
+                index: 1.5,
+                ..SurfaceParams::default()
+            }),
+            Vec3::Z,
+            Vec3::Z,
+            Vec3::Z,
+            &RGB,
+            None,
+            None,
+        );
+        assert_eq!(glass.with_clearcoat(smooth, Vec3::Z).mirror, glass.mirror);
     }
 
     #[test]

@@ -334,6 +334,36 @@ pub struct MaterialDesc {
     /// length d inside keeps exp(−σ d) (Beer–Lambert; glTF's `KHR_materials_volume`
     /// attenuation). `None`: clear.
     pub absorption: Option<Vec3>,
+    /// pbrt's `mix`: the physical reading takes one of two materials at each point; the course
+    /// fields above hold the larger part.
+    pub mix: Option<Box<MixDesc>>,
+    /// A clear coat over the physical reading (glTF's `KHR_materials_clearcoat`, pbrt-v4's
+    /// `coatedconductor`).
+    pub clearcoat: Option<ClearCoat>,
+}
+
+/// A clear dielectric coat over a material: it reflects `weight`·F(θ) (Fresnel of index `eta`,
+/// smooth or GGX of α `alpha`), and what lies under it is seen through it both ways, times
+/// (1 − weight·F(θo))(1 − weight·F(θi)): reciprocal, and never more than all the light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ClearCoat {
+    /// How much of the surface the coat covers (glTF's `clearcoatFactor`), 0 to 1.
+    pub weight: f32,
+    /// The coat's index.
+    pub eta: f32,
+    /// The coat's GGX α (below [`SMOOTH_ALPHA`] a smooth coat).
+    pub alpha: f32,
+}
+
+/// pbrt's `mix` material: at each point the second material with probability `amount` (its
+/// first channel), else the first, chosen by a hash of the point and the direction the light
+/// leaves by, as pbrt-v4 chooses: in the mean the two BSDFs blend by `amount`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MixDesc {
+    /// The two materials.
+    pub materials: [MaterialDesc; 2],
+    /// The second's share.
+    pub amount: Param,
 }
 
 /// The faces of a surface that emit. A face is named by the geometric normal: a triangle's
@@ -538,6 +568,12 @@ impl MaterialDesc {
         if let Some(mr) = &self.metallic_roughness {
             let _ = mr.try_map(&mut visit);
         }
+        if let Some(mix) = &self.mix {
+            let _ = visit(&mix.amount);
+            for m in &mix.materials {
+                maps.extend(m.image_maps());
+            }
+        }
         maps.extend(self.normal_map.as_ref().map(|n| n.map.clone()));
         maps
     }
@@ -563,6 +599,8 @@ impl Default for MaterialDesc {
             alpha: None,
             emitting_faces: EmittingFaces::Both,
             absorption: None,
+            mix: None,
+            clearcoat: None,
         }
     }
 }

@@ -83,6 +83,20 @@ pub struct Material {
     pub emitting_faces: crate::description::EmittingFaces,
     /// Absorption per unit of length inside a solid glass ([`crate::description::MaterialDesc::absorption`]).
     pub absorption: Option<Vec3>,
+    /// pbrt's `mix`: one of two materials at each point ([`Mix`]).
+    pub mix: Option<Mix>,
+    /// A clear coat over the physical reading.
+    pub clearcoat: Option<crate::description::ClearCoat>,
+}
+
+/// A mix of two materials in a built scene: at each point the second with probability
+/// `amount` (its first channel), else the first (`description::MixDesc`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mix {
+    /// The two materials' ids.
+    pub materials: [u32; 2],
+    /// The second's share.
+    pub amount: Channel,
 }
 
 /// A material's constant colours as fitted smooth spectra (for spectral transport); `None`
@@ -284,7 +298,7 @@ impl Material {
     }
 
     /// The physical reading's values at texture coordinates `uv`, if it has its own.
-    #[inline]
+    #[inline(always)]
     pub fn physical_at(&self, textures: &[Texture], uv: Vec2) -> Option<PhysicalMaterial<Vec3>> {
         if let Some(mr) = &self.metallic_roughness {
             let texel = mr.texture.eval(textures, uv);

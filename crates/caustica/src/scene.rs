@@ -82,6 +82,9 @@ pub struct Occluders {
 /// Few primitives come near one gather; past this many, testing the whole BVH is as cheap.
 const OCCLUDER_CAPACITY: usize = 8;
 
+/// How deep mixes of mixes are followed (pbrt files nest a few).
+const MAX_MIX_DEPTH: u32 = 8;
+
 impl Occluders {
     fn push(&mut self, prim: u32) {
         if self.len < OCCLUDER_CAPACITY {
@@ -157,6 +160,10 @@ pub struct Scene {
     material_spectra: Vec<OnceLock<MaterialSpectra>>,
     /// Whether some material absorbs inside ([`Scene::absorption_beyond`]).
     absorbs: bool,
+    /// Whether some material is a mix ([`Scene::choose`]).
+    mixes: bool,
+    /// Whether some material has a clear coat.
+    coats: bool,
     /// Each untextured material's lobes, worked out once (`None`: textured).
     material_lobes: Vec<Option<Lobes>>,
     textures: Vec<Texture>,
@@ -283,6 +290,8 @@ impl Scene {
             ambient,
             material_spectra: materials.iter().map(|_| OnceLock::new()).collect(),
             absorbs: materials.iter().any(|m| m.absorption.is_some()),
+            mixes: materials.iter().any(|m| m.mix.is_some()),
+            coats: materials.iter().any(|m| m.clearcoat.is_some()),
             material_lobes: materials
                 .iter()
                 .map(|m| (!m.is_textured()).then(|| Lobes::new(&m.eval(&[], Vec2::ZERO))))
@@ -503,13 +512,28 @@ impl Scene {
 
     /// The physical reading's values at a surface point, when its material has its own (a
     /// blend of per-vertex materials reads the first vertex's).
-    #[inline]
+    #[inline(always)]
     pub fn physical(&self, hit: &SurfaceHit) -> Option<crate::material::PhysicalMaterial<Vec3>> {
         let id = match hit.material {
             MaterialRef::One(id) => id,
             MaterialRef::Blend { ids, .. } => ids[0],
         };
         self.materials[id as usize].physical_at(&self.textures, hit.uv)
+    }
+
+    /// The clear coat over the material at a surface point, if it has one.
+    #[inline]
+    pub fn clearcoat(&self, hit: &SurfaceHit) -> Option<crate::description::ClearCoat> {
+        match hit.material {
+            MaterialRef::One(id) => self.materials[id as usize].clearcoat,
+            MaterialRef::Blend { .. } => None,
+        }
+    }
+
+    /// Whether some material has a clear coat.
+    #[inline]
+    pub fn has_clearcoats(&self) -> bool {
+        self.coats
     }
 
     /// The emitted radiance (`emissive`) at a surface point.
@@ -764,7 +788,12 @@ impl Scene {
                 geometric_normal: normal,
                 shading_normal: normal,
                 uv: hit.uv,
-                material: MaterialRef::One(self.part_material(hit.prim as usize, hit.part)),
+                material: MaterialRef::One(self.choose(
+                    self.part_material(hit.prim as usize, hit.part),
+                    point,
+                    ray.dir,
+                    hit.uv,
+                )),
                 object: ObjectRef::Shape(hit.prim),
                 prim: hit.prim,
             };
@@ -792,14 +821,21 @@ impl Scene {
             }
             None => geometric_normal,
         };
-        let material = match &mesh.vertex_materials {
-            Some(ids) => MaterialRef::Blend {
-                ids: [ids[i0], ids[i1], ids[i2]],
-                weights: w,
-            },
-            None => MaterialRef::One(mesh.material),
+        let point = ray.at(hit.t);
+        let (material, id) = match &mesh.vertex_materials {
+            Some(ids) => (
+                MaterialRef::Blend {
+                    ids: [ids[i0], ids[i1], ids[i2]],
+                    weights: w,
+                },
+                mesh.material,
+            ),
+            None => {
+                let id = self.choose(mesh.material, point, ray.dir, uv);
+                (MaterialRef::One(id), id)
+            }
         };
-        let shading_normal = match (&mesh.tangents, self.materials[mesh.material as usize].normal_map) {
+        let shading_normal = match (&mesh.tangents, self.materials[id as usize].normal_map) {
             (Some(t), Some((texture, scale))) => {
                 let tangent = t[i0] * w[0] + t[i1] * w[1] + t[i2] * w[2];
                 let sign = if t[i0].w < 0.0 { -1.0 } else { 1.0 };
@@ -817,7 +853,7 @@ impl Scene {
         };
         SurfaceHit {
             t: hit.t,
-            point: ray.at(hit.t),
+            point,
             point_error: Vec3::ZERO,
             geometric_normal,
             shading_normal,
@@ -918,15 +954,56 @@ impl Scene {
             ObjectRef::Mesh(i) => {
                 let mesh = &self.meshes[i as usize];
                 match &mesh.vertex_materials {
-                    Some(ids) => ids.iter().any(|&id| test(&self.materials[id as usize])),
-                    None => test(&self.materials[mesh.material as usize]),
+                    Some(ids) => ids.iter().any(|&id| self.material_or_part(id, &test, MAX_MIX_DEPTH)),
+                    None => self.material_or_part(mesh.material, &test, MAX_MIX_DEPTH),
                 }
             }
             ObjectRef::Shape(i) => self
                 .shape_material_ids(i as usize)
                 .iter()
-                .any(|&id| test(&self.materials[id as usize])),
+                .any(|&id| self.material_or_part(id, &test, MAX_MIX_DEPTH)),
         }
+    }
+
+    /// Whether material `id`, or a part of it if it is a mix, passes `test`.
+    fn material_or_part(&self, id: u32, test: &dyn Fn(&Material) -> bool, depth: u32) -> bool {
+        let m = &self.materials[id as usize];
+        test(m)
+            || depth > 0
+                && m.mix.is_some_and(|mix| {
+                    mix.materials
+                        .iter()
+                        .any(|&part| self.material_or_part(part, test, depth - 1))
+                })
+    }
+
+    /// The material a surface point of material `id` shows: `id` itself, or for a mix one of
+    /// its parts, chosen by a hash of the point and the ray's direction (the same point seen
+    /// along the same ray always shows the same part; pbrt-v4 chooses so).
+    #[inline(always)]
+    fn choose(&self, id: u32, point: Vec3, dir: Vec3, uv: Vec2) -> u32 {
+        if !self.mixes {
+            return id;
+        }
+        self.choose_mixed(id, point, dir, uv)
+    }
+
+    #[inline(never)]
+    fn choose_mixed(&self, id: u32, point: Vec3, dir: Vec3, uv: Vec2) -> u32 {
+        let mut id = id;
+        for level in 0..MAX_MIX_DEPTH {
+            let Some(mix) = self.materials[id as usize].mix else {
+                break;
+            };
+            let amount = mix.amount.eval(&self.textures, uv).x;
+            let words = [point.x, point.y, point.z, dir.x, dir.y, dir.z].map(f32::to_bits);
+            let hash = words.iter().fold(u64::from(level) ^ u64::from(id) << 32, |h, &w| {
+                crate::sampling::mix64(h ^ u64::from(w))
+            });
+            let u = (hash >> 40) as f32 / (1u64 << 24) as f32;
+            id = mix.materials[usize::from(u < amount)];
+        }
+        id
     }
 }
 

@@ -171,13 +171,24 @@ fn physical_lobes_sample_their_density() {
         ("GGX conductor α 0.3", conductor(0.3), 0.0),
         ("GGX conductor α 0.5", conductor(0.5), 1.2),
         ("GGX conductor α 0.9", conductor(0.9), 0.8),
-        ("coated diffuse, rough coat", coated, 0.7),
+        ("coated diffuse, rough coat", coated.clone(), 0.7),
         ("diffuse transmission", translucent, 0.5),
     ];
     for (i, (name, material, theta)) in cases.into_iter().enumerate() {
         let wo = at(theta);
         let bsdf = Bsdf::physical(&material, Vec3::Z, Vec3::Z, wo, &Wavelengths::Rgb);
         assert_samples_match_pdf(&format!("{name}, θo {theta}"), &bsdf, wo, 20 + i as u64);
+    }
+    // A rough clear coat over a rough metal and over a rough coated diffuse base.
+    let coat = crate::description::ClearCoat {
+        weight: 0.8,
+        eta: 1.5,
+        alpha: 0.1,
+    };
+    for (i, (material, theta)) in [(conductor(0.4), 0.6f32), (coated, 1.1)].into_iter().enumerate() {
+        let wo = at(theta);
+        let bsdf = Bsdf::physical(&material, Vec3::Z, Vec3::Z, wo, &Wavelengths::Rgb).with_clearcoat(coat, wo);
+        assert_samples_match_pdf(&format!("clear coat {i}, θo {theta}"), &bsdf, wo, 30 + i as u64);
     }
 }
 

@@ -152,20 +152,8 @@ mod tests {
         bsdf.sample(wo, rng.uniform(), rng.uniform2(), mode)
     }
 
-    /// ∫ f·|cos θi| dωi over the whole sphere by the midpoint rule in θ and φ.
     fn albedo_by_quadrature(bsdf: &Bsdf, wo: Vec3, mode: Transport) -> f64 {
-        let (nt, np) = (3000, 720);
-        let (dt, dp) = (std::f64::consts::PI / nt as f64, 2.0 * std::f64::consts::PI / np as f64);
-        let mut sum = 0.0f64;
-        for i in 0..nt {
-            let t = (i as f64 + 0.5) * dt;
-            for j in 0..np {
-                let p = (j as f64 + 0.5) * dp;
-                let wi = Vec3::new((t.sin() * p.cos()) as f32, (t.sin() * p.sin()) as f32, t.cos() as f32);
-                sum += bsdf.eval_in(wo, wi, mode).x as f64 * t.cos().abs() * t.sin() * dt * dp;
-            }
-        }
-        sum
+        super::super::tests::albedo_by_quadrature(bsdf, wo, true, mode)
     }
 
     /// Every sample weighs f·|cos|/pdf with the pdf [`Bsdf::pdf`] states; the mean weight is the

@@ -9,7 +9,7 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    repair_vertex_attributes, Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc,
+    repair_vertex_attributes, Alpha, CameraDesc, ClearCoat, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc,
     MetallicRoughness, NormalMap, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
     SMOOTH_ALPHA,
 };
@@ -39,6 +39,7 @@ const READ_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "KHR_materials_specular",
     "KHR_materials_dispersion",
+    "KHR_materials_clearcoat",
     "KHR_texture_transform",
 ];
 
@@ -368,7 +369,7 @@ impl Reader<'_, '_> {
 
     fn read(&mut self, blob: Option<&[u8]>) -> Result<SceneDescription, ParseError> {
         self.desc.hints.physical = true;
-        // Every extension the file uses and caustica does not render is said (sheen, clearcoat,
+        // Every extension the file uses and caustica does not render is said (sheen,
         // iridescence, anisotropy, …): the picture may differ from the author's there.
         let unread: Vec<(usize, String)> = self
             .root
@@ -905,6 +906,7 @@ impl Reader<'_, '_> {
             normal_map,
             alpha: cut_outs,
             name: m.name.clone(),
+            clearcoat: self.clearcoat(&ext, &path, transmission >= 0.5),
             ..MaterialDesc::default()
         };
         if let Some(texture) = mr_texture.clone().filter(|_| !glass_textured) {
@@ -1033,6 +1035,48 @@ impl Reader<'_, '_> {
             }
         }
         Ok(desc)
+    }
+
+    /// `KHR_materials_clearcoat`: a clear coat of index 1.5 (the extension's), `clearcoatFactor`
+    /// thick and `clearcoatRoughnessFactor` rough (GGX α its square). Its textures are read by
+    /// their factors, and a coat on glass is not rendered (warnings).
+    fn clearcoat(
+        &mut self,
+        ext: &json::extensions::material::Material,
+        path: &str,
+        transmissive: bool,
+    ) -> Option<ClearCoat> {
+        let coat = ext.others.get("KHR_materials_clearcoat")?;
+        let number = |name: &str, default: f64| coat.get(name).and_then(|v| v.as_f64()).unwrap_or(default) as f32;
+        let weight = number("clearcoatFactor", 0.0).clamp(0.0, 1.0);
+        let roughness = number("clearcoatRoughnessFactor", 0.0).clamp(0.0, 1.0);
+        let textured = [
+            "clearcoatTexture",
+            "clearcoatRoughnessTexture",
+            "clearcoatNormalTexture",
+        ]
+        .into_iter()
+        .filter(|t| coat.get(*t).is_some())
+        .collect::<Vec<_>>();
+        if !textured.is_empty() {
+            self.warn_once(
+                "clearcoattexture",
+                &format!("{path}.extensions.KHR_materials_clearcoat"),
+                format!("{} not read: the factors are used", textured.join(", ")),
+            );
+        }
+        if weight > 0.0 && transmissive {
+            self.warn_once(
+                "clearcoatglass",
+                &format!("{path}.extensions.KHR_materials_clearcoat"),
+                "a clear coat on transmissive glass is not rendered",
+            );
+        }
+        (weight > 0.0).then_some(ClearCoat {
+            weight,
+            eta: 1.5,
+            alpha: roughness * roughness,
+        })
     }
 
     /// A colour texture (`info` at JSON path `path`) times `factor`, sRGB-decoded: its image

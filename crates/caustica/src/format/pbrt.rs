@@ -21,8 +21,8 @@ use self::lexer::{Kind, Lexer, Token};
 use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
-    Alpha, CameraDesc, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, NormalMap, ObjectDesc,
-    Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    Alpha, CameraDesc, ClearCoat, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, MixDesc,
+    NormalMap, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
@@ -861,9 +861,15 @@ impl<'f> Reader<'f> {
     /// GGX α from pbrt's `roughness` (or the mean of `uroughness`/`vroughness`), `default`
     /// when neither is given (0 in pbrt-v4; pbrt-v3's materials have their own).
     fn roughness(&mut self, params: &Params, span: &Span, default: f32) -> Result<f32, ParseError> {
-        let r = self.float_slot(params, "roughness", default)?;
-        let u = self.float_slot(params, "uroughness", r)?;
-        let v = self.float_slot(params, "vroughness", r)?;
+        self.roughness_of(params, span, "", default)
+    }
+
+    /// [`Parser::roughness`] of the parameters named with `prefix` (`coatedconductor`'s
+    /// `interface.` and `conductor.`).
+    fn roughness_of(&mut self, params: &Params, span: &Span, prefix: &str, default: f32) -> Result<f32, ParseError> {
+        let r = self.float_slot(params, &format!("{prefix}roughness"), default)?;
+        let u = self.float_slot(params, &format!("{prefix}uroughness"), r)?;
+        let v = self.float_slot(params, &format!("{prefix}vroughness"), r)?;
         if (u - v).abs() > 1e-6 {
             self.warn("anisotropic roughness is read as the mean of u and v", span.clone());
         }
@@ -915,35 +921,32 @@ impl<'f> Reader<'f> {
             "conductor" | "metal" => {
                 // pbrt-v3's metal is a little rough by default.
                 let alpha = self.roughness(params, span, if kind == "metal" { 0.01 } else { 0.0 })?;
-                let reflectance = params.has("reflectance");
-                let (eta, k, r) = if reflectance {
-                    if params.has("eta") || params.has("k") {
-                        return Err(ParseError::new(
-                            "a conductor takes `reflectance` or `eta` and `k`, not both",
-                            span.clone(),
-                        ));
-                    }
-                    let r = self.colour(params, "reflectance", Vec3::ONE)?;
-                    (Vec3::ONE, Vec3::ZERO, Some(r))
-                } else {
-                    let (cu_eta, cu_k) = spectra::metal("metal-Cu").expect("copper is known");
-                    (
-                        self.index_rgb(params, "eta", cu_eta)?,
-                        self.index_rgb(params, "k", cu_k)?,
-                        None,
-                    )
-                };
-                let f0 = match &r {
-                    Some(Param::Constant(c)) => *c,
-                    Some(_) => Vec3::splat(0.8),
-                    None => ((eta - Vec3::ONE).powf(2.0) + k * k) / ((eta + Vec3::ONE).powf(2.0) + k * k),
-                };
+                let (physical, f0) = self.conductor(params, span, "", alpha, 1.0)?;
                 let mut m = MaterialDesc {
-                    physical: Some(PhysicalMaterial::Conductor {
-                        eta,
-                        k,
-                        reflectance: r,
-                        roughness: alpha,
+                    physical: Some(physical),
+                    ..MaterialDesc::default()
+                };
+                course_gloss(&mut m, f0, alpha);
+                m
+            }
+            "coatedconductor" => {
+                // A conductor under a clear coat, the conductor's index taken relative to the
+                // coat's (pbrt-v4 divides it so); light bouncing between them is not followed.
+                let coat_alpha = self.roughness_of(params, span, "interface.", 0.0)?;
+                let coat_eta = self.float_slot(params, "interface.eta", 1.5)?.max(1.0);
+                let alpha = self.roughness_of(params, span, "conductor.", 0.0)?;
+                let (physical, f0) = self.conductor(params, span, "conductor.", alpha, coat_eta)?;
+                for unused in ["thickness", "albedo", "g", "maxdepth", "nsamples"] {
+                    if let Some(s) = params.span_of(unused) {
+                        self.warn(format!("`{unused}` of the coated conductor is not modelled"), s);
+                    }
+                }
+                let mut m = MaterialDesc {
+                    physical: Some(physical),
+                    clearcoat: Some(ClearCoat {
+                        weight: 1.0,
+                        eta: coat_eta,
+                        alpha: coat_alpha,
                     }),
                     ..MaterialDesc::default()
                 };
@@ -974,15 +977,22 @@ impl<'f> Reader<'f> {
                 if names.len() != 2 {
                     return Err(ParseError::new("`materials` names two materials", s));
                 }
-                let chosen = &names[usize::from(amount >= 0.5)];
-                self.warn(
-                    format!("a mix material is read as its larger part, \"{chosen}\""),
-                    span.clone(),
-                );
-                match self.named_materials.get(chosen) {
-                    Some(m) => m.clone(),
-                    None => return Err(ParseError::new(format!("no material named \"{chosen}\""), s)),
+                let mut parts = Vec::with_capacity(2);
+                for name in &names {
+                    match self.named_materials.get(name) {
+                        Some(m) => parts.push(m.clone()),
+                        None => return Err(ParseError::new(format!("no material named \"{name}\""), s)),
+                    }
                 }
+                let second = parts.pop().expect("two parts");
+                let first = parts.pop().expect("two parts");
+                // The course model reads the larger part.
+                let mut m = if amount >= 0.5 { second.clone() } else { first.clone() };
+                m.mix = Some(Box::new(MixDesc {
+                    materials: [first, second],
+                    amount: Param::grey(amount.clamp(0.0, 1.0)),
+                }));
+                m
             }
             other => {
                 self.warn(
@@ -1194,6 +1204,50 @@ impl<'f> Reader<'f> {
     }
 
     /// A dielectric's `eta`: n_d, and V_d for named or sampled glasses.
+    /// A conductor from `reflectance`, or from `eta` and `k` named with `prefix` (copper by
+    /// default), with GGX α `alpha`, in a medium of index `outside` (its index is
+    /// taken relative to it); also its normal reflectance, for the course reading.
+    fn conductor(
+        &mut self,
+        params: &Params,
+        span: &Span,
+        prefix: &str,
+        alpha: f32,
+        outside: f32,
+    ) -> Result<(PhysicalMaterial, Vec3), ParseError> {
+        // `reflectance` has no prefix in pbrt-v4's coated conductor either.
+        let (reflectance_name, eta_name, k_name) = ("reflectance", format!("{prefix}eta"), format!("{prefix}k"));
+        let (eta, k, r) = if params.has(reflectance_name) {
+            if params.has(&eta_name) || params.has(&k_name) {
+                return Err(ParseError::new(
+                    "a conductor takes `reflectance` or `eta` and `k`, not both",
+                    span.clone(),
+                ));
+            }
+            let r = self.colour(params, reflectance_name, Vec3::ONE)?;
+            (Vec3::ONE, Vec3::ZERO, Some(r))
+        } else {
+            let (cu_eta, cu_k) = spectra::metal("metal-Cu").expect("copper is known");
+            (
+                self.index_rgb(params, &eta_name, cu_eta)? / outside,
+                self.index_rgb(params, &k_name, cu_k)? / outside,
+                None,
+            )
+        };
+        let f0 = match &r {
+            Some(Param::Constant(c)) => *c,
+            Some(_) => Vec3::splat(0.8),
+            None => ((eta - Vec3::ONE).powf(2.0) + k * k) / ((eta + Vec3::ONE).powf(2.0) + k * k),
+        };
+        let physical = PhysicalMaterial::Conductor {
+            eta,
+            k,
+            reflectance: r,
+            roughness: alpha,
+        };
+        Ok((physical, f0))
+    }
+
     fn eta(&mut self, params: &Params) -> Result<(f32, Option<f32>), ParseError> {
         let (eta, abbe) = match params.spectrum("eta")? {
             None => (1.5, None),

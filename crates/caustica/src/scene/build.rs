@@ -507,6 +507,14 @@ impl Builder {
             },
             emitting_faces: desc.emitting_faces,
             absorption: desc.absorption.filter(|a| a.cmpgt(Vec3::ZERO).any()),
+            mix: match &desc.mix {
+                Some(m) => Some(crate::material::Mix {
+                    materials: [self.material(&m.materials[0])?, self.material(&m.materials[1])?],
+                    amount: self.channel(&m.amount)?,
+                }),
+                None => None,
+            },
+            clearcoat: desc.clearcoat.filter(|c| c.weight > 0.0),
         };
         let key = MaterialKey(
             [
@@ -527,13 +535,15 @@ impl Builder {
             .chain([material.abbe.map_or(0, f32::to_bits)])
             .chain(
                 format!(
-                    "{:?} {:?} {:?} {:?} {:?} {:?}",
+                    "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
                     material.physical,
                     material.normal_map,
                     material.metallic_roughness,
                     material.alpha,
                     material.emitting_faces,
-                    material.absorption
+                    material.absorption,
+                    material.mix,
+                    material.clearcoat
                 )
                 .bytes()
                 .map(u32::from),

@@ -573,7 +573,7 @@ fn gltf_volume_attenuation_is_absorption_inside_the_glass() {
 fn gltf_extensions_not_rendered_are_said() {
     let text = gltf_file(&meshes()).replace(
         "\"extensionsUsed\":[",
-        "\"extensionsUsed\":[\"KHR_materials_sheen\",\"KHR_materials_clearcoat\",\"KHR_xmp_json_ld\",",
+        "\"extensionsUsed\":[\"KHR_materials_sheen\",\"KHR_materials_iridescence\",\"KHR_materials_clearcoat\",\"KHR_xmp_json_ld\",",
     );
     let dir = std::env::temp_dir().join(format!("caustica-extensions-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
@@ -581,7 +581,7 @@ fn gltf_extensions_not_rendered_are_said() {
     std::fs::write(&path, text).unwrap();
     let scene = caustica::loader::load(&path, &caustica::loader::LoadSettings::default()).unwrap();
     let warnings = scene.warnings();
-    for name in ["KHR_materials_sheen", "KHR_materials_clearcoat"] {
+    for name in ["KHR_materials_sheen", "KHR_materials_iridescence"] {
         let said: Vec<_> = warnings.iter().filter(|w| w.contains(name)).collect();
         assert_eq!(said.len(), 1, "{name}: {warnings:?}");
         assert!(
@@ -592,6 +592,7 @@ fn gltf_extensions_not_rendered_are_said() {
     }
     // Metadata changes nothing in the picture: no warning either.
     for read in [
+        "KHR_materials_clearcoat",
         "KHR_materials_transmission",
         "KHR_materials_volume",
         "KHR_lights_punctual",
@@ -600,6 +601,40 @@ fn gltf_extensions_not_rendered_are_said() {
         assert!(
             !warnings.iter().any(|w| w.contains(&format!("{read} is not"))),
             "{warnings:?}"
+        );
+    }
+}
+
+/// pbrt's `mix` blends two materials by `amount` in the mean: a floor that is a white diffuse
+/// (0.8) and a black one at amount 0.25 (the second's share), under a uniform sky of radiance
+/// 1 with nothing else to shade it, has radiance 0.75 · 0.8 = 0.6, for camera paths and for
+/// light paths alike.
+#[test]
+fn pbrt_mix_blends_its_materials_by_amount() {
+    let text = "LookAt 0 1 0  0 0 0  0 0 1\nCamera \"perspective\" \"float fov\" 30\nWorldBegin\n\
+        LightSource \"infinite\" \"rgb L\" [1 1 1]\n\
+        MakeNamedMaterial \"white\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n\
+        MakeNamedMaterial \"black\" \"string type\" \"diffuse\" \"rgb reflectance\" [0 0 0]\n\
+        Material \"mix\" \"string materials\" [\"white\" \"black\"] \"float amount\" 0.25\n\
+        Shape \"bilinearmesh\" \"point3 P\" [-100 0 -100  100 0 -100  -100 0 100  100 0 100]\n";
+    let dir = std::env::temp_dir().join(format!("caustica-mix-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("mix.pbrt");
+    std::fs::write(&path, text).unwrap();
+    let scene = caustica::loader::load(&path, &caustica::loader::LoadSettings::default()).unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        scene.warnings().iter().all(|w| !w.contains("mix")),
+        "{:?}",
+        scene.warnings()
+    );
+    for (integrator, passes) in [("path", 32), ("vcm", 8)] {
+        let film = crate::common::render_integrator(&scene, integrator, 24, passes, 20_000, 5);
+        let mean = film.region_mean((0, 23), (0, 23));
+        eprintln!("{integrator}: {mean}");
+        assert!(
+            (mean - Vec3::splat(0.6)).abs().max_element() < 0.01,
+            "{integrator}: {mean}"
         );
     }
 }

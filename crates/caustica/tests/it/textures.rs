@@ -442,6 +442,21 @@ fn a_constant_normal_map_tilts_the_shading_by_its_decoded_normal() {
     );
 }
 
+/// The scene's material read with a metallic-roughness texture, after checking that no
+/// warning mentions any of `unsaid`.
+fn metallic_roughness_material<'s>(scene: &'s Scene, unsaid: &[&str]) -> &'s caustica::material::Material {
+    assert!(
+        scene.warnings().iter().all(|w| unsaid.iter().all(|u| !w.contains(u))),
+        "{:?}",
+        scene.warnings()
+    );
+    scene
+        .materials()
+        .iter()
+        .find(|m| m.metallic_roughness.is_some())
+        .unwrap()
+}
+
 /// glTF's metallic-roughness texture, linear: blue times `metallicFactor` is metalness, green
 /// times `roughnessFactor` roughness (GGX α its square); a metal point reflects the base colour,
 /// a dielectric point is the base colour under the coat of the ior.
@@ -458,16 +473,7 @@ fn a_metallic_roughness_texture_decides_metal_and_roughness_point_by_point() {
         &LoadSettings::default(),
     )
     .unwrap();
-    assert!(
-        scene.warnings().iter().all(|w| !w.contains("metallic")),
-        "{:?}",
-        scene.warnings()
-    );
-    let m = scene
-        .materials()
-        .iter()
-        .find(|m| m.metallic_roughness.is_some())
-        .unwrap();
+    let m = metallic_roughness_material(&scene, &["metallic"]);
     let base = Vec3::new(0.9, 0.6, 0.2);
     let alpha = |g: u8| (g as f32 / 255.0 * 0.8).powi(2);
     match m.physical_at(scene.textures(), Vec2::new(0.25, 0.5)) {
@@ -512,19 +518,7 @@ fn a_metallic_roughness_texture_on_glass_makes_it_rough_or_metal_point_by_point(
     let sampler = r#"{"magFilter":9728,"wrapS":10497,"wrapT":10497}"#;
     let path = quad_gltf(&dir, &image, Holder::File, &material, sampler);
     let scene = load(&path, &LoadSettings::default()).unwrap();
-    assert!(
-        scene
-            .warnings()
-            .iter()
-            .all(|w| !w.contains("metallic") && !w.contains("rough")),
-        "{:?}",
-        scene.warnings()
-    );
-    let m = scene
-        .materials()
-        .iter()
-        .find(|m| m.metallic_roughness.is_some())
-        .unwrap();
+    let m = metallic_roughness_material(&scene, &["metallic", "rough"]);
     let base = Vec3::new(0.9, 0.6, 0.2);
     match m.physical_at(scene.textures(), Vec2::new(1.0 / 6.0, 0.5)) {
         Some(PhysicalMaterial::RoughDielectric {
@@ -560,6 +554,41 @@ fn a_metallic_roughness_texture_on_glass_makes_it_rough_or_metal_point_by_point(
             _ => None,
         });
     assert_eq!(rough, Some(0.25));
+}
+
+/// glTF's `KHR_materials_clearcoat` over a Lambert base (specular 0): under the uniform sky
+/// caustica adds to a file without lights, a quad seen face-on has radiance
+/// F(0) + (1 − F(0))·ρ·(1 − F̄) with the coat's F of index 1.5 (F(0) = 0.04, F̄ its
+/// cosine-weighted mean): the coat's reflection of the sky plus the base seen through it.
+#[test]
+fn a_gltf_clear_coat_reflects_the_sky_and_shows_the_base_through_it() {
+    let dir = folder("clearcoat");
+    let image = png(1, 1, &[[255, 255, 255]]);
+    let material = r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":1},
+"extensions":{"KHR_materials_specular":{"specularFactor":0},"KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":0}}}"#;
+    let path = quad_gltf(&dir, &image, Holder::File, material, "{}");
+    let scene = load(&path, &LoadSettings::default()).unwrap();
+    assert!(
+        scene.warnings().iter().all(|w| !w.contains("clearcoat")),
+        "{:?}",
+        scene.warnings()
+    );
+    let n = 4096;
+    let mean_f = (0..n)
+        .map(|j| caustica::bsdf::fresnel_dielectric(((j as f32 + 0.5) / n as f32).sqrt(), 1.5))
+        .sum::<f32>()
+        / n as f32;
+    let want = 0.04 + 0.96 * 0.5 * (1.0 - mean_f);
+    for integrator in ["path", "vcm"] {
+        // The quad fills the view (within 22° of its normal, where F moves by 0.0002).
+        let film = crate::common::render_integrator(&scene, integrator, 16, 32, 10_000, 3);
+        let got = film.region_mean((0, 15), (0, 15));
+        eprintln!("{integrator}: {got}, want {want}");
+        assert!(
+            (got - Vec3::splat(want)).abs().max_element() < 0.015 * want,
+            "{integrator}: {got} vs {want}"
+        );
+    }
 }
 
 /// glTF's `alphaMode`: MASK cuts holes where the base colour's alpha times its factor is below

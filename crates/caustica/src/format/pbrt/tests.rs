@@ -442,3 +442,67 @@ fn rough_dielectrics_become_ggx_glass() {
     assert_eq!(m[3].physical, None);
     assert!(matches!(m[4].physical, Some(PhysicalMaterial::ThinDielectric { .. })));
 }
+
+/// pbrt's `mix` keeps both materials and the second's share (nested mixes too); the course
+/// fields hold the larger part; a part that is not defined is an error at the list.
+#[test]
+fn mix_keeps_both_parts_and_the_amount() {
+    let desc = scene(
+        "MakeNamedMaterial \"white\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.8 0.8 0.8]\n\
+         MakeNamedMaterial \"glass\" \"string type\" \"dielectric\"\n\
+         MakeNamedMaterial \"half\" \"string type\" \"mix\" \"string materials\" [\"white\" \"glass\"] \"float amount\" 0.3\n\
+         MakeNamedMaterial \"nested\" \"string type\" \"mix\" \"string materials\" [\"half\" \"white\"] \"float amount\" 0.9\n\
+         NamedMaterial \"half\"\nShape \"sphere\"\nNamedMaterial \"nested\"\nShape \"sphere\"",
+    );
+    let m: Vec<&MaterialDesc> = desc.objects.iter().map(|o| &o.material).collect();
+    let mix = m[0].mix.as_ref().expect("a mix");
+    assert_eq!(mix.amount, Param::grey(0.3));
+    assert_eq!(mix.materials[0].diffuse, Param::grey(0.8));
+    assert_eq!(mix.materials[1].transmissive, Param::grey(1.0));
+    assert_eq!(m[0].diffuse, Param::grey(0.8), "the course reading: the larger part");
+    let nested = m[1].mix.as_ref().expect("a mix");
+    assert!(nested.materials[0].mix.is_some(), "a mix inside a mix");
+    assert_eq!(nested.amount, Param::grey(0.9));
+    assert!(
+        desc.warnings.iter().all(|(w, _)| !w.contains("mix")),
+        "{:?}",
+        desc.warnings
+    );
+    let (message, line, _) = error(
+        "WorldBegin\nMakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"white\" \"nothing\"]\n",
+    );
+    assert!(message.contains("no material named \"white\""), "{message}");
+    assert_eq!(line, 2);
+}
+
+/// pbrt-v4's `coatedconductor`: the conductor (its index relative to the coat's, as pbrt-v4
+/// divides it) under a clear coat of `interface.eta` and `interface.roughness`.
+#[test]
+fn coated_conductors_are_a_conductor_under_a_clear_coat() {
+    let desc = scene(
+        "Material \"coatedconductor\" \"float interface.roughness\" 0.04 \"float interface.eta\" 1.6 \
+         \"rgb conductor.eta\" [0.2 0.9 1.1] \"rgb conductor.k\" [3.9 2.4 2.1] \"float conductor.roughness\" 0.01\n\
+         Shape \"sphere\"\n\
+         Material \"coatedconductor\" \"rgb reflectance\" [0.9 0.5 0.2] \"float albedo\" 0.3\nShape \"sphere\"",
+    );
+    let m: Vec<&MaterialDesc> = desc.objects.iter().map(|o| &o.material).collect();
+    let coat = m[0].clearcoat.expect("a coat");
+    assert_eq!((coat.weight, coat.eta), (1.0, 1.6));
+    assert!((coat.alpha - 0.2).abs() < 1e-6, "remapped √0.04: {}", coat.alpha);
+    let Some(PhysicalMaterial::Conductor { eta, k, roughness, .. }) = &m[0].physical else {
+        panic!("{:?}", m[0].physical)
+    };
+    assert!((*eta - Vec3::new(0.2, 0.9, 1.1) / 1.6).abs().max_element() < 1e-6);
+    assert!((*k - Vec3::new(3.9, 2.4, 2.1) / 1.6).abs().max_element() < 1e-6);
+    assert!((roughness - 0.1).abs() < 1e-6);
+    assert!(matches!(
+        &m[1].physical,
+        Some(PhysicalMaterial::Conductor { reflectance: Some(Param::Constant(r)), .. }) if *r == Vec3::new(0.9, 0.5, 0.2)
+    ));
+    assert_eq!(m[1].clearcoat.map(|c| c.eta), Some(1.5));
+    assert!(
+        desc.warnings.iter().any(|(w, _)| w.contains("`albedo`")),
+        "{:?}",
+        desc.warnings
+    );
+}
