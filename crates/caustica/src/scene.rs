@@ -991,12 +991,12 @@ impl Scene {
     #[inline(never)]
     fn choose_mixed(&self, id: u32, point: Vec3, dir: Vec3, uv: Vec2) -> u32 {
         let mut id = id;
+        let words = [point.x, point.y, point.z, dir.x, dir.y, dir.z].map(f32::to_bits);
         for level in 0..MAX_MIX_DEPTH {
             let Some(mix) = self.materials[id as usize].mix else {
                 break;
             };
             let amount = mix.amount.eval(&self.textures, uv).x;
-            let words = [point.x, point.y, point.z, dir.x, dir.y, dir.z].map(f32::to_bits);
             let hash = words.iter().fold(u64::from(level) ^ u64::from(id) << 32, |h, &w| {
                 crate::sampling::mix64(h ^ u64::from(w))
             });
