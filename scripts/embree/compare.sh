@@ -16,7 +16,7 @@ gcc -O2 -std=gnu11 -o "$work/embree_rays" "$root/scripts/embree/embree_rays.c" "
 # The bench writes its rays (`BVH_BENCH_DUMP`) so both programs trace exactly the same ones; its
 # filter matches no tracer, so it only builds the meshes and writes the rays.
 (cd "$root" && BVH_BENCH_QUICK=1 BVH_BENCH_FILTER=dump-only BVH_BENCH_DUMP="$work" \
-    cargo bench -p caustica --bench bvh >/dev/null 2>&1)
+    cargo bench -p caustica-bench --bench bvh >/dev/null 2>&1)
 for mesh in "sphere-37k 96 192 0" "bumpy-1M 500 1000 1"; do
     set -- $mesh
     for kind in incoherent bounce; do
