@@ -74,6 +74,9 @@ pub struct Bsdf {
     pick: [f32; 6],
     /// Index of a clear coat over the diffuse lobe (0: none).
     coat: f32,
+    /// The largest share that coat reflects (its tint's largest channel): what the diffuse
+    /// lobe loses is that times the coat's Fresnel reflectance, each way.
+    coat_weight: f32,
     /// The GGX reflection lobe, if any.
     microfacet: Option<Microfacet>,
     /// Lambertian transmission albedo.
@@ -126,8 +129,8 @@ impl Lambertian {
 enum Fresnel {
     /// A conductor of complex index η + ik per channel.
     Conductor { eta: Vec3, k: Vec3 },
-    /// A dielectric of index η (a coat).
-    Dielectric(f32),
+    /// A dielectric of index η (a coat), its reflectance times `tint`.
+    Dielectric { eta: f32, tint: Vec3 },
 }
 
 /// A GGX reflection lobe.
@@ -259,6 +262,7 @@ impl Bsdf {
             dispersive,
             pick,
             coat: 0.0,
+            coat_weight: 0.0,
             microfacet: None,
             diffuse_transmission: Spectrum::ZERO,
             thin: false,
@@ -311,10 +315,13 @@ impl Bsdf {
                 reflectance,
                 eta,
                 roughness,
+                coat_tint,
                 layered,
             } => {
                 let eta = eta.max(1.0);
-                let f = fresnel_dielectric(cos_o, eta);
+                let tint = clamp01(coat_tint);
+                let weight = tint.max_element();
+                let f = weight * fresnel_dielectric(cos_o, eta);
                 b.diffuse = wl.reflectance(clamp01(reflectance));
                 if layered {
                     // The base's light reflected back down by the coat, again and again, and
@@ -323,16 +330,21 @@ impl Bsdf {
                     b.diffuse /= (Spectrum::ONE - b.diffuse * inside) * (eta * eta);
                 }
                 b.coat = eta;
+                b.coat_weight = weight;
                 b.pick[0] = b.diffuse.max_element() * (1.0 - f);
                 if roughness < SMOOTH_ALPHA {
-                    b.mirror = wl.grey(f);
+                    b.mirror = if tint == Vec3::ONE {
+                        wl.grey(f)
+                    } else {
+                        wl.reflectance(tint) * fresnel_dielectric(cos_o, eta)
+                    };
                     b.pick[2] = f;
                 } else {
                     b.microfacet = Some(Microfacet {
                         alpha: roughness.min(1.0),
-                        fresnel: Fresnel::Dielectric(eta),
+                        fresnel: Fresnel::Dielectric { eta, tint },
                     });
-                    b.pick[4] = f.max(0.04);
+                    b.pick[4] = f.max(0.04 * weight);
                 }
             }
             PhysicalMaterial::DiffuseTransmission {
@@ -432,7 +444,10 @@ impl Bsdf {
     fn coat_lobe(&self) -> Microfacet {
         Microfacet {
             alpha: self.clear.alpha,
-            fresnel: Fresnel::Dielectric(self.clear.eta),
+            fresnel: Fresnel::Dielectric {
+                eta: self.clear.eta,
+                tint: Vec3::ONE,
+            },
         }
     }
 
@@ -879,7 +894,9 @@ impl Bsdf {
         if self.coat <= 0.0 {
             return 1.0;
         }
-        (1.0 - fresnel_dielectric(cos_o.clamp(0.0, 1.0), self.coat)) * (1.0 - fresnel_dielectric(cos_i, self.coat))
+        let w = self.coat_weight;
+        (1.0 - w * fresnel_dielectric(cos_o.clamp(0.0, 1.0), self.coat))
+            * (1.0 - w * fresnel_dielectric(cos_i, self.coat))
     }
 }
 
@@ -922,7 +939,7 @@ impl Microfacet {
     fn fresnel(&self, cos: f32) -> Vec3 {
         match self.fresnel {
             Fresnel::Conductor { eta, k } => fresnel_conductor_rgb(cos, eta, k),
-            Fresnel::Dielectric(eta) => Vec3::splat(fresnel_dielectric(cos, eta)),
+            Fresnel::Dielectric { eta, tint } => tint * fresnel_dielectric(cos, eta),
         }
     }
 
@@ -1339,6 +1356,7 @@ mod tests {
                     reflectance: Vec3::ONE,
                     eta: 1.5,
                     roughness,
+                    coat_tint: Vec3::ONE,
                     layered: false,
                 };
                 let bsdf = Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &RGB);
@@ -1358,6 +1376,7 @@ mod tests {
                     reflectance: Vec3::ZERO,
                     eta: 1.5,
                     roughness: 0.0,
+                    coat_tint: Vec3::ONE,
                     layered: true,
                 };
                 if theta == 0.0 {
@@ -1385,6 +1404,7 @@ mod tests {
                     reflectance: Vec3::splat(r),
                     eta: 1.5,
                     roughness: 0.0,
+                    coat_tint: Vec3::ONE,
                     layered: true,
                 };
                 let bsdf = Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &RGB);

@@ -340,6 +340,10 @@ pub struct MaterialDesc {
     /// A clear coat over the physical reading (glTF's `KHR_materials_clearcoat`, pbrt-v4's
     /// `coatedconductor`).
     pub clearcoat: Option<ClearCoat>,
+    /// The clear coat's textures, where it has some.
+    pub clearcoat_maps: Option<ClearCoatMaps>,
+    /// The physical lobe's roughness from a texture (pbrt's textured `roughness`).
+    pub roughness_map: Option<RoughnessMap>,
 }
 
 /// A clear dielectric coat over a material: it reflects `weight`·F(θ) (Fresnel of index `eta`,
@@ -353,6 +357,39 @@ pub struct ClearCoat {
     pub eta: f32,
     /// The coat's GGX α (below [`SMOOTH_ALPHA`] a smooth coat).
     pub alpha: f32,
+}
+
+/// A clear coat's textures (glTF's `clearcoatTexture` and `clearcoatRoughnessTexture`), their
+/// factors included: where given, the coat's weight is the first's x channel, and its
+/// roughness the second's y channel (GGX α its square).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ClearCoatMaps<P = Param> {
+    /// The weight.
+    pub weight: Option<P>,
+    /// The roughness.
+    pub roughness: Option<P>,
+}
+
+impl<P> ClearCoatMaps<P> {
+    /// The same with each texture mapped by `f`.
+    pub fn try_map<Q, E>(&self, mut f: impl FnMut(&P) -> Result<Q, E>) -> Result<ClearCoatMaps<Q>, E> {
+        Ok(ClearCoatMaps {
+            weight: self.weight.as_ref().map(&mut f).transpose()?,
+            roughness: self.roughness.as_ref().map(&mut f).transpose()?,
+        })
+    }
+}
+
+/// A roughness read from a texture: at each point the GGX α of the physical reading
+/// (conductor, coated diffuse, rough dielectric) is the texture's x channel, or its square root
+/// with `remap` (pbrt's `remaproughness`); a dielectric smoother than [`SMOOTH_ALPHA`] there is
+/// smooth.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoughnessMap<P = Param> {
+    /// The texture (its x channel).
+    pub texture: P,
+    /// α = √value rather than the value.
+    pub remap: bool,
 }
 
 /// pbrt's `mix` material: at each point the second material with probability `amount` (its
@@ -449,6 +486,10 @@ pub enum PhysicalMaterial<P = Param> {
         eta: f32,
         /// GGX α of the coat; below 1e-3 smooth.
         roughness: f32,
+        /// What the coat reflects, per channel, times its Fresnel reflectance: 1 for a clear coat;
+        /// glTF's specular weight times its specular colour (`KHR_materials_specular`). The base
+        /// under it loses its largest channel's share.
+        coat_tint: P,
         /// Whether the coat's underside sends the base's light back down to it, again and again
         /// (pbrt-v4's layered `coateddiffuse`): the base's albedo r counts as r / (η²(1 − r·F̄ᵢ)),
         /// F̄ᵢ the coat's mean reflectance from inside. Otherwise light crosses the coat once
@@ -504,11 +545,13 @@ impl<P> PhysicalMaterial<P> {
                 reflectance,
                 eta,
                 roughness,
+                coat_tint,
                 layered,
             } => PhysicalMaterial::CoatedDiffuse {
                 reflectance: f(reflectance)?,
                 eta: *eta,
                 roughness: *roughness,
+                coat_tint: f(coat_tint)?,
                 layered: *layered,
             },
             PhysicalMaterial::DiffuseTransmission {
@@ -568,6 +611,12 @@ impl MaterialDesc {
         if let Some(mr) = &self.metallic_roughness {
             let _ = mr.try_map(&mut visit);
         }
+        if let Some(maps) = &self.clearcoat_maps {
+            let _ = maps.try_map(&mut visit);
+        }
+        if let Some(r) = &self.roughness_map {
+            let _ = visit(&r.texture);
+        }
         if let Some(mix) = &self.mix {
             let _ = visit(&mix.amount);
             for m in &mix.materials {
@@ -601,6 +650,8 @@ impl Default for MaterialDesc {
             absorption: None,
             mix: None,
             clearcoat: None,
+            clearcoat_maps: None,
+            roughness_map: None,
         }
     }
 }
@@ -623,6 +674,9 @@ pub struct MetallicRoughness<P = Param> {
     pub roughness: f32,
     /// The dielectric's coat index (`None`: no specular layer).
     pub coat: Option<f32>,
+    /// What that coat reflects per channel, times its Fresnel reflectance
+    /// ([`PhysicalMaterial::CoatedDiffuse`]'s `coat_tint`).
+    pub coat_tint: P,
     /// Solid glass's index and Abbe number, where the material transmits.
     pub glass: Option<(f32, Option<f32>)>,
 }
@@ -636,6 +690,7 @@ impl MetallicRoughness<Param> {
             metallic: self.metallic,
             roughness: self.roughness,
             coat: self.coat,
+            coat_tint: f(&self.coat_tint)?,
             glass: self.glass,
         })
     }

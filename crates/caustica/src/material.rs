@@ -87,6 +87,10 @@ pub struct Material {
     pub mix: Option<Mix>,
     /// A clear coat over the physical reading.
     pub clearcoat: Option<crate::description::ClearCoat>,
+    /// Its textures.
+    pub clearcoat_maps: Option<crate::description::ClearCoatMaps<Channel>>,
+    /// The physical reading's roughness from a texture.
+    pub roughness_map: Option<crate::description::RoughnessMap<Channel>>,
 }
 
 /// A mix of two materials in a built scene: at each point the second with probability
@@ -325,12 +329,27 @@ impl Material {
                     reflectance: base,
                     eta,
                     roughness: alpha,
+                    coat_tint: mr.coat_tint.eval(textures, uv),
                     layered: false,
                 })
             };
         }
         let physical = self.physical.as_ref()?;
-        physical.try_map(|c| Ok::<Vec3, ()>(c.eval(textures, uv))).ok()
+        let mut physical = physical.try_map(|c| Ok::<Vec3, ()>(c.eval(textures, uv))).ok()?;
+        if let Some(map) = &self.roughness_map {
+            let r = map.texture.eval(textures, uv).x.max(0.0);
+            let alpha = if map.remap { r.sqrt() } else { r };
+            match &mut physical {
+                PhysicalMaterial::Conductor { roughness, .. } | PhysicalMaterial::CoatedDiffuse { roughness, .. } => {
+                    *roughness = alpha
+                }
+                // Smooth glass is the course fields' dielectric.
+                PhysicalMaterial::RoughDielectric { .. } if alpha < crate::description::SMOOTH_ALPHA => return None,
+                PhysicalMaterial::RoughDielectric { roughness, .. } => *roughness = alpha,
+                _ => {}
+            }
+        }
+        Some(physical)
     }
 
     /// Whether a caustic can show on it: some `diffuse` or `specular` value may be non-zero.

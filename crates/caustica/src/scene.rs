@@ -524,10 +524,21 @@ impl Scene {
     /// The clear coat over the material at a surface point, if it has one.
     #[inline]
     pub fn clearcoat(&self, hit: &SurfaceHit) -> Option<crate::description::ClearCoat> {
-        match hit.material {
-            MaterialRef::One(id) => self.materials[id as usize].clearcoat,
-            MaterialRef::Blend { .. } => None,
+        let material = match hit.material {
+            MaterialRef::One(id) => &self.materials[id as usize],
+            MaterialRef::Blend { .. } => return None,
+        };
+        let mut coat = material.clearcoat?;
+        if let Some(maps) = &material.clearcoat_maps {
+            if let Some(weight) = &maps.weight {
+                coat.weight = weight.eval(&self.textures, hit.uv).x.clamp(0.0, 1.0);
+            }
+            if let Some(roughness) = &maps.roughness {
+                let r = roughness.eval(&self.textures, hit.uv).y.clamp(0.0, 1.0);
+                coat.alpha = r * r;
+            }
         }
+        Some(coat)
     }
 
     /// Whether some material has a clear coat.

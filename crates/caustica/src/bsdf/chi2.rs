@@ -160,6 +160,7 @@ fn physical_lobes_sample_their_density() {
         reflectance: Vec3::splat(0.7),
         eta: 1.5,
         roughness: 0.3,
+        coat_tint: Vec3::ONE,
         layered: true,
     };
     let translucent = PhysicalMaterial::DiffuseTransmission {

@@ -23,7 +23,7 @@ impl Interface {
         Interface {
             ggx: Microfacet {
                 alpha,
-                fresnel: Fresnel::Dielectric(eta),
+                fresnel: Fresnel::Dielectric { eta, tint: Vec3::ONE },
             },
             eta,
         }

@@ -9,15 +9,15 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    repair_vertex_attributes, Alpha, CameraDesc, ClearCoat, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc,
-    MetallicRoughness, NormalMap, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc,
-    SMOOTH_ALPHA,
+    repair_vertex_attributes, Alpha, CameraDesc, ClearCoat, ClearCoatMaps, EmittingFaces, FovAxis, ImageMap,
+    ImageSource, LightDesc, MaterialDesc, MetallicRoughness, NormalMap, ObjectDesc, Param, PhysicalMaterial,
+    SceneDescription, ShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use crate::error::{Error, ParseError, Result, Span};
 use crate::progress::Progress;
 use crate::texture::{Encoding, Wrap};
 use ::gltf::json;
-use glam::{Affine2, Mat4, Quat, Vec2, Vec3, Vec4};
+use glam::{Affine2, Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use json::validation::{Checked, Validate};
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -763,7 +763,12 @@ impl Reader<'_, '_> {
                 self.warn(&format!("{path}.attributes"), warning);
             }
             let closed = is_closed(&points, &triangles);
-            let material = self.material(primitive.material.map(|m| m.value()), closed, &path)?;
+            let mut material = self.material(primitive.material.map(|m| m.value()), closed, &path)?;
+            // glTF's front is counter-clockwise, clockwise under a transform that swaps
+            // handedness; caustica's is the side of the world winding's normal.
+            if material.emitting_faces == EmittingFaces::Front && Mat3::from_mat4(world).determinant() < 0.0 {
+                material.emitting_faces = EmittingFaces::Back;
+            }
             self.desc.objects.push(ObjectDesc {
                 shape: ShapeDesc::Trimesh(Box::new(TrimeshDesc {
                     points,
@@ -815,13 +820,6 @@ impl Reader<'_, '_> {
                 "KHR_materials_volume.thicknessTexture",
                 "the thickness texture is not read",
             ),
-            (
-                ext.specular
-                    .as_ref()
-                    .is_some_and(|v| v.specular_texture.is_some() || v.specular_color_texture.is_some()),
-                "KHR_materials_specular",
-                "specular textures are not read",
-            ),
         ];
         for (given, at, what) in unread {
             if given {
@@ -833,6 +831,7 @@ impl Reader<'_, '_> {
             }
         }
         let specular = ext.specular.as_ref().map_or(1.0, |s| s.specular_factor.0);
+        let coat_tint = self.coat_tint(&ext, &path, transmission >= 0.5);
         let emissive_strength = ext.emissive_strength.as_ref().map_or(1.0, |e| e.emissive_strength.0);
         let dispersion = ext
             .others
@@ -879,9 +878,6 @@ impl Reader<'_, '_> {
             Some(info) if emissive != Vec3::ZERO => self.texture(info, &format!("{path}.emissiveTexture"), emissive),
             _ => Param::Constant(emissive),
         };
-        if emissive != Vec3::ZERO && !m.double_sided {
-            self.warn_once("onesided", &path, "caustica's emissive surfaces emit from both faces");
-        }
         // Coverage: the base colour's alpha times its texture's alpha channel.
         let cutoff = match m.alpha_mode {
             Checked::Valid(json::material::AlphaMode::Mask) => Some(Some(m.alpha_cutoff.map_or(0.5, |c| c.0))),
@@ -906,9 +902,14 @@ impl Reader<'_, '_> {
             normal_map,
             alpha: cut_outs,
             name: m.name.clone(),
-            clearcoat: self.clearcoat(&ext, &path, transmission >= 0.5),
             ..MaterialDesc::default()
         };
+        // A single-sided material shows its front alone: an emissive one emits from it alone
+        // (which face that is in the world, the node's handedness says: `primitives`).
+        if emissive != Vec3::ZERO && !m.double_sided {
+            desc.emitting_faces = EmittingFaces::Front;
+        }
+        (desc.clearcoat, desc.clearcoat_maps) = self.clearcoat(&ext, &path, transmission >= 0.5);
         if let Some(texture) = mr_texture.clone().filter(|_| !glass_textured) {
             desc.diffuse = base.clone();
             desc.metallic_roughness = Some(MetallicRoughness {
@@ -917,6 +918,7 @@ impl Reader<'_, '_> {
                 metallic,
                 roughness,
                 coat: (specular > 0.0).then_some(ior),
+                coat_tint,
                 glass: None,
             });
             return Ok(desc);
@@ -991,6 +993,7 @@ impl Reader<'_, '_> {
                         metallic,
                         roughness,
                         coat: None,
+                        coat_tint: Param::grey(1.0),
                         glass: Some((ior, desc.abbe)),
                     });
                 } else if alpha >= SMOOTH_ALPHA {
@@ -1023,6 +1026,7 @@ impl Reader<'_, '_> {
                     reflectance: base,
                     eta: ior,
                     roughness: alpha,
+                    coat_tint,
                     layered: false,
                 });
                 let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2) * specular.min(1.0);
@@ -1037,46 +1041,128 @@ impl Reader<'_, '_> {
         Ok(desc)
     }
 
+    /// `KHR_materials_specular` as what a dielectric's coat reflects per channel, times its
+    /// Fresnel reflectance: `specularFactor` times the alpha of `specularTexture`, times
+    /// `specularColorFactor` times `specularColorTexture` (sRGB). The extension tints the
+    /// reflectance at normal incidence (F0) where caustica tints F(θ): the same at normal
+    /// incidence, and a coloured tint stays coloured towards grazing, where the extension's
+    /// tends to white. Metals take no
+    /// specular layer (as the extension says), nor does glass (a warning when the extension
+    /// would change it).
+    fn coat_tint(&mut self, ext: &json::extensions::material::Material, path: &str, glass: bool) -> Param {
+        let Some(s) = ext.specular.as_ref() else {
+            return Param::grey(1.0);
+        };
+        let at = format!("{path}.extensions.KHR_materials_specular");
+        let factor = Vec3::from(s.specular_color_factor.0).max(Vec3::ZERO) * s.specular_factor.0.max(0.0);
+        let textured = s.specular_texture.is_some() || s.specular_color_texture.is_some();
+        if glass {
+            if factor != Vec3::ONE || textured {
+                self.warn_once(
+                    "KHR_materials_specular",
+                    &at,
+                    "a specular layer on glass is not rendered: its index alone sets its reflectance",
+                );
+            }
+            return Param::grey(1.0);
+        }
+        match (&s.specular_texture, &s.specular_color_texture) {
+            (weight, Some(colour)) => {
+                if weight.is_some() {
+                    self.warn_once(
+                        "specularTexture",
+                        &format!("{at}.specularTexture"),
+                        "with a specular colour texture the specular texture is read by its factor",
+                    );
+                }
+                self.texture(colour, &format!("{at}.specularColorTexture"), factor)
+            }
+            (Some(weight), None) => {
+                let wpath = format!("{at}.specularTexture");
+                let transform = weight.extensions.as_ref().and_then(|e| e.texture_transform.as_ref());
+                match self.image_map(weight.index.value(), weight.tex_coord, transform, &wpath) {
+                    // The weight is the texture's alpha, linear.
+                    Some(mut map) => {
+                        map.encoding = Encoding::Coverage;
+                        map.sampler.scale = factor;
+                        Param::Texture(Box::new(map))
+                    }
+                    None => Param::Constant(factor),
+                }
+            }
+            (None, None) => Param::Constant(factor),
+        }
+    }
+
     /// `KHR_materials_clearcoat`: a clear coat of index 1.5 (the extension's), `clearcoatFactor`
-    /// thick and `clearcoatRoughnessFactor` rough (GGX α its square). Its textures are read by
-    /// their factors, and a coat on glass is not rendered (warnings).
+    /// times the red of `clearcoatTexture` thick and `clearcoatRoughnessFactor` times the green
+    /// of `clearcoatRoughnessTexture` rough (GGX α its square), both textures linear. The coat's
+    /// normal texture is not read, and a coat on glass is not rendered (warnings).
     fn clearcoat(
         &mut self,
         ext: &json::extensions::material::Material,
         path: &str,
         transmissive: bool,
-    ) -> Option<ClearCoat> {
-        let coat = ext.others.get("KHR_materials_clearcoat")?;
+    ) -> (Option<ClearCoat>, Option<ClearCoatMaps>) {
+        let Some(coat) = ext.others.get("KHR_materials_clearcoat") else {
+            return (None, None);
+        };
+        let at = format!("{path}.extensions.KHR_materials_clearcoat");
         let number = |name: &str, default: f64| coat.get(name).and_then(|v| v.as_f64()).unwrap_or(default) as f32;
         let weight = number("clearcoatFactor", 0.0).clamp(0.0, 1.0);
         let roughness = number("clearcoatRoughnessFactor", 0.0).clamp(0.0, 1.0);
-        let textured = [
-            "clearcoatTexture",
-            "clearcoatRoughnessTexture",
-            "clearcoatNormalTexture",
-        ]
-        .into_iter()
-        .filter(|t| coat.get(*t).is_some())
-        .collect::<Vec<_>>();
-        if !textured.is_empty() {
+        if weight <= 0.0 {
+            return (None, None);
+        }
+        if coat.get("clearcoatNormalTexture").is_some() {
             self.warn_once(
-                "clearcoattexture",
-                &format!("{path}.extensions.KHR_materials_clearcoat"),
-                format!("{} not read: the factors are used", textured.join(", ")),
+                "clearcoatnormal",
+                &format!("{at}.clearcoatNormalTexture"),
+                "the clear coat's normal texture is not read: the coat follows the base's normal",
             );
         }
-        if weight > 0.0 && transmissive {
+        if transmissive {
             self.warn_once(
                 "clearcoatglass",
-                &format!("{path}.extensions.KHR_materials_clearcoat"),
+                &at,
                 "a clear coat on transmissive glass is not rendered",
             );
         }
-        (weight > 0.0).then_some(ClearCoat {
+        let maps = ClearCoatMaps {
+            weight: self.extension_texture(coat.get("clearcoatTexture"), &format!("{at}.clearcoatTexture"), weight),
+            roughness: self.extension_texture(
+                coat.get("clearcoatRoughnessTexture"),
+                &format!("{at}.clearcoatRoughnessTexture"),
+                roughness,
+            ),
+        };
+        let coat = ClearCoat {
             weight,
             eta: 1.5,
             alpha: roughness * roughness,
-        })
+        };
+        (
+            Some(coat),
+            (maps.weight.is_some() || maps.roughness.is_some()).then_some(maps),
+        )
+    }
+
+    /// A linear data texture named in an extension the glTF crate leaves as JSON (`value`, at
+    /// JSON path `path`), times `factor`; `None` (with a warning when something was given)
+    /// where it cannot be used.
+    fn extension_texture(&mut self, value: Option<&json::Value>, path: &str, factor: f32) -> Option<Param> {
+        let info = match json::deserialize::from_value::<json::texture::Info>(value?.clone()) {
+            Ok(info) if info.index.value() < self.root.textures.len() => info,
+            _ => {
+                self.warn(path, "not a valid texture reference: the factor is used");
+                return None;
+            }
+        };
+        let transform = info.extensions.as_ref().and_then(|e| e.texture_transform.as_ref());
+        let mut map = self.image_map(info.index.value(), info.tex_coord, transform, path)?;
+        map.encoding = Encoding::Linear;
+        map.sampler.scale = Vec3::splat(factor);
+        Some(Param::Texture(Box::new(map)))
     }
 
     /// A colour texture (`info` at JSON path `path`) times `factor`, sRGB-decoded: its image

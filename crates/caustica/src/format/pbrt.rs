@@ -22,7 +22,8 @@ use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
     Alpha, CameraDesc, ClearCoat, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, MixDesc,
-    NormalMap, ObjectDesc, Param, PhysicalMaterial, SceneDescription, ShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    NormalMap, ObjectDesc, Param, PhysicalMaterial, RoughnessMap, SceneDescription, ShapeDesc, TrimeshDesc,
+    SMOOTH_ALPHA,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
@@ -858,6 +859,38 @@ impl<'f> Reader<'f> {
         params.float_or(name, default)
     }
 
+    /// pbrt's roughness from an image texture (`uroughness`, else `roughness`, else
+    /// `vroughness`, each with `prefix`), read at each point by the physical lobe.
+    fn roughness_map(
+        &mut self,
+        params: &Params,
+        span: &Span,
+        prefix: &str,
+    ) -> Result<Option<RoughnessMap>, ParseError> {
+        let mut found = Vec::new();
+        for name in ["uroughness", "roughness", "vroughness"] {
+            if let Some((Spectrum::Texture(t), _)) = params.spectrum(&format!("{prefix}{name}"))? {
+                if let Some(TextureValue::Param(p @ Param::Texture(_))) = self.textures.get(&t) {
+                    found.push(p.clone());
+                }
+            }
+        }
+        let Some(texture) = found.first().cloned() else {
+            return Ok(None);
+        };
+        if found.iter().any(|t| *t != texture) {
+            self.warn_once(
+                "anisotropictexture",
+                "anisotropic roughness textures are read as `uroughness`'s",
+                span.clone(),
+            );
+        }
+        Ok(Some(RoughnessMap {
+            texture,
+            remap: params.bool_or("remaproughness", true)?,
+        }))
+    }
+
     /// GGX α from pbrt's `roughness` (or the mean of `uroughness`/`vroughness`), `default`
     /// when neither is given (0 in pbrt-v4; pbrt-v3's materials have their own).
     fn roughness(&mut self, params: &Params, span: &Span, default: f32) -> Result<f32, ParseError> {
@@ -867,6 +900,12 @@ impl<'f> Reader<'f> {
     /// [`Parser::roughness`] of the parameters named with `prefix` (`coatedconductor`'s
     /// `interface.` and `conductor.`).
     fn roughness_of(&mut self, params: &Params, span: &Span, prefix: &str, default: f32) -> Result<f32, ParseError> {
+        // An image texture is read point by point (`roughness_map`; the coat of a coated
+        // conductor has no such reading): the constant only picks the lobe and the course
+        // model's gloss.
+        if prefix != "interface." && self.roughness_map(params, span, prefix)?.is_some() {
+            return Ok(TEXTURED_ALPHA);
+        }
         let r = self.float_slot(params, &format!("{prefix}roughness"), default)?;
         let u = self.float_slot(params, &format!("{prefix}uroughness"), r)?;
         let v = self.float_slot(params, &format!("{prefix}vroughness"), r)?;
@@ -1003,6 +1042,8 @@ impl<'f> Reader<'f> {
             }
         };
         let mut m = m;
+        let prefix = if kind == "coatedconductor" { "conductor." } else { "" };
+        m.roughness_map = self.roughness_map(params, span, prefix)?;
         if let Some(s) = params.span_of("displacement") {
             let _ = params.spectrum("displacement");
             self.warn("`displacement` is not applied", s);
@@ -1889,6 +1930,11 @@ fn diffuse_transmission(r: Param, t: Param) -> MaterialDesc {
 /// A base of reflectance `base` under a clear coat of index `eta` and GGX α; `layered`: light
 /// reflected inside the coat goes back to the base (pbrt-v4), not out of the picture (pbrt-v3's
 /// plastic and substrate add their lobes).
+/// The GGX α a material with an image texture for its roughness takes where one number is
+/// needed: it makes a dielectric rough (points the texture makes smooth are smooth) and gives
+/// the course model a middling gloss.
+const TEXTURED_ALPHA: f32 = 0.1;
+
 fn coated(base: Param, eta: f32, alpha: f32, layered: bool) -> MaterialDesc {
     let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
     let mut m = diffuse(base.clone());
@@ -1896,6 +1942,7 @@ fn coated(base: Param, eta: f32, alpha: f32, layered: bool) -> MaterialDesc {
         reflectance: base,
         eta,
         roughness: alpha,
+        coat_tint: Param::grey(1.0),
         layered,
     });
     course_gloss(&mut m, Vec3::splat(f0), alpha);

@@ -515,6 +515,17 @@ impl Builder {
                 None => None,
             },
             clearcoat: desc.clearcoat.filter(|c| c.weight > 0.0),
+            clearcoat_maps: match &desc.clearcoat_maps {
+                Some(maps) => Some(maps.try_map(|param| self.channel(param))?),
+                None => None,
+            },
+            roughness_map: match &desc.roughness_map {
+                Some(r) => Some(crate::description::RoughnessMap {
+                    texture: self.channel(&r.texture)?,
+                    remap: r.remap,
+                }),
+                None => None,
+            },
         };
         let key = MaterialKey(
             [
@@ -535,7 +546,7 @@ impl Builder {
             .chain([material.abbe.map_or(0, f32::to_bits)])
             .chain(
                 format!(
-                    "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
+                    "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
                     material.physical,
                     material.normal_map,
                     material.metallic_roughness,
@@ -543,7 +554,9 @@ impl Builder {
                     material.emitting_faces,
                     material.absorption,
                     material.mix,
-                    material.clearcoat
+                    material.clearcoat,
+                    material.clearcoat_maps,
+                    material.roughness_map
                 )
                 .bytes()
                 .map(u32::from),

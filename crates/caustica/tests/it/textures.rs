@@ -299,6 +299,56 @@ fn an_image_that_cannot_be_read_is_a_warning_and_the_factor_stands_in() {
         .any(|w| w.contains("KTX2") && w.contains("texels.ktx2")));
 }
 
+/// pbrt's roughness from a float image texture, read point by point: a conductor's and a
+/// coated diffuse's GGX α is the texel (its square root with `remaproughness`), and a
+/// dielectric is rough where the texel says so and smooth where it is 0.
+#[test]
+fn pbrt_roughness_textures_set_the_lobe_point_by_point() {
+    use caustica::description::PhysicalMaterial;
+    let dir = folder("pbrt-roughness");
+    std::fs::write(dir.join("rough.png"), png(2, 1, &[[0, 0, 0], [128, 128, 128]])).unwrap();
+    let roughness_at = |material: &str, u: f32| {
+        let text = format!(
+            r#"LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+WorldBegin
+LightSource "point" "rgb I" [1 1 1] "point3 from" [0 0 2]
+Texture "r" "float" "imagemap" "string filename" "rough.png" "string filter" "point" "string encoding" "linear"
+Material {material}
+Shape "trianglemesh" "point3 P" [0 0 0 1 0 0 1 1 0 0 1 0] "point2 uv" [0 0 1 0 1 1 0 1] "integer indices" [0 1 2 0 2 3]
+"#
+        );
+        std::fs::write(dir.join("scene.pbrt"), text).unwrap();
+        let scene = load(&dir.join("scene.pbrt"), &LoadSettings::default()).unwrap();
+        assert!(
+            scene.warnings().iter().all(|w| !w.contains("rough")),
+            "{:?}",
+            scene.warnings()
+        );
+        let m = scene
+            .materials()
+            .iter()
+            .find(|m| m.roughness_map.is_some())
+            .expect("a roughness map");
+        match m.physical_at(scene.textures(), Vec2::new(u, 0.5)) {
+            Some(PhysicalMaterial::Conductor { roughness, .. })
+            | Some(PhysicalMaterial::CoatedDiffuse { roughness, .. })
+            | Some(PhysicalMaterial::RoughDielectric { roughness, .. }) => Some(roughness),
+            None => None,
+            other => panic!("{other:?}"),
+        }
+    };
+    let texel = 128.0f32 / 255.0;
+    let conductor = r#""conductor" "texture roughness" "r" "bool remaproughness" false"#;
+    assert_eq!(roughness_at(conductor, 0.25), Some(0.0));
+    assert!((roughness_at(conductor, 0.75).unwrap() - texel).abs() < 1e-6);
+    let remapped = r#""coateddiffuse" "texture uroughness" "r" "texture vroughness" "r""#;
+    assert!((roughness_at(remapped, 0.75).unwrap() - texel.sqrt()).abs() < 1e-6);
+    let glass = r#""dielectric" "texture roughness" "r" "bool remaproughness" false"#;
+    assert_eq!(roughness_at(glass, 0.25), None, "smooth: the course fields' dielectric");
+    assert!((roughness_at(glass, 0.75).unwrap() - texel).abs() < 1e-6);
+}
+
 /// pbrt-v4's `imagemap`: 8-bit images are sRGB unless `encoding` says "linear" or "gamma G";
 /// `uscale`/`udelta` map u, `scale` multiplies, `wrap "black"` is black outside, `filter
 /// "point"` reads the nearest texel.
@@ -492,9 +542,10 @@ fn a_metallic_roughness_texture_decides_metal_and_roughness_point_by_point() {
             reflectance,
             eta,
             roughness,
+            coat_tint,
             layered,
         }) => {
-            assert_eq!((reflectance, eta, layered), (base, 1.5, false));
+            assert_eq!((reflectance, eta, layered, coat_tint), (base, 1.5, false, Vec3::ONE));
             assert!((roughness - alpha(200)).abs() < 1e-6, "{roughness}");
         }
         other => panic!("a dielectric point: {other:?}"),
@@ -589,6 +640,166 @@ fn a_gltf_clear_coat_reflects_the_sky_and_shows_the_base_through_it() {
             "{integrator}: {got} vs {want}"
         );
     }
+}
+
+/// A single-sided emissive glTF material emits from its front alone: the counter-clockwise
+/// face, or the clockwise one under a node that swaps handedness; a double-sided one emits
+/// from both.
+#[test]
+fn single_sided_gltf_emitters_emit_from_their_front() {
+    let dir = folder("one-sided");
+    let image = png(1, 1, &[[255, 255, 255]]);
+    let emits = |double_sided: bool, mirrored: bool| {
+        let material = format!(r#"{{"emissiveFactor":[1,1,1],"doubleSided":{double_sided}}}"#);
+        let path = quad_gltf(&dir, &image, Holder::File, &material, "{}");
+        if mirrored {
+            let json = std::fs::read_to_string(&path).unwrap();
+            std::fs::write(
+                &path,
+                json.replacen(r#"{"mesh":0}"#, r#"{"mesh":0,"scale":[-1,1,1]}"#, 1),
+            )
+            .unwrap();
+        }
+        let scene = load(&path, &LoadSettings::default()).unwrap();
+        let x = if mirrored { -0.5 } else { 0.5 };
+        let ray = caustica::math::Ray::new(Vec3::new(x, 0.5, 1.0), -Vec3::Z);
+        let hit = scene.intersect(&ray, f32::INFINITY).expect("the quad");
+        let surface = scene.surface(&ray, &hit);
+        let rgb = caustica::spectrum::Wavelengths::Rgb;
+        let towards = |d: Vec3| scene.emission_towards(&surface, d, &rgb).x;
+        (towards(Vec3::Z), towards(-Vec3::Z))
+    };
+    assert_eq!(emits(true, false), (1.0, 1.0));
+    assert_eq!(emits(false, false), (1.0, 0.0), "the front is +z, counter-clockwise");
+    assert_eq!(emits(false, true), (1.0, 0.0), "mirrored: +z stays the front");
+}
+
+/// glTF's clear coat textures (linear): the coat's weight is `clearcoatFactor` times the red
+/// of `clearcoatTexture`, its roughness `clearcoatRoughnessFactor` times the green of
+/// `clearcoatRoughnessTexture` (GGX α its square).
+#[test]
+fn gltf_clear_coat_textures_set_the_coat_point_by_point() {
+    let dir = folder("clearcoat-textures");
+    let image = png(2, 1, &[[0, 128, 0], [255, 255, 0]]);
+    let material = r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":1},
+"extensions":{"KHR_materials_clearcoat":{"clearcoatFactor":0.8,"clearcoatTexture":{"index":0},
+"clearcoatRoughnessFactor":0.5,"clearcoatRoughnessTexture":{"index":0}}}}"#;
+    let sampler = r#"{"magFilter":9728,"wrapS":33071,"wrapT":33071}"#;
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, material, sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        scene.warnings().iter().all(|w| !w.contains("clearcoat")),
+        "{:?}",
+        scene.warnings()
+    );
+    let coat_at = |x: f32| {
+        let ray = caustica::math::Ray::new(Vec3::new(x, 0.5, 1.0), -Vec3::Z);
+        let hit = scene.intersect(&ray, f32::INFINITY).expect("the quad");
+        scene.clearcoat(&scene.surface(&ray, &hit)).expect("a coat")
+    };
+    let (left, right) = (coat_at(0.25), coat_at(0.75));
+    assert_eq!((left.weight, right.weight), (0.0, 0.8));
+    let r = 0.5 * 128.0 / 255.0;
+    assert!((left.alpha - r * r).abs() < 1e-6, "{}", left.alpha);
+    assert!((right.alpha - 0.25).abs() < 1e-6, "{}", right.alpha);
+    // A reference that is not a texture is said, and the factor used.
+    let bad = material.replace(r#""clearcoatTexture":{"index":0}"#, r#""clearcoatTexture":{"index":7}"#);
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, &bad, sampler),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        scene
+            .warnings()
+            .iter()
+            .any(|w| w.contains("clearcoatTexture") && w.contains("factor")),
+        "{:?}",
+        scene.warnings()
+    );
+}
+
+/// glTF's `KHR_materials_specular` over a Lambert base: the coat reflects the specular weight
+/// times its colour times F, and the base loses the largest channel's share each way. Under the
+/// uniform sky, a quad seen face-on has radiance c·F(0) + ρ(1 − w·F(0))(1 − w·F̄) per channel,
+/// c the weight times the colour and w its largest channel.
+#[test]
+fn a_gltf_specular_layer_reflects_its_colour_and_weight() {
+    let dir = folder("specular");
+    let image = png(1, 1, &[[255, 255, 255]]);
+    let material = r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":0},
+"extensions":{"KHR_materials_specular":{"specularFactor":0.5,"specularColorFactor":[1,0.5,0.25]}}}"#;
+    let path = quad_gltf(&dir, &image, Holder::File, material, "{}");
+    let scene = load(&path, &LoadSettings::default()).unwrap();
+    assert!(
+        scene.warnings().iter().all(|w| !w.contains("specular")),
+        "{:?}",
+        scene.warnings()
+    );
+    let n = 4096;
+    let mean_f = (0..n)
+        .map(|j| caustica::bsdf::fresnel_dielectric(((j as f32 + 0.5) / n as f32).sqrt(), 1.5))
+        .sum::<f32>()
+        / n as f32;
+    let c = Vec3::new(0.5, 0.25, 0.125);
+    let w = 0.5;
+    let want = c * 0.04 + Vec3::splat(0.5 * (1.0 - w * 0.04) * (1.0 - w * mean_f));
+    for integrator in ["path", "vcm"] {
+        let film = crate::common::render_integrator(&scene, integrator, 16, 32, 10_000, 3);
+        let got = film.region_mean((0, 15), (0, 15));
+        eprintln!("{integrator}: {got}, want {want}");
+        assert!(
+            ((got - want) / want).abs().max_element() < 0.015,
+            "{integrator}: {got} vs {want}"
+        );
+    }
+}
+
+/// `KHR_materials_specular`'s textures: the weight is `specularTexture`'s alpha (linear), the
+/// colour `specularColorTexture` (sRGB), each times its factors.
+#[test]
+fn gltf_specular_textures_set_the_coat_point_by_point() {
+    use caustica::description::PhysicalMaterial;
+    let dir = folder("specular-textures");
+    let rgba = image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba([188, 188, 188, if x == 0 { 51 } else { 255 }]));
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    rgba.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+    let image = bytes.into_inner();
+    let sampler = r#"{"magFilter":9728,"wrapS":10497,"wrapT":10497}"#;
+    let tint_at = |specular: &str, u: f32| {
+        let material = format!(
+            r#"{{"pbrMetallicRoughness":{{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":0.5}},
+"extensions":{{"KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.5,1],{specular}}}}}}}"#
+        );
+        let scene = load(
+            &quad_gltf(&dir, &image, Holder::File, &material, sampler),
+            &LoadSettings::default(),
+        )
+        .unwrap();
+        assert!(
+            scene.warnings().iter().all(|w| !w.contains("specular")),
+            "{:?}",
+            scene.warnings()
+        );
+        let m = scene.materials().iter().find(|m| m.physical.is_some()).unwrap();
+        match m.physical_at(scene.textures(), Vec2::new(u, 0.5)) {
+            Some(PhysicalMaterial::CoatedDiffuse { coat_tint, .. }) => coat_tint,
+            other => panic!("{other:?}"),
+        }
+    };
+    let factor = Vec3::new(0.8, 0.4, 0.8);
+    // The weight: alpha 51/255 = 0.2 on the left, 1 on the right.
+    let left = tint_at(r#""specularTexture":{"index":0}"#, 0.25);
+    let right = tint_at(r#""specularTexture":{"index":0}"#, 0.75);
+    assert!((left - factor * 0.2).abs().max_element() < 1e-4, "{left}");
+    assert!((right - factor).abs().max_element() < 1e-4, "{right}");
+    // The colour: sRGB 188 is 0.5 linear.
+    let colour = tint_at(r#""specularColorTexture":{"index":0}"#, 0.25);
+    let srgb = ((188.0f32 / 255.0 + 0.055) / 1.055).powf(2.4);
+    assert!((colour - factor * srgb).abs().max_element() < 1e-3, "{colour}");
 }
 
 /// glTF's `alphaMode`: MASK cuts holes where the base colour's alpha times its factor is below

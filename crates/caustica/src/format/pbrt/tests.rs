@@ -175,6 +175,7 @@ fn pbrt_v3_materials_are_read() {
             roughness,
             reflectance,
             layered,
+            ..
         }) => {
             assert_eq!((*eta, *reflectance == Param::grey(0.5), *layered), (1.5, true, false));
             assert!((roughness - 0.2).abs() < 1e-6, "remapped √0.04: {roughness}");
