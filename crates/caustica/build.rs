@@ -1,6 +1,7 @@
 //! Tells the tests which parts of `../shared` (the course corpus, the reference renders and the
 //! scenes from the field, beside the repository) are present, so tests that need them are
-//! reported as ignored instead of passing without checking anything.
+//! reported as ignored instead of passing without checking anything; and whether Blender is on
+//! the PATH, for the tests that read what its exporter writes.
 
 use std::path::Path;
 
@@ -9,6 +10,7 @@ fn main() {
     println!("cargo::rustc-check-cfg=cfg(caustica_corpus)");
     println!("cargo::rustc-check-cfg=cfg(caustica_reference)");
     println!("cargo::rustc-check-cfg=cfg(caustica_field)");
+    println!("cargo::rustc-check-cfg=cfg(caustica_blender)");
     if shared.join("scenes/sbt-corpus").is_dir() {
         println!("cargo::rustc-cfg=caustica_corpus");
     }
@@ -18,6 +20,13 @@ fn main() {
     if shared.join("field/pbrt/cornell-box/pbrt/TungstenRender.exr").is_file() {
         println!("cargo::rustc-cfg=caustica_field");
     }
+    let on_path = |name: &str| {
+        std::env::var_os("PATH").is_some_and(|path| std::env::split_paths(&path).any(|dir| dir.join(name).is_file()))
+    };
+    if on_path("blender") {
+        println!("cargo::rustc-cfg=caustica_blender");
+    }
+    println!("cargo::rerun-if-env-changed=PATH");
     // Watching an absent path would rerun this script, and rebuild the crate, on every build;
     // so it reruns only when changed itself (touch it after adding or removing ../shared).
     println!("cargo::rerun-if-changed=build.rs");

@@ -832,6 +832,9 @@ impl Reader<'_, '_> {
         }
         let specular = ext.specular.as_ref().map_or(1.0, |s| s.specular_factor.0);
         let coat_tint = self.coat_tint(&ext, &path, transmission >= 0.5);
+        // No specular layer: a factor of 0, or a colour of black (Blender's exporter writes its
+        // Specular 0 so).
+        let specular = if coat_tint == Param::grey(0.0) { 0.0 } else { specular };
         let emissive_strength = ext.emissive_strength.as_ref().map_or(1.0, |e| e.emissive_strength.0);
         let dispersion = ext
             .others
