@@ -26,8 +26,8 @@ fn main() {
     if on_path("blender") {
         println!("cargo::rustc-cfg=caustica_blender");
     }
-    println!("cargo::rerun-if-env-changed=PATH");
-    // Watching an absent path would rerun this script, and rebuild the crate, on every build;
-    // so it reruns only when changed itself (touch it after adding or removing ../shared).
+    // Watching an absent path (or PATH, which pip's build of the Python module changes) would
+    // rerun this script, and rebuild the crate, on more builds than need it; so it reruns only
+    // when changed itself (touch it after adding or removing ../shared or Blender).
     println!("cargo::rerun-if-changed=build.rs");
 }

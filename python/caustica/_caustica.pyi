@@ -89,6 +89,11 @@ class Scene:
         cone_quirks: bool = False,
         dialect: Literal["tokenizer", "dictionary", "hkust"] | None = None,
     ) -> None: ...
+    @staticmethod
+    def from_dict(description: dict[str, Any]) -> Scene:
+        """A scene described in memory: `camera`, `materials` by name, `shapes` (meshes from
+        numpy arrays, spheres) and `lights`, in radiometric units (docs/python.md, "Scenes from
+        Python"). A key or value that cannot be used raises ValueError or TypeError naming it."""
     def info(self) -> dict[str, Any]:
         """What was read: the same dict as `caustica info --json` prints."""
     @property

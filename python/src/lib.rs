@@ -12,6 +12,7 @@ mod options;
 mod photons;
 mod progressive;
 mod scene;
+mod scene_dict;
 
 use caustica::diagnostic::Diagnostic;
 use caustica::error::Error;

@@ -3,12 +3,13 @@
 use crate::arrays::film_array;
 use crate::options::{self, Options};
 use crate::run_interruptible;
-use caustica::description::RenderHints;
+use caustica::description::{RenderHints, SceneDescription};
 use caustica::format::Format;
 use caustica::integrator::config::thread_pool;
 use caustica::integrator::{image_size, RenderSession};
 use caustica::loader::{load_timed, LoadSettings};
 use caustica::progress::{Control, NoProgress};
+use caustica::scene::build::{build, BuildSettings};
 use caustica::scene::summary::{LoadSeconds, SceneReport};
 use caustica::scene::Scene;
 use caustica::Error;
@@ -16,9 +17,11 @@ use numpy::PyArray3;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use std::fmt::Write;
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
+use std::time::Instant;
 
 /// A scene file read and built once, to render or query many times.
 ///
@@ -50,23 +53,69 @@ impl LoadedScene {
     pub fn load(path: Option<PathBuf>, settings: &LoadSettings) -> caustica::Result<LoadedScene> {
         let loaded = load_timed(path.as_deref(), settings, &NoProgress)?;
         let name = path.map_or_else(|| "<built-in ring scene>".to_string(), |p| p.display().to_string());
-        let summary = loaded.scene.summary();
+        LoadedScene::new(
+            loaded.scene,
+            loaded.scene_id,
+            name,
+            (loaded.parse_seconds, loaded.build_seconds),
+        )
+    }
+
+    /// Builds a scene described in memory (`Scene.from_dict`), read in `read_seconds`.
+    pub fn from_description(desc: SceneDescription, read_seconds: f64) -> caustica::Result<LoadedScene> {
+        let start = Instant::now();
+        // The description's every value, so that parts of one split render merge only with
+        // parts of the same scene.
+        let mut id = Fingerprint::default();
+        let _ = write!(id, "{desc:?}");
+        let scene = build(&desc, &BuildSettings::default())
+            .map_err(|e| Error::InvalidSettings(format!("the scene cannot be built: {}", e.message)))?;
+        let seconds = (read_seconds, start.elapsed().as_secs_f64());
+        LoadedScene::new(
+            scene,
+            format!("dict:{:016x}", id.0),
+            "<scene from a dict>".into(),
+            seconds,
+        )
+    }
+
+    fn new(scene: Scene, scene_id: String, name: String, seconds: (f64, f64)) -> caustica::Result<LoadedScene> {
+        let summary = scene.summary();
         let report = serde_json::to_string(&SceneReport {
             scene: name.clone(),
             summary: &summary,
             seconds: LoadSeconds {
-                parse: loaded.parse_seconds,
-                build: loaded.build_seconds,
+                parse: seconds.0,
+                build: seconds.1,
             },
         })
         .map_err(|e| Error::InvalidSettings(format!("cannot describe the scene: {e}")))?;
         Ok(LoadedScene {
-            scene: loaded.scene,
-            scene_id: loaded.scene_id,
+            scene,
+            scene_id,
             name,
             report,
-            seconds: (loaded.parse_seconds, loaded.build_seconds),
+            seconds,
         })
+    }
+}
+
+/// FNV-1a over text written to it: a stable hash of a description's `Debug` form, without
+/// holding the text.
+struct Fingerprint(u64);
+
+impl Default for Fingerprint {
+    fn default() -> Self {
+        Fingerprint(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl std::fmt::Write for Fingerprint {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        for b in s.bytes() {
+            self.0 = (self.0 ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+        Ok(())
     }
 }
 
@@ -79,6 +128,22 @@ impl PyScene {
         let cancel = Arc::new(AtomicBool::new(false));
         // Loading cannot be cancelled: after Ctrl-C it finishes unseen.
         let loaded = run_interruptible(py, &cancel, false, move || LoadedScene::load(path, &settings))?;
+        Ok(PyScene {
+            loaded: Arc::new(loaded),
+        })
+    }
+
+    /// A scene described in memory: a dict of a `camera`, `materials` by name, `shapes`
+    /// (meshes from numpy arrays, spheres) and `lights`, in radiometric units
+    /// (docs/python.md, "Scenes from Python"). A key or value caustica cannot use raises
+    /// ValueError or TypeError naming it, e.g. `shapes[1].indices[4]: vertex 9 is out of range`.
+    #[staticmethod]
+    fn from_dict(py: Python<'_>, description: &Bound<'_, PyAny>) -> PyResult<PyScene> {
+        let start = Instant::now();
+        let desc = crate::scene_dict::description(description)?;
+        let read = start.elapsed().as_secs_f64();
+        let cancel = Arc::new(AtomicBool::new(false));
+        let loaded = run_interruptible(py, &cancel, false, move || LoadedScene::from_description(desc, read))?;
         Ok(PyScene {
             loaded: Arc::new(loaded),
         })

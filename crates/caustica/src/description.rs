@@ -581,6 +581,61 @@ impl<P> PhysicalMaterial<P> {
 }
 
 impl MaterialDesc {
+    /// A Lambertian reflector of reflectance `reflectance` (both models).
+    pub fn lambert(reflectance: Param) -> MaterialDesc {
+        MaterialDesc {
+            diffuse: reflectance,
+            ..MaterialDesc::default()
+        }
+    }
+
+    /// A base of reflectance `base` under a clear coat of index `eta` and GGX α; `layered`:
+    /// light reflected inside the coat goes back to the base (pbrt-v4), not out of the picture
+    /// (pbrt-v3's plastic and substrate add their lobes).
+    pub fn coated(base: Param, eta: f32, alpha: f32, layered: bool) -> MaterialDesc {
+        let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
+        let mut m = MaterialDesc::lambert(base.clone());
+        m.physical = Some(PhysicalMaterial::CoatedDiffuse {
+            reflectance: base,
+            eta,
+            roughness: alpha,
+            coat_tint: Param::grey(1.0),
+            layered,
+        });
+        m.course_gloss(Vec3::splat(f0), alpha);
+        m
+    }
+
+    /// A smooth mirror of reflectance `r` (pbrt's `conductor` with `reflectance`, v3's `mirror`).
+    pub fn mirror(r: Param) -> MaterialDesc {
+        let f0 = match &r {
+            Param::Constant(c) => *c,
+            _ => Vec3::splat(0.8),
+        };
+        let mut m = MaterialDesc {
+            physical: Some(PhysicalMaterial::Conductor {
+                eta: Vec3::ONE,
+                k: Vec3::ZERO,
+                reflectance: Some(r),
+                roughness: 0.0,
+            }),
+            ..MaterialDesc::default()
+        };
+        m.course_gloss(f0, 0.0);
+        m
+    }
+
+    /// The course reading of a glossy lobe of normal reflectance `f0` and GGX α: a mirror when
+    /// smooth, else a Phong highlight of exponent 2/α² − 2 (the Beckmann–Phong correspondence).
+    pub fn course_gloss(&mut self, f0: Vec3, alpha: f32) {
+        if alpha < 1e-3 {
+            self.reflective = Param::Constant(f0);
+        } else {
+            self.specular = Param::Constant(f0);
+            self.shininess = Param::grey((2.0 / (alpha * alpha) - 2.0).clamp(1.0, 10_000.0));
+        }
+    }
+
     /// Every image map the material reads (colours, physical lobes, cut-outs, normal map).
     pub fn image_maps(&self) -> Vec<ImageMap> {
         let mut maps = Vec::new();

@@ -127,7 +127,7 @@ impl<'f> Reader<'f> {
         let lexer = Lexer::new(text, 0);
         let state = GraphicsState {
             ctm: Mat4::IDENTITY,
-            material: CurrentMaterial::Desc(Box::new(diffuse(Param::grey(0.5)))),
+            material: CurrentMaterial::Desc(Box::new(MaterialDesc::lambert(Param::grey(0.5)))),
             area_light: None,
             reverse_orientation: false,
         };
@@ -922,7 +922,7 @@ impl<'f> Reader<'f> {
 
     fn material(&mut self, kind: &str, params: &Params, span: &Span) -> Result<CurrentMaterial, ParseError> {
         let m = match kind {
-            "diffuse" => diffuse(self.colour(params, "reflectance", Vec3::splat(0.5))?),
+            "diffuse" => MaterialDesc::lambert(self.colour(params, "reflectance", Vec3::splat(0.5))?),
             "dielectric" | "thindielectric" | "glass" => {
                 // pbrt-v3 glass may give its index as `index`.
                 let (index, abbe) = if kind == "glass" && params.has("index") && !params.has("eta") {
@@ -965,7 +965,7 @@ impl<'f> Reader<'f> {
                     physical: Some(physical),
                     ..MaterialDesc::default()
                 };
-                course_gloss(&mut m, f0, alpha);
+                m.course_gloss(f0, alpha);
                 m
             }
             "coatedconductor" => {
@@ -989,14 +989,14 @@ impl<'f> Reader<'f> {
                     }),
                     ..MaterialDesc::default()
                 };
-                course_gloss(&mut m, f0, alpha);
+                m.course_gloss(f0, alpha);
                 m
             }
             "coateddiffuse" => {
                 let base = self.colour(params, "reflectance", Vec3::splat(0.5))?;
                 let alpha = self.roughness(params, span, 0.0)?;
                 let eta = self.float_slot(params, "eta", 1.5)?.max(1.0);
-                coated(base, eta, alpha, true)
+                MaterialDesc::coated(base, eta, alpha, true)
             }
             "matte" | "plastic" | "substrate" | "mirror" | "uber" | "translucent" => {
                 self.v3_material(kind, params, span)?
@@ -1038,7 +1038,7 @@ impl<'f> Reader<'f> {
                     format!("the {other} material is not supported: grey diffuse instead"),
                     span.clone(),
                 );
-                diffuse(Param::grey(0.5))
+                MaterialDesc::lambert(Param::grey(0.5))
             }
         };
         let mut m = m;
@@ -1080,7 +1080,7 @@ impl<'f> Reader<'f> {
                         span.clone(),
                     );
                 }
-                diffuse(self.colour(params, "Kd", Vec3::splat(0.5))?)
+                MaterialDesc::lambert(self.colour(params, "Kd", Vec3::splat(0.5))?)
             }
             // Lambert under a highlight: a diffuse base under a clear coat of index 1.5 (the
             // index pbrt-v3's plastic gives its Fresnel term); without Ks, the base alone.
@@ -1089,14 +1089,14 @@ impl<'f> Reader<'f> {
                 let ks = self.colour(params, "Ks", Vec3::splat(0.25))?;
                 let alpha = self.roughness(params, span, 0.1)?;
                 if ks == Param::grey(0.0) {
-                    diffuse(base)
+                    MaterialDesc::lambert(base)
                 } else {
                     self.warn_once(
                         "plastic",
                         "plastic is read as a diffuse base under a clear coat of index 1.5: Ks does not scale its highlight",
                         span.clone(),
                     );
-                    coated(base, 1.5, alpha, false)
+                    MaterialDesc::coated(base, 1.5, alpha, false)
                 }
             }
             // Ashikhmin–Shirley: a base under a coat whose normal reflectance is Ks.
@@ -1110,11 +1110,11 @@ impl<'f> Reader<'f> {
                     }
                 };
                 let alpha = self.roughness(params, span, 0.1)?;
-                coated(base, (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()), alpha, false)
+                MaterialDesc::coated(base, (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()), alpha, false)
             }
             "mirror" => {
                 let kr = self.colour(params, "Kr", Vec3::splat(0.9))?;
-                mirror(kr)
+                MaterialDesc::mirror(kr)
             }
             // Its main lobe: glass where it transmits, a mirror where it only reflects, else a
             // coated base; `opacity` below one lets rays through.
@@ -1137,11 +1137,11 @@ impl<'f> Reader<'f> {
                         ..MaterialDesc::default()
                     }
                 } else if kr != black && kd == black {
-                    mirror(kr)
+                    MaterialDesc::mirror(kr)
                 } else if ks == black {
-                    diffuse(kd)
+                    MaterialDesc::lambert(kd)
                 } else {
-                    coated(kd, index.max(1.0), alpha, false)
+                    MaterialDesc::coated(kd, index.max(1.0), alpha, false)
                 };
                 self.warn_once(
                     "uber",
@@ -1905,13 +1905,6 @@ fn luminance(c: Vec3) -> f32 {
     0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
 }
 
-fn diffuse(reflectance: Param) -> MaterialDesc {
-    MaterialDesc {
-        diffuse: reflectance,
-        ..MaterialDesc::default()
-    }
-}
-
 /// Lambert reflection `r` and Lambert transmission `t` (the course model's `diffuse` and
 /// `transmissive` at index 1).
 fn diffuse_transmission(r: Param, t: Param) -> MaterialDesc {
@@ -1927,62 +1920,15 @@ fn diffuse_transmission(r: Param, t: Param) -> MaterialDesc {
     }
 }
 
-/// A base of reflectance `base` under a clear coat of index `eta` and GGX α; `layered`: light
-/// reflected inside the coat goes back to the base (pbrt-v4), not out of the picture (pbrt-v3's
-/// plastic and substrate add their lobes).
 /// The GGX α a material with an image texture for its roughness takes where one number is
 /// needed: it makes a dielectric rough (points the texture makes smooth are smooth) and gives
 /// the course model a middling gloss.
 const TEXTURED_ALPHA: f32 = 0.1;
 
-fn coated(base: Param, eta: f32, alpha: f32, layered: bool) -> MaterialDesc {
-    let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
-    let mut m = diffuse(base.clone());
-    m.physical = Some(PhysicalMaterial::CoatedDiffuse {
-        reflectance: base,
-        eta,
-        roughness: alpha,
-        coat_tint: Param::grey(1.0),
-        layered,
-    });
-    course_gloss(&mut m, Vec3::splat(f0), alpha);
-    m
-}
-
-/// A smooth mirror of reflectance `r` (pbrt's `conductor` with `reflectance`, v3's `mirror`).
-fn mirror(r: Param) -> MaterialDesc {
-    let f0 = match &r {
-        Param::Constant(c) => *c,
-        _ => Vec3::splat(0.8),
-    };
-    let mut m = MaterialDesc {
-        physical: Some(PhysicalMaterial::Conductor {
-            eta: Vec3::ONE,
-            k: Vec3::ZERO,
-            reflectance: Some(r),
-            roughness: 0.0,
-        }),
-        ..MaterialDesc::default()
-    };
-    course_gloss(&mut m, f0, 0.0);
-    m
-}
-
 fn scaled(p: Param, s: f32) -> Param {
     match p {
         Param::Constant(c) => Param::Constant(c * s),
         other => other,
-    }
-}
-
-/// The course reading of a glossy lobe of normal reflectance `f0` and GGX α: a mirror when
-/// smooth, else a Phong highlight of exponent 2/α² − 2 (the Beckmann–Phong correspondence).
-fn course_gloss(m: &mut MaterialDesc, f0: Vec3, alpha: f32) {
-    if alpha < 1e-3 {
-        m.reflective = Param::Constant(f0);
-    } else {
-        m.specular = Param::Constant(f0);
-        m.shininess = Param::grey((2.0 / (alpha * alpha) - 2.0).clamp(1.0, 10_000.0));
     }
 }
 
