@@ -4,7 +4,7 @@
 
 use caustica::description::{
     CameraDesc, EmittingFaces, FovAxis, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial, RenderHints,
-    SceneDescription, ShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use caustica::math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use numpy::{PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -569,6 +569,12 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
         "spot" => {
             let outer = t.float("angle", 45.0)?;
             let inner = t.float("inner_angle", outer)?;
+            let exponent = t.float("exponent", 0.0)?;
+            if exponent < 0.0 {
+                return Err(at
+                    .key("exponent")
+                    .error(format!("a falloff exponent is not negative, not {exponent}")));
+            }
             if !(0.0..=90.0).contains(&outer) || !(0.0..=outer).contains(&inner) {
                 return Err(at.error(format!(
                     "0 ≤ inner_angle ≤ angle ≤ 90 (degrees from the axis), not {inner} and {outer}"
@@ -581,7 +587,7 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
                 attenuation: [0.0, 0.0, 1.0],
                 inner_degrees: inner,
                 outer_degrees: outer,
-                exponent: 0.0,
+                exponent,
                 span,
             }
         }
@@ -598,6 +604,18 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
                 _ => LightDesc::Directional { direction, color, span },
             }
         }
+        "area" => {
+            let (corner, u, v) = (t.required_vec3("corner")?, t.required_vec3("u")?, t.required_vec3("v")?);
+            if u.cross(v).length_squared() == 0.0 {
+                return Err(at.error("the edges `u` and `v` span no area"));
+            }
+            LightDesc::Soft {
+                shape: SoftShapeDesc::Parallelogram { corner, u, v },
+                color: t.colour("radiance", Vec3::ONE)?,
+                attenuation: [0.0, 0.0, 1.0],
+                span,
+            }
+        }
         "environment" => LightDesc::Environment {
             color: t.colour("radiance", Vec3::ONE)?,
             map: t.string("file")?.map(Into::into),
@@ -607,7 +625,7 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
         },
         other => {
             return Err(at.key("type").error(format!(
-                "\"point\", \"spot\", \"sun\" or \"environment\", not \"{other}\""
+                "\"point\", \"spot\", \"sun\", \"area\" or \"environment\", not \"{other}\""
             )))
         }
     };

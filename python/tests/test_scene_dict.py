@@ -78,6 +78,11 @@ def test_the_scene_reports_what_it_holds():
         (lambda d: d["shapes"][0].update(positions=np.zeros((4, 2))), ValueError, "shapes[0].positions: expected an array of shape (n, 3)"),
         (lambda d: d["shapes"][0].update(positions=np.full((4, 3), np.nan)), ValueError, "shapes[0].positions[0]: not finite"),
         (lambda d: d["lights"][0].update(type="laser"), ValueError, "lights[0].type"),
+        (
+            lambda d: d["lights"].append({"type": "area", "corner": [0, 3, 0], "u": [1, 0, 0], "v": [2, 0, 0]}),
+            ValueError,
+            "lights[1]: the edges `u` and `v` span no area",
+        ),
         (lambda d: d["camera"].update(fov="wide"), TypeError, "camera.fov: expected a number"),
     ],
 )

@@ -1,0 +1,293 @@
+"""The evaluated Blender scene as the dict `caustica.Scene.from_dict` reads: meshes (modifiers
+applied, split normals, UVs) per material, the camera, lights in Blender's units, the world's
+colour, and materials read from their node trees. What cannot be read is said in `warnings`.
+"""
+
+import math
+
+import numpy as np
+
+
+class Conversion:
+    def __init__(self, depsgraph, width, height):
+        self.depsgraph = depsgraph
+        self.scene = depsgraph.scene_eval
+        self.width, self.height = width, height
+        self.warnings = []
+        self.materials = {}
+        self.shapes = []
+        self.lights = []
+
+    def warn(self, message):
+        if message not in self.warnings:
+            self.warnings.append(message)
+
+    def run(self):
+        for instance in self.depsgraph.object_instances:
+            obj = instance.object
+            matrix = np.array(instance.matrix_world, dtype=np.float64)
+            if obj.type == "MESH":
+                self.mesh(obj, matrix)
+            elif obj.type == "LIGHT":
+                self.light(obj.data, matrix)
+        description = {
+            "camera": self.camera(),
+            "materials": self.materials,
+            "shapes": self.shapes,
+            "lights": self.lights + self.world(),
+        }
+        return description
+
+    # ---- the camera -------------------------------------------------------------------------
+
+    def camera(self):
+        cam_obj = self.scene.camera
+        if cam_obj is None:
+            raise ValueError("the scene has no camera")
+        cam = cam_obj.data
+        if cam.type != "PERSP":
+            self.warn(f"camera {cam_obj.name}: only perspective cameras are rendered")
+        if cam.shift_x != 0.0 or cam.shift_y != 0.0:
+            self.warn(f"camera {cam_obj.name}: lens shift is not applied")
+        w, h = self.width, self.height
+        # The field of view of the sensor's fitted side, turned into the vertical one.
+        fit = cam.sensor_fit
+        if fit == "AUTO":
+            fit = "HORIZONTAL" if w >= h else "VERTICAL"
+        sensor = cam.sensor_height if cam.sensor_fit == "VERTICAL" else cam.sensor_width
+        half = math.atan(0.5 * sensor / cam.lens)
+        if fit == "HORIZONTAL":
+            half = math.atan(math.tan(half) * h / w)
+        return {
+            "matrix": np.array(cam_obj.matrix_world, dtype=np.float64),
+            "fov": math.degrees(2.0 * half),
+            "fov_axis": "vertical",
+            "width": w,
+            "height": h,
+        }
+
+    # ---- meshes -----------------------------------------------------------------------------
+
+    def mesh(self, obj, matrix):
+        mesh = obj.to_mesh()
+        try:
+            mesh.calc_loop_triangles()
+            if hasattr(mesh, "calc_normals_split"):
+                mesh.calc_normals_split()
+            n_tris = len(mesh.loop_triangles)
+            if n_tris == 0:
+                return
+            tri_loops = np.empty(n_tris * 3, dtype=np.int32)
+            mesh.loop_triangles.foreach_get("loops", tri_loops)
+            tri_material = np.empty(n_tris, dtype=np.int32)
+            mesh.loop_triangles.foreach_get("material_index", tri_material)
+            n_loops = len(mesh.loops)
+            loop_vertex = np.empty(n_loops, dtype=np.int32)
+            mesh.loops.foreach_get("vertex_index", loop_vertex)
+            loop_normal = np.empty(n_loops * 3, dtype=np.float32)
+            mesh.loops.foreach_get("normal", loop_normal)
+            co = np.empty(len(mesh.vertices) * 3, dtype=np.float32)
+            mesh.vertices.foreach_get("co", co)
+            positions = co.reshape(-1, 3)[loop_vertex[tri_loops]]
+            normals = loop_normal.reshape(-1, 3)[tri_loops]
+            uvs = None
+            if mesh.uv_layers.active is not None:
+                uv = np.empty(n_loops * 2, dtype=np.float32)
+                mesh.uv_layers.active.data.foreach_get("uv", uv)
+                uvs = uv.reshape(-1, 2)[tri_loops]
+            slots = [s.material for s in obj.material_slots] or [None]
+            for index in np.unique(tri_material):
+                material = slots[min(index, len(slots) - 1)]
+                name = self.material(material)
+                picked = np.nonzero(tri_material == index)[0]
+                corners = (picked[:, None] * 3 + np.arange(3)[None, :]).ravel()
+                shape = {
+                    "type": "mesh",
+                    "positions": positions[corners],
+                    "normals": normals[corners],
+                    "indices": np.arange(len(corners), dtype=np.int64).reshape(-1, 3),
+                    "matrix": matrix,
+                    "material": name,
+                }
+                if uvs is not None:
+                    shape["uvs"] = uvs[corners]
+                self.shapes.append(shape)
+        finally:
+            obj.to_mesh_clear()
+
+    # ---- materials --------------------------------------------------------------------------
+
+    def material(self, material):
+        name = material.name if material is not None else "(none)"
+        if name in self.materials:
+            return name
+        if material is None or not material.use_nodes or material.node_tree is None:
+            colour = list(material.diffuse_color[:3]) if material is not None else [0.8, 0.8, 0.8]
+            self.materials[name] = {"type": "diffuse", "reflectance": colour}
+            return name
+        output = next(
+            (n for n in material.node_tree.nodes if n.type == "OUTPUT_MATERIAL" and n.is_active_output),
+            None,
+        )
+        link = output.inputs["Surface"].links[0] if output and output.inputs["Surface"].is_linked else None
+        node = link.from_node if link else None
+        self.materials[name] = self.shader(node, name)
+        return name
+
+    def value(self, socket, material, what):
+        """A socket's value; a linked one (a texture) is read by its default, with a warning."""
+        if socket.is_linked:
+            self.warn(f"material {material}: {what} from a node link is read by its value (textures are not yet converted)")
+        v = socket.default_value
+        try:
+            return list(v)[:3]
+        except TypeError:
+            return float(v)
+
+    def shader(self, node, material):
+        if node is None:
+            return {"type": "diffuse", "reflectance": 0.0}
+        kind = node.type
+        if kind == "BSDF_PRINCIPLED":
+            i = node.inputs
+            base = self.value(i["Base Color"], material, "the base colour")
+            metallic = self.value(i["Metallic"], material, "metallic")
+            roughness = self.value(i["Roughness"], material, "roughness")
+            transmission = self.value(i["Transmission"], material, "transmission")
+            ior = max(1.0, self.value(i["IOR"], material, "the IOR"))
+            specular = self.value(i["Specular"], material, "specular")
+            alpha = roughness * roughness
+            if i["Alpha"].is_linked or i["Alpha"].default_value < 1.0:
+                self.warn(f"material {material}: alpha is not rendered")
+            if metallic >= 0.5:
+                out = {"type": "conductor", "reflectance": base, "alpha": alpha}
+            elif transmission >= 0.5:
+                out = {"type": "glass", "ior": ior, "alpha": alpha, "tint": base}
+            elif specular > 0.0:
+                # Blender's Specular 0.5 is F0 4%, the reflectance of index 1.5.
+                f0 = min(0.99, 0.08 * specular)
+                out = {
+                    "type": "coated",
+                    "reflectance": base,
+                    "ior": (1 + math.sqrt(f0)) / (1 - math.sqrt(f0)),
+                    "alpha": alpha,
+                }
+            else:
+                out = {"type": "diffuse", "reflectance": base}
+            strength = self.value(i["Emission Strength"], material, "emission strength")
+            emission = np.array(self.value(i["Emission"], material, "emission")) * strength
+            if emission.max() > 0.0:
+                out["emission"] = list(emission)
+                out["two_sided"] = True
+            return out
+        if kind == "BSDF_DIFFUSE":
+            return {"type": "diffuse", "reflectance": self.value(node.inputs["Color"], material, "the colour")}
+        if kind == "BSDF_GLOSSY":
+            r = self.value(node.inputs["Roughness"], material, "roughness")
+            return {"type": "conductor", "reflectance": self.value(node.inputs["Color"], material, "the colour"), "alpha": r * r}
+        if kind in {"BSDF_GLASS", "BSDF_REFRACTION"}:
+            r = self.value(node.inputs["Roughness"], material, "roughness")
+            return {
+                "type": "glass",
+                "ior": max(1.0, self.value(node.inputs["IOR"], material, "the IOR")),
+                "alpha": r * r,
+                "tint": self.value(node.inputs["Color"], material, "the colour"),
+            }
+        if kind == "EMISSION":
+            colour = np.array(self.value(node.inputs["Color"], material, "the colour"))
+            strength = self.value(node.inputs["Strength"], material, "the strength")
+            return {"type": "diffuse", "reflectance": 0.0, "emission": list(colour * strength), "two_sided": True}
+        self.warn(f"material {material}: the {node.name} node ({kind}) is not read: grey diffuse instead")
+        return {"type": "diffuse", "reflectance": 0.5}
+
+    # ---- lights -----------------------------------------------------------------------------
+
+    def light(self, light, matrix):
+        colour = np.array(light.color[:3], dtype=np.float64)
+        position = matrix[:3, 3]
+        # Blender's lights shine down their local −z.
+        direction = matrix[:3, :3] @ np.array([0.0, 0.0, -1.0])
+        if light.type in {"POINT", "SPOT"}:
+            if light.shadow_soft_size > 0.0:
+                self.warn(f"light {light.name}: its radius is not rendered (a point light)")
+            # A point light of P watts has intensity P/(4π) W/sr (Cycles', and the glTF exporter's).
+            intensity = list(colour * light.energy / (4.0 * math.pi))
+            if light.type == "POINT":
+                self.lights.append({"type": "point", "position": position, "intensity": intensity})
+            else:
+                outer = math.degrees(light.spot_size) / 2.0
+                # Cycles fades a spot smoothly (in the cosine) over the blend's share of the
+                # cosines between its edge and its axis, as caustica fades from the inner cone.
+                cos_outer = math.cos(math.radians(outer))
+                inner = math.degrees(math.acos(min(1.0, cos_outer + (1.0 - cos_outer) * light.spot_blend)))
+                self.lights.append(
+                    {
+                        "type": "spot",
+                        "position": position,
+                        "direction": direction,
+                        "intensity": intensity,
+                        "angle": outer,
+                        "inner_angle": min(inner, outer),
+                        # Cycles' spots fade as the cosine from their axis.
+                        "exponent": 1.0,
+                    }
+                )
+        elif light.type == "SUN":
+            self.lights.append(
+                {
+                    "type": "sun",
+                    "direction": direction,
+                    "irradiance": list(colour * light.energy),
+                    "angle": math.degrees(light.angle),
+                }
+            )
+        elif light.type == "AREA":
+            self.area_light(light, matrix, colour)
+        else:
+            self.warn(f"light {light.name}: {light.type} lights are not rendered")
+
+    def area_light(self, light, matrix, colour):
+        sx = light.size
+        sy = light.size_y if light.shape in {"RECTANGLE", "ELLIPSE"} else light.size
+        area = sx * sy
+        if light.shape in {"DISK", "ELLIPSE"}:
+            # A rectangle of the same area and proportions: the same light, differently shaped
+            # at close range.
+            area = math.pi * 0.25 * sx * sy
+            sx, sy = sx * math.sqrt(math.pi) / 2.0, sy * math.sqrt(math.pi) / 2.0
+            self.warn(f"light {light.name}: a {light.shape.lower()} is rendered as a rectangle of its area")
+        m = matrix[:3, :3]
+        # Lit down its −z: u × v points there. Cycles gives an area light of P watts the radiance
+        # P/(4A) (measured: scripts/race/blender_lights.py).
+        self.lights.append(
+            {
+                "type": "area",
+                "corner": matrix[:3, 3] + m @ np.array([-sx / 2.0, -sy / 2.0, 0.0]),
+                "u": m @ np.array([0.0, sy, 0.0]),
+                "v": m @ np.array([sx, 0.0, 0.0]),
+                "radiance": list(colour * light.energy / (4.0 * area)),
+            }
+        )
+
+    def world(self):
+        world = self.scene.world
+        if world is None:
+            return []
+        colour, strength = np.array(world.color[:3]), 1.0
+        if world.use_nodes and world.node_tree is not None:
+            output = next((n for n in world.node_tree.nodes if n.type == "OUTPUT_WORLD" and n.is_active_output), None)
+            link = output.inputs["Surface"].links[0] if output and output.inputs["Surface"].is_linked else None
+            node = link.from_node if link else None
+            if node is None:
+                return []
+            if node.type != "BACKGROUND":
+                self.warn(f"world: the {node.name} node is not read: no world light")
+                return []
+            if node.inputs["Color"].is_linked:
+                self.warn("world: an environment texture is not yet converted: its colour's value is used")
+            colour = np.array(node.inputs["Color"].default_value[:3])
+            strength = node.inputs["Strength"].default_value
+        radiance = colour * strength
+        if radiance.max() <= 0.0:
+            return []
+        return [{"type": "environment", "radiance": list(radiance)}]

@@ -1,0 +1,104 @@
+"""The Blender add-on (`blender/caustica_blender`), run in Blender headless: F12 on a floor
+under a point light, a sun and a square area light renders the floor's analytic radiance in
+Blender's units (a point light of P watts has intensity P/(4π) W/sr, a sun of S W/m² that
+irradiance, an area light of P watts and area A the radiance P/(4A), as Cycles has them:
+scripts/race/blender_lights.py compares them with Cycles). Skipped without `blender` on the
+PATH."""
+import json
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import caustica
+
+BLENDER = shutil.which("blender")
+ROOT = Path(__file__).resolve().parents[2]
+
+SCRIPT = r"""
+import json, math, sys
+import bpy
+sys.path.insert(0, ADDONS)
+import caustica_blender
+caustica_blender.register()
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+bpy.ops.mesh.primitive_plane_add(size=20.0)
+floor = bpy.data.materials.new("Floor")
+floor.use_nodes = True
+bsdf = floor.node_tree.nodes["Principled BSDF"]
+bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
+bsdf.inputs["Specular"].default_value = 0.0
+bpy.context.object.data.materials.append(floor)
+cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+cam.location = (0.0, 0.0, 6.0)
+scene.collection.objects.link(cam)
+scene.camera = cam
+scene.render.engine = "CAUSTICA"
+scene.caustica.integrator = "PATH"
+scene.caustica.time_limit = 0.0
+scene.caustica.passes = 4
+scene.render.resolution_x, scene.render.resolution_y = 40, 30
+scene.render.resolution_percentage = 100
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+def lamp(kind, **props):
+    for o in [o for o in scene.objects if o.type == "LIGHT"]:
+        bpy.data.objects.remove(o)
+    light = bpy.data.lights.new(kind, type=kind)
+    for k, v in props.items():
+        setattr(light, k, v)
+    obj = bpy.data.objects.new(kind, light)
+    obj.location = (0.0, 0.0, 3.0)
+    scene.collection.objects.link(obj)
+    return obj
+for name, kind, props in [
+    ("point", "POINT", dict(energy=1000.0, shadow_soft_size=0.0)),
+    ("sun", "SUN", dict(energy=3.0, angle=0.0)),
+    ("area", "AREA", dict(energy=500.0, shape="SQUARE", size=1.0)),
+]:
+    obj = lamp(kind, **props)
+    if kind == "SUN":
+        obj.rotation_euler = (math.radians(30.0), 0.0, 0.0)
+    scene.render.filepath = OUT + name + ".exr"
+    bpy.ops.render.render(write_still=True)
+json.dump({"engine": scene.render.engine}, open(OUT + ".json", "w"))
+"""
+
+
+@pytest.mark.skipif(BLENDER is None, reason="blender is not on the PATH")
+def test_f12_renders_the_floor_under_each_light_as_blender_means_it(tmp_path):
+    out = str(tmp_path / "floor-")
+    script = tmp_path / "scene.py"
+    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + SCRIPT)
+    env = dict(os.environ)
+    # Blender's own Python finds the caustica package where this test imports it from.
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(caustica.__file__).parents[1]), env.get("PYTHONPATH", "")])
+    done = subprocess.run(
+        [BLENDER, "-b", "--factory-startup", "--python-use-system-env", "--python-exit-code", "1", "-P", str(script)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert json.load(open(out + ".json"))["engine"] == "CAUSTICA"
+    rho = 0.5
+    # Straight under the point light, 3 m below it: E = (1000/4π)/3².
+    point = 1000.0 / (4.0 * np.pi) / 9.0
+    # The sun 30° from the zenith: E = 3 cos 30°.
+    sun = 3.0 * np.cos(np.radians(30.0))
+    # Under the middle of a 1 m square of radiance L = 500/4, 3 m up: four corner rectangles of
+    # ½ m, each E = L/2 · (A/√(1+A²) atan(B/√(1+A²)) + B/√(1+B²) atan(A/√(1+B²))), A = B = ½/3.
+    a = 0.5 / 3.0
+    corner = 0.5 * 2.0 * a / np.sqrt(1.0 + a * a) * np.arctan(a / np.sqrt(1.0 + a * a))
+    area = 500.0 / 4.0 * 4.0 * corner
+    for name, irradiance in [("point", point), ("sun", sun), ("area", area)]:
+        image = caustica.read_exr(out + name + ".exr")
+        assert image.shape == (30, 40, 3)
+        want = rho / np.pi * irradiance
+        centre = image[14:16, 19:21].mean(axis=(0, 1))
+        assert np.allclose(centre, want, rtol=0.01), (name, centre, want)
