@@ -4,7 +4,10 @@ colour, and materials read from their node trees. What cannot be read is said in
 """
 
 import math
+import os
+import tempfile
 
+import bpy
 import numpy as np
 
 
@@ -131,13 +134,76 @@ class Conversion:
         )
         link = output.inputs["Surface"].links[0] if output and output.inputs["Surface"].is_linked else None
         node = link.from_node if link else None
-        self.materials[name] = self.shader(node, name)
+        shader = self.shader(node, name)
+        if node is not None:
+            normal_map = self.normal_map(node, name)
+            if normal_map is not None:
+                shader["normal_map"] = normal_map
+        self.materials[name] = shader
         return name
 
-    def value(self, socket, material, what):
-        """A socket's value; a linked one (a texture) is read by its default, with a warning."""
+    def image_file(self, image):
+        """A file holding `image`: its own, or a copy of its packed bytes."""
+        if image.packed_file is not None:
+            suffix = {"PNG": ".png", "JPEG": ".jpg", "OPEN_EXR": ".exr", "HDR": ".hdr", "TARGA": ".tga"}.get(
+                image.file_format, ".png"
+            )
+            path = os.path.join(self.temp_dir(), f"{len(os.listdir(self.temp_dir()))}{suffix}")
+            with open(path, "wb") as f:
+                f.write(image.packed_file.data)
+            return path
+        path = bpy.path.abspath(image.filepath, library=image.library)
+        return path if os.path.isfile(path) else None
+
+    def temp_dir(self):
+        if not hasattr(self, "_temp"):
+            self._temp = tempfile.mkdtemp(prefix="caustica-blender-")
+        return self._temp
+
+    def texture(self, socket, material, what):
+        """The image texture linked straight into `socket`, as the dict reads it; None (with a
+        warning) for any other link."""
+        node = socket.links[0].from_node
+        if node.type == "TEX_IMAGE" and node.image is not None and not node.inputs["Vector"].is_linked:
+            path = self.image_file(node.image)
+            if path is None:
+                self.warn(f"material {material}: the image {node.image.name} of {what} has no file")
+                return None
+            linear = node.image.colorspace_settings.name in {"Non-Color", "Linear", "Raw"}
+            return {
+                "file": path,
+                "encoding": "linear" if linear else "srgb",
+                "filter": "nearest" if node.interpolation == "Closest" else "linear",
+                "wrap": {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat"),
+            }
+        self.warn(f"material {material}: {what} from the {node.name} node is read by the input's own value")
+        return None
+
+    def colour(self, socket, material, what):
+        """A colour input: an image texture straight into it, else its value."""
         if socket.is_linked:
-            self.warn(f"material {material}: {what} from a node link is read by its value (textures are not yet converted)")
+            t = self.texture(socket, material, what)
+            if t is not None:
+                return t
+        return list(socket.default_value)[:3]
+
+    def normal_map(self, node, material):
+        """The tangent-space normal map behind a shader's Normal input, if there is one."""
+        normal = node.inputs.get("Normal")
+        if normal is None or not normal.is_linked:
+            return None
+        n = normal.links[0].from_node
+        if n.type == "NORMAL_MAP" and n.space == "TANGENT" and n.inputs["Color"].is_linked:
+            t = self.texture(n.inputs["Color"], material, "the normal map")
+            if t is not None:
+                return {"file": t["file"], "strength": n.inputs["Strength"].default_value}
+        self.warn(f"material {material}: the {n.name} node on the normal is not read")
+        return None
+
+    def value(self, socket, material, what):
+        """A number input's value; a linked one is read by its own value, with a warning."""
+        if socket.is_linked:
+            self.warn(f"material {material}: {what} from a node link is read by the input's own value")
         v = socket.default_value
         try:
             return list(v)[:3]
@@ -150,7 +216,7 @@ class Conversion:
         kind = node.type
         if kind == "BSDF_PRINCIPLED":
             i = node.inputs
-            base = self.value(i["Base Color"], material, "the base colour")
+            base = self.colour(i["Base Color"], material, "the base colour")
             metallic = self.value(i["Metallic"], material, "metallic")
             roughness = self.value(i["Roughness"], material, "roughness")
             transmission = self.value(i["Transmission"], material, "transmission")
@@ -181,17 +247,17 @@ class Conversion:
                 out["two_sided"] = True
             return out
         if kind == "BSDF_DIFFUSE":
-            return {"type": "diffuse", "reflectance": self.value(node.inputs["Color"], material, "the colour")}
+            return {"type": "diffuse", "reflectance": self.colour(node.inputs["Color"], material, "the colour")}
         if kind == "BSDF_GLOSSY":
             r = self.value(node.inputs["Roughness"], material, "roughness")
-            return {"type": "conductor", "reflectance": self.value(node.inputs["Color"], material, "the colour"), "alpha": r * r}
+            return {"type": "conductor", "reflectance": self.colour(node.inputs["Color"], material, "the colour"), "alpha": r * r}
         if kind in {"BSDF_GLASS", "BSDF_REFRACTION"}:
             r = self.value(node.inputs["Roughness"], material, "roughness")
             return {
                 "type": "glass",
                 "ior": max(1.0, self.value(node.inputs["IOR"], material, "the IOR")),
                 "alpha": r * r,
-                "tint": self.value(node.inputs["Color"], material, "the colour"),
+                "tint": self.colour(node.inputs["Color"], material, "the colour"),
             }
         if kind == "EMISSION":
             colour = np.array(self.value(node.inputs["Color"], material, "the colour"))

@@ -3,15 +3,17 @@
 //! (docs/python.md, "Scenes from Python"). Errors name the key and the index at fault.
 
 use caustica::description::{
-    CameraDesc, EmittingFaces, FovAxis, LightDesc, MaterialDesc, ObjectDesc, Param, PhysicalMaterial, RenderHints,
-    SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    CameraDesc, EmittingFaces, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, NormalMap, ObjectDesc, Param,
+    PhysicalMaterial, RenderHints, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use caustica::math::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use caustica::texture::{Encoding, Wrap};
 use numpy::{PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::collections::HashMap;
+use std::path::PathBuf;
 
 /// A key's place in the dict, for messages: `shapes[2].indices`.
 #[derive(Clone)]
@@ -88,6 +90,17 @@ impl<'py> Table<'py> {
         }
     }
 
+    /// A colour that may be a texture: a number, three, or an image (`image_map`).
+    fn param(&mut self, key: &str, default: Vec3) -> PyResult<Param> {
+        match self.get(key)? {
+            Some(v) if v.cast::<PyDict>().is_ok() => {
+                image_map(&v, self.at.key(key), Encoding::Srgb).map(|m| Param::Texture(Box::new(m)))
+            }
+            Some(v) => colour(&v, &self.at.key(key)).map(Param::Constant),
+            None => Ok(Param::Constant(default)),
+        }
+    }
+
     fn vec3(&mut self, key: &str) -> PyResult<Option<Vec3>> {
         match self.get(key)? {
             Some(v) => vec3(&v, &self.at.key(key)).map(Some),
@@ -156,6 +169,54 @@ fn vec3(value: &Bound<'_, PyAny>, at: &At) -> PyResult<Vec3> {
         [x, y, z] => Ok(Vec3::new(*x as f32, *y as f32, *z as f32)),
         other => Err(at.error(format!("expected three numbers, not {}", other.len()))),
     }
+}
+
+/// An image from a file: `{"file": path, "encoding": "srgb" | "linear", "scale": colour,
+/// "wrap": "repeat" | "clamp" | "mirror", "filter": "linear" | "nearest"}`; the encoding
+/// defaults to `encoding` (sRGB for colours), wrap to repeat, filter to linear.
+fn image_map(value: &Bound<'_, PyAny>, at: At, encoding: Encoding) -> PyResult<ImageMap> {
+    let mut t = Table::new(value, at.clone())?;
+    let file: PathBuf = t
+        .string("file")?
+        .ok_or_else(|| at.key("file").error("required (an image file: PNG, JPEG, EXR, HDR, …)"))?
+        .into();
+    if !file.is_file() {
+        return Err(at.key("file").error(format!("no file `{}`", file.display())));
+    }
+    let mut map = ImageMap::colour(ImageSource::File(file), 0..0);
+    map.encoding = match t.string("encoding")?.as_deref() {
+        None => encoding,
+        Some("srgb") => Encoding::Srgb,
+        Some("linear") => Encoding::Linear,
+        Some(other) => {
+            return Err(at
+                .key("encoding")
+                .error(format!("\"srgb\" or \"linear\", not \"{other}\"")))
+        }
+    };
+    map.sampler.scale = t.colour("scale", Vec3::ONE)?;
+    let wrap = match t.string("wrap")?.as_deref() {
+        None | Some("repeat") => Wrap::Repeat,
+        Some("clamp") => Wrap::Clamp,
+        Some("mirror") => Wrap::Mirror,
+        Some(other) => {
+            return Err(at
+                .key("wrap")
+                .error(format!("\"repeat\", \"clamp\" or \"mirror\", not \"{other}\"")))
+        }
+    };
+    map.sampler.wrap = [wrap; 2];
+    map.sampler.nearest = match t.string("filter")?.as_deref() {
+        None | Some("linear") => false,
+        Some("nearest") => true,
+        Some(other) => {
+            return Err(at
+                .key("filter")
+                .error(format!("\"linear\" or \"nearest\", not \"{other}\"")))
+        }
+    };
+    t.done()?;
+    Ok(map)
 }
 
 /// An array of shape (n, `columns`), as float32 (anything numpy turns into numbers).
@@ -337,16 +398,16 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         Ok(n)
     };
     let mut m = match kind.as_str() {
-        "diffuse" => MaterialDesc::lambert(Param::Constant(t.colour("reflectance", Vec3::splat(0.5))?)),
+        "diffuse" => MaterialDesc::lambert(t.param("reflectance", Vec3::splat(0.5))?),
         "glass" => {
             let (eta, alpha) = (ior(&mut t)?, alpha(&mut t)?);
-            let tint = t.colour("tint", Vec3::ONE)?;
+            let tint = t.param("tint", Vec3::ONE)?;
             let abbe = match t.float("abbe", 0.0)? {
                 v if v > 0.0 => Some(v),
                 _ => None,
             };
             let mut m = MaterialDesc {
-                transmissive: Param::Constant(tint),
+                transmissive: tint.clone(),
                 index: Param::grey(eta),
                 abbe,
                 absorption: t
@@ -358,7 +419,7 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
                 m.physical = Some(PhysicalMaterial::RoughDielectric {
                     eta,
                     roughness: alpha,
-                    tint: Param::Constant(tint),
+                    tint,
                     abbe,
                 });
             }
@@ -366,20 +427,20 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         }
         "thin_glass" => {
             let eta = ior(&mut t)?;
-            let tint = t.colour("tint", Vec3::ONE)?;
+            let tint = t.param("tint", Vec3::ONE)?;
             MaterialDesc {
-                transmissive: Param::Constant(tint),
+                transmissive: tint.clone(),
                 index: Param::grey(1.0),
-                physical: Some(PhysicalMaterial::ThinDielectric {
-                    eta,
-                    tint: Param::Constant(tint),
-                }),
+                physical: Some(PhysicalMaterial::ThinDielectric { eta, tint }),
                 ..MaterialDesc::default()
             }
         }
         "conductor" => {
             let alpha = alpha(&mut t)?;
-            let reflectance = t.vec3("reflectance")?;
+            let reflectance = match t.get("reflectance")? {
+                Some(_) => Some(t.param("reflectance", Vec3::ONE)?),
+                None => None,
+            };
             let (eta, k) = (t.vec3("eta")?, t.vec3("k")?);
             let (eta, k, reflectance) = match (reflectance, eta, k) {
                 (Some(r), None, None) => (Vec3::ONE, Vec3::ZERO, Some(r)),
@@ -388,15 +449,19 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
                     return Err(at.error("a conductor has `reflectance`, or `eta` and `k` (each three numbers)"));
                 }
             };
-            let f0 = reflectance.unwrap_or_else(|| {
-                let (n, k2) = (eta, k * k);
-                ((n - Vec3::ONE) * (n - Vec3::ONE) + k2) / ((n + Vec3::ONE) * (n + Vec3::ONE) + k2)
-            });
+            let f0 = match &reflectance {
+                Some(Param::Constant(r)) => *r,
+                Some(_) => Vec3::splat(0.8),
+                None => {
+                    let (n, k2) = (eta, k * k);
+                    ((n - Vec3::ONE) * (n - Vec3::ONE) + k2) / ((n + Vec3::ONE) * (n + Vec3::ONE) + k2)
+                }
+            };
             let mut m = MaterialDesc {
                 physical: Some(PhysicalMaterial::Conductor {
                     eta,
                     k,
-                    reflectance: reflectance.map(Param::Constant),
+                    reflectance,
                     roughness: alpha,
                 }),
                 ..MaterialDesc::default()
@@ -405,9 +470,9 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
             m
         }
         "coated" => {
-            let base = t.colour("reflectance", Vec3::splat(0.5))?;
+            let base = t.param("reflectance", Vec3::splat(0.5))?;
             let (eta, alpha) = (ior(&mut t)?, alpha(&mut t)?);
-            MaterialDesc::coated(Param::Constant(base), eta, alpha, true)
+            MaterialDesc::coated(base, eta, alpha, true)
         }
         other => {
             return Err(at.key("type").error(format!(
@@ -415,15 +480,27 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
             )))
         }
     };
-    let emission = t.colour("emission", Vec3::ZERO)?;
-    if emission.min_element() < 0.0 {
+    let emission = t.param("emission", Vec3::ZERO)?;
+    if matches!(emission, Param::Constant(e) if e.min_element() < 0.0) {
         return Err(at.key("emission").error("a radiance is not negative"));
     }
-    if emission != Vec3::ZERO {
-        m.emissive = Param::Constant(emission);
+    if emission != Param::grey(0.0) {
+        m.emissive = emission;
         if !t.flag("two_sided", false)? {
             m.emitting_faces = EmittingFaces::Front;
         }
+    }
+    if let Some(n) = t.get("normal_map")? {
+        let at = at.key("normal_map");
+        let mut nt = Table::new(&n, at.clone())?;
+        let scale = nt.float("strength", 1.0)?;
+        let file = nt.get("file")?.ok_or_else(|| at.key("file").error("required"))?;
+        nt.done()?;
+        let spec = PyDict::new(n.py());
+        spec.set_item("file", file)?;
+        // Tangent-space normals are data: linear.
+        let map = image_map(&spec, at.clone(), Encoding::Linear)?;
+        m.normal_map = Some(NormalMap { map, scale });
     }
     t.done()?;
     Ok(m)

@@ -92,3 +92,75 @@ def test_errors_name_the_key_and_the_index(change, error, words):
     with pytest.raises(error) as e:
         caustica.Scene.from_dict(d)
     assert words in str(e.value)
+
+
+def png(path, rgb_rows):
+    """An 8-bit RGB PNG of `rgb_rows` (rows from the top), written with zlib alone."""
+    import struct
+    import zlib
+
+    h, w = len(rgb_rows), len(rgb_rows[0])
+    raw = b"".join(b"\0" + bytes(c for px in row for c in px) for row in rgb_rows)
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF)
+
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+        + chunk(b"IDAT", zlib.compress(raw))
+        + chunk(b"IEND", b"")
+    )
+
+
+def test_textures_from_files_render_as_the_same_pbrt_imagemap(tmp_path):
+    png(tmp_path / "tex.png", [[(200, 30, 30), (30, 30, 200)]])
+    pbrt = tmp_path / "quad.pbrt"
+    pbrt.write_text(
+        """LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" 40
+Film "rgb" "integer xresolution" 24 "integer yresolution" 24
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+Texture "t" "spectrum" "imagemap" "string filename" "tex.png" "string filter" "point"
+Material "diffuse" "texture reflectance" "t"
+Shape "trianglemesh" "point3 P" [-1 -1 0 1 -1 0 1 1 0 -1 1 0] "point2 uv" [0 0 1 0 1 1 0 1] "integer indices" [0 1 2 0 2 3]
+"""
+    )
+    scene = caustica.Scene.from_dict(
+        {
+            "camera": {
+                "matrix": np.array([[-1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 3], [0, 0, 0, 1]]),
+                "fov": 40,
+                "fov_axis": "shorter",
+                "width": 24,
+                "height": 24,
+            },
+            "materials": {"tex": {"type": "diffuse", "reflectance": {"file": str(tmp_path / "tex.png"), "filter": "nearest"}}},
+            "shapes": [
+                {
+                    "type": "mesh",
+                    "positions": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]],
+                    "uvs": [[0, 0], [1, 0], [1, 1], [0, 1]],
+                    "indices": [[0, 1, 2], [0, 2, 3]],
+                    "material": "tex",
+                }
+            ],
+            "lights": [{"type": "environment", "radiance": 1}],
+        }
+    )
+    options = dict(integrator="path", passes=2, seed=1, threads=1)
+    from_dict = caustica.render(scene, **options)
+    np.testing.assert_array_equal(from_dict, caustica.render(str(pbrt), **options))
+    # The image's left texel (sRGB 200, 30, 30) on the left of the picture: the camera's right
+    # is −x here, so the quad's u = 0 edge is on the picture's right.
+    right, left = from_dict[12, 20], from_dict[12, 3]
+    assert right[0] > right[2] and left[2] > left[0], (left, right)
+
+
+def test_a_missing_texture_file_is_named():
+    d = description()
+    d["materials"]["floor"]["reflectance"] = {"file": "/no/such/image.png"}
+    with pytest.raises(ValueError) as e:
+        caustica.Scene.from_dict(d)
+    assert "materials.floor.reflectance.file: no file `/no/such/image.png`" in str(e.value)
