@@ -3,6 +3,7 @@
 The add-on turns the evaluated scene (modifiers applied) into a `caustica.Scene` through
 `caustica.Scene.from_dict` and renders it pass by pass, the image in Blender's editor after each
 pass. It needs the `caustica` Python package importable from Blender's Python (docs/blender.md).
+Its unit rules (`rules.py`) import nothing of Blender's, so they are tested outside it.
 """
 
 bl_info = {
@@ -15,19 +16,12 @@ bl_info = {
     "category": "Render",
 }
 
-if "bpy" in locals():
-    import importlib
-
-    importlib.reload(settings)  # noqa: F821 (a reload inside Blender)
-    importlib.reload(convert)  # noqa: F821
-    importlib.reload(engine)  # noqa: F821
-else:
-    from . import convert, engine, settings
-
-import bpy
-
 
 def register():
+    import bpy
+
+    from . import engine, settings
+
     settings.register()
     bpy.utils.register_class(engine.CausticaRenderEngine)
     for panel in engine.compatible_panels():
@@ -35,6 +29,10 @@ def register():
 
 
 def unregister():
+    import bpy
+
+    from . import engine, settings
+
     for panel in engine.compatible_panels():
         panel.COMPAT_ENGINES.discard(engine.CausticaRenderEngine.bl_idname)
     bpy.utils.unregister_class(engine.CausticaRenderEngine)

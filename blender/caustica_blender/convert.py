@@ -10,6 +10,8 @@ import tempfile
 import bpy
 import numpy as np
 
+from . import rules
+
 
 class Conversion:
     def __init__(self, depsgraph, width, height):
@@ -52,21 +54,13 @@ class Conversion:
             self.warn(f"camera {cam_obj.name}: only perspective cameras are rendered")
         if cam.shift_x != 0.0 or cam.shift_y != 0.0:
             self.warn(f"camera {cam_obj.name}: lens shift is not applied")
-        w, h = self.width, self.height
-        # The field of view of the sensor's fitted side, turned into the vertical one.
-        fit = cam.sensor_fit
-        if fit == "AUTO":
-            fit = "HORIZONTAL" if w >= h else "VERTICAL"
-        sensor = cam.sensor_height if cam.sensor_fit == "VERTICAL" else cam.sensor_width
-        half = math.atan(0.5 * sensor / cam.lens)
-        if fit == "HORIZONTAL":
-            half = math.atan(math.tan(half) * h / w)
+        fov = rules.vertical_fov(cam.sensor_fit, cam.sensor_width, cam.sensor_height, cam.lens, self.width, self.height)
         return {
             "matrix": np.array(cam_obj.matrix_world, dtype=np.float64),
-            "fov": math.degrees(2.0 * half),
+            "fov": fov,
             "fov_axis": "vertical",
-            "width": w,
-            "height": h,
+            "width": self.width,
+            "height": self.height,
         }
 
     # ---- meshes -----------------------------------------------------------------------------
@@ -220,26 +214,11 @@ class Conversion:
             metallic = self.value(i["Metallic"], material, "metallic")
             roughness = self.value(i["Roughness"], material, "roughness")
             transmission = self.value(i["Transmission"], material, "transmission")
-            ior = max(1.0, self.value(i["IOR"], material, "the IOR"))
+            ior = self.value(i["IOR"], material, "the IOR")
             specular = self.value(i["Specular"], material, "specular")
-            alpha = roughness * roughness
             if i["Alpha"].is_linked or i["Alpha"].default_value < 1.0:
                 self.warn(f"material {material}: alpha is not rendered")
-            if metallic >= 0.5:
-                out = {"type": "conductor", "reflectance": base, "alpha": alpha}
-            elif transmission >= 0.5:
-                out = {"type": "glass", "ior": ior, "alpha": alpha, "tint": base}
-            elif specular > 0.0:
-                # Blender's Specular 0.5 is F0 4%, the reflectance of index 1.5.
-                f0 = min(0.99, 0.08 * specular)
-                out = {
-                    "type": "coated",
-                    "reflectance": base,
-                    "ior": (1 + math.sqrt(f0)) / (1 - math.sqrt(f0)),
-                    "alpha": alpha,
-                }
-            else:
-                out = {"type": "diffuse", "reflectance": base}
+            out = rules.principled(base, metallic, roughness, transmission, ior, specular)
             strength = self.value(i["Emission Strength"], material, "emission strength")
             emission = np.array(self.value(i["Emission"], material, "emission")) * strength
             if emission.max() > 0.0:
@@ -276,16 +255,11 @@ class Conversion:
         if light.type in {"POINT", "SPOT"}:
             if light.shadow_soft_size > 0.0:
                 self.warn(f"light {light.name}: its radius is not rendered (a point light)")
-            # A point light of P watts has intensity P/(4π) W/sr (Cycles', and the glTF exporter's).
-            intensity = list(colour * light.energy / (4.0 * math.pi))
+            intensity = list(colour * rules.point_intensity(light.energy))
             if light.type == "POINT":
                 self.lights.append({"type": "point", "position": position, "intensity": intensity})
             else:
-                outer = math.degrees(light.spot_size) / 2.0
-                # Cycles fades a spot smoothly (in the cosine) over the blend's share of the
-                # cosines between its edge and its axis, as caustica fades from the inner cone.
-                cos_outer = math.cos(math.radians(outer))
-                inner = math.degrees(math.acos(min(1.0, cos_outer + (1.0 - cos_outer) * light.spot_blend)))
+                outer, inner = rules.spot_cone(light.spot_size, light.spot_blend)
                 self.lights.append(
                     {
                         "type": "spot",
@@ -293,7 +267,7 @@ class Conversion:
                         "direction": direction,
                         "intensity": intensity,
                         "angle": outer,
-                        "inner_angle": min(inner, outer),
+                        "inner_angle": inner,
                         # Cycles' spots fade as the cosine from their axis.
                         "exponent": 1.0,
                     }
@@ -323,15 +297,14 @@ class Conversion:
             sx, sy = sx * math.sqrt(math.pi) / 2.0, sy * math.sqrt(math.pi) / 2.0
             self.warn(f"light {light.name}: a {light.shape.lower()} is rendered as a rectangle of its area")
         m = matrix[:3, :3]
-        # Lit down its −z: u × v points there. Cycles gives an area light of P watts the radiance
-        # P/(4A) (measured: scripts/race/blender_lights.py).
+        # Lit down its −z: u × v points there.
         self.lights.append(
             {
                 "type": "area",
                 "corner": matrix[:3, 3] + m @ np.array([-sx / 2.0, -sy / 2.0, 0.0]),
                 "u": m @ np.array([0.0, sy, 0.0]),
                 "v": m @ np.array([sx, 0.0, 0.0]),
-                "radiance": list(colour * light.energy / (4.0 * area)),
+                "radiance": list(colour * rules.area_radiance(light.energy, area)),
             }
         )
 

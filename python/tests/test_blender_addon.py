@@ -5,6 +5,7 @@ irradiance, an area light of P watts and area A the radiance P/(4A), as Cycles h
 scripts/race/blender_lights.py compares them with Cycles). Skipped without `blender` on the
 PATH."""
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -102,3 +103,159 @@ def test_f12_renders_the_floor_under_each_light_as_blender_means_it(tmp_path):
         want = rho / np.pi * irradiance
         centre = image[14:16, 19:21].mean(axis=(0, 1))
         assert np.allclose(centre, want, rtol=0.01), (name, centre, want)
+
+
+GLASS = r"""
+import math, sys
+import bpy
+sys.path.insert(0, ADDONS)
+import caustica_blender
+caustica_blender.register()
+
+
+def build(glass_node):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    bpy.ops.mesh.primitive_plane_add(size=20.0)
+    floor = bpy.data.materials.new("Floor")
+    floor.use_nodes = True
+    bsdf = floor.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
+    bsdf.inputs["Specular"].default_value = 0.0
+    bpy.context.object.data.materials.append(floor)
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0, location=(0.0, 0.0, 1.5))
+    bpy.ops.object.shade_smooth()
+    glass = bpy.data.materials.new("Glass")
+    glass.use_nodes = True
+    nodes = glass.node_tree.nodes
+    if glass_node:
+        nodes.remove(nodes["Principled BSDF"])
+        g = nodes.new("ShaderNodeBsdfGlass")
+        g.inputs["IOR"].default_value = 1.5
+        g.inputs["Roughness"].default_value = 0.0
+        glass.node_tree.links.new(g.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
+    else:
+        p = nodes["Principled BSDF"]
+        p.inputs["Transmission"].default_value = 1.0
+        p.inputs["IOR"].default_value = 1.5
+        p.inputs["Roughness"].default_value = 0.0
+        p.inputs["Base Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    bpy.context.object.data.materials.append(glass)
+    light = bpy.data.lights.new("Lamp", type="POINT")
+    light.energy = 2000.0
+    light.shadow_soft_size = 0.0
+    lamp = bpy.data.objects.new("Lamp", light)
+    lamp.location = (0.0, 0.0, 6.0)
+    scene.collection.objects.link(lamp)
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.location = (0.0, -7.0, 6.0)
+    cam.rotation_euler = (math.radians(45.0), 0.0, 0.0)
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+    scene.render.engine = "CAUSTICA"
+    scene.caustica.integrator = "VCM"
+    scene.caustica.time_limit = 0.0
+    scene.caustica.passes = 32
+    scene.render.resolution_x, scene.render.resolution_y = 64, 48
+    scene.render.resolution_percentage = 100
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    return scene
+
+
+for name, glass_node in [("glass-node", True), ("principled", False)]:
+    scene = build(glass_node)
+    scene.render.filepath = OUT + name + ".exr"
+    bpy.ops.render.render(write_still=True)
+# The Principled scene as Blender's exporter writes it, for caustica to read as a file.
+bpy.ops.export_scene.gltf(filepath=OUT + "scene.glb", export_format="GLB", export_cameras=True, export_lights=True)
+
+# A checker (sRGB 200 and 50) on a plane under a sun 30° from the zenith, seen from straight above.
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+image = bpy.data.images.new("checker", width=2, height=2)
+image.pixels = [200 / 255, 200 / 255, 200 / 255, 1, 50 / 255, 50 / 255, 50 / 255, 1,
+                50 / 255, 50 / 255, 50 / 255, 1, 200 / 255, 200 / 255, 200 / 255, 1]
+image.filepath_raw = OUT + "checker.png"
+image.file_format = "PNG"
+image.save()
+bpy.ops.mesh.primitive_plane_add(size=2.0)
+m = bpy.data.materials.new("Checker")
+m.use_nodes = True
+p = m.node_tree.nodes["Principled BSDF"]
+p.inputs["Specular"].default_value = 0.0
+t = m.node_tree.nodes.new("ShaderNodeTexImage")
+t.image = image
+t.interpolation = "Closest"
+m.node_tree.links.new(t.outputs["Color"], p.inputs["Base Color"])
+bpy.context.object.data.materials.append(m)
+sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", type="SUN"))
+sun.data.energy = 3.0
+sun.data.angle = 0.0
+sun.rotation_euler = (math.radians(30.0), 0.0, 0.0)
+scene.collection.objects.link(sun)
+cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+cam.location = (0.0, 0.0, 3.0)
+scene.collection.objects.link(cam)
+scene.camera = cam
+scene.render.engine = "CAUSTICA"
+scene.caustica.integrator = "PATH"
+scene.caustica.time_limit = 0.0
+scene.caustica.passes = 2
+scene.render.resolution_x, scene.render.resolution_y = 40, 40
+scene.render.resolution_percentage = 100
+scene.render.image_settings.file_format = "OPEN_EXR"
+scene.render.image_settings.color_depth = "32"
+scene.render.filepath = OUT + "checker.exr"
+bpy.ops.render.render(write_still=True)
+"""
+
+
+def run_blender(tmp_path, script_text):
+    out = str(tmp_path / "r-")
+    script = tmp_path / "scene.py"
+    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + script_text)
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(Path(caustica.__file__).parents[1]), env.get("PYTHONPATH", "")])
+    done = subprocess.run(
+        [BLENDER, "-b", "--factory-startup", "--python-use-system-env", "--python-exit-code", "1", "-P", str(script)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    return out
+
+
+@pytest.mark.skipif(BLENDER is None, reason="blender is not on the PATH")
+def test_a_glass_ball_built_in_blender_renders_as_its_gltf_export_and_a_textured_plane_as_its_closed_form(tmp_path):
+    out = run_blender(tmp_path, GLASS)
+    node = caustica.read_exr(out + "glass-node.exr")
+    principled = caustica.read_exr(out + "principled.exr")
+    # The Glass BSDF and Principled glass of the same index read alike: the same pixels, but for
+    # float rounding (the scene is built again in Blender for each).
+    np.testing.assert_allclose(node, principled, rtol=1e-4, atol=1e-6)
+    # The same scene exported by Blender and read by caustica as a file.
+    from_file = caustica.render(out + "scene.glb", integrator="vcm", passes=32, width=64, height=48)
+    for name, (r0, r1, c0, c1) in {
+        "caustic": (15, 20, 28, 36),
+        "floor": (36, 48, 0, 64),
+        "ball": (0, 9, 24, 40),
+    }.items():
+        a = principled[r0:r1, c0:c1].mean()
+        b = from_file[r0:r1, c0:c1].mean()
+        assert a == pytest.approx(b, rel=0.05), (name, a, b)
+    # The checker under the sun: radiance ρ/π · 3 cos 30°, ρ the texel's sRGB decoded.
+    checker = caustica.read_exr(out + "checker.exr")
+
+    def srgb(v):
+        c = v / 255.0
+        return ((c + 0.055) / 1.055) ** 2.4
+
+    e = 3.0 * math.cos(math.radians(30.0))
+    # Blender's first pixel row is the image's bottom: (0, 0) bright, (1, 0) dark; seen from
+    # above with +y up in the picture, the bottom-left quarter is bright.
+    quarters = {"bottom-left": checker[30:36, 4:10], "bottom-right": checker[30:36, 30:36]}
+    assert quarters["bottom-left"].mean() == pytest.approx(srgb(200) / math.pi * e, rel=0.01)
+    assert quarters["bottom-right"].mean() == pytest.approx(srgb(50) / math.pi * e, rel=0.01)
