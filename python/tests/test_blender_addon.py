@@ -70,11 +70,10 @@ json.dump({"engine": scene.render.engine}, open(OUT + ".json", "w"))
 """
 
 
-@pytest.mark.skipif(BLENDER is None, reason="blender is not on the PATH")
-def test_f12_renders_the_floor_under_each_light_as_blender_means_it(tmp_path):
-    out = str(tmp_path / "floor-")
+def run_blender(tmp_path, script_text):
+    out = str(tmp_path / "r-")
     script = tmp_path / "scene.py"
-    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + SCRIPT)
+    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + script_text)
     env = dict(os.environ)
     # Blender's own Python finds the caustica package where this test imports it from.
     env["PYTHONPATH"] = os.pathsep.join([str(Path(caustica.__file__).parents[1]), env.get("PYTHONPATH", "")])
@@ -86,6 +85,12 @@ def test_f12_renders_the_floor_under_each_light_as_blender_means_it(tmp_path):
         timeout=300,
     )
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    return out
+
+
+@pytest.mark.skipif(BLENDER is None, reason="blender is not on the PATH")
+def test_f12_renders_the_floor_under_each_light_as_blender_means_it(tmp_path):
+    out = run_blender(tmp_path, SCRIPT)
     assert json.load(open(out + ".json"))["engine"] == "CAUSTICA"
     rho = 0.5
     # Straight under the point light, 3 m below it: E = (1000/4π)/3².
@@ -209,23 +214,6 @@ scene.render.image_settings.color_depth = "32"
 scene.render.filepath = OUT + "checker.exr"
 bpy.ops.render.render(write_still=True)
 """
-
-
-def run_blender(tmp_path, script_text):
-    out = str(tmp_path / "r-")
-    script = tmp_path / "scene.py"
-    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + script_text)
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([str(Path(caustica.__file__).parents[1]), env.get("PYTHONPATH", "")])
-    done = subprocess.run(
-        [BLENDER, "-b", "--factory-startup", "--python-use-system-env", "--python-exit-code", "1", "-P", str(script)],
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=300,
-    )
-    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
-    return out
 
 
 @pytest.mark.skipif(BLENDER is None, reason="blender is not on the PATH")

@@ -607,28 +607,46 @@ fn a_metallic_roughness_texture_on_glass_makes_it_rough_or_metal_point_by_point(
     assert_eq!(rough, Some(0.25));
 }
 
+/// The cosine-weighted mean of Fresnel's reflectance over the hemisphere for index `eta` (F̄),
+/// by quadrature in cos².
+fn mean_fresnel(eta: f32) -> f32 {
+    let n = 4096;
+    (0..n)
+        .map(|j| caustica::bsdf::fresnel_dielectric(((j as f32 + 0.5) / n as f32).sqrt(), eta))
+        .sum::<f32>()
+        / n as f32
+}
+
+/// The glTF quad of `material` (with a white texel), read, no warning mentioning `unsaid`.
+fn white_quad(test: &str, material: &str, unsaid: &str) -> Scene {
+    let dir = folder(test);
+    let image = png(1, 1, &[[255, 255, 255]]);
+    let scene = load(
+        &quad_gltf(&dir, &image, Holder::File, material, "{}"),
+        &LoadSettings::default(),
+    )
+    .unwrap();
+    assert!(
+        scene.warnings().iter().all(|w| !w.contains(unsaid)),
+        "{:?}",
+        scene.warnings()
+    );
+    scene
+}
+
 /// glTF's `KHR_materials_clearcoat` over a Lambert base (specular 0): under the uniform sky
 /// caustica adds to a file without lights, a quad seen face-on has radiance
 /// F(0) + (1 − F(0))·ρ·(1 − F̄) with the coat's F of index 1.5 (F(0) = 0.04, F̄ its
 /// cosine-weighted mean): the coat's reflection of the sky plus the base seen through it.
 #[test]
 fn a_gltf_clear_coat_reflects_the_sky_and_shows_the_base_through_it() {
-    let dir = folder("clearcoat");
-    let image = png(1, 1, &[[255, 255, 255]]);
-    let material = r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":1},
-"extensions":{"KHR_materials_specular":{"specularFactor":0},"KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":0}}}"#;
-    let path = quad_gltf(&dir, &image, Holder::File, material, "{}");
-    let scene = load(&path, &LoadSettings::default()).unwrap();
-    assert!(
-        scene.warnings().iter().all(|w| !w.contains("clearcoat")),
-        "{:?}",
-        scene.warnings()
+    let scene = white_quad(
+        "clearcoat",
+        r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":1},
+"extensions":{"KHR_materials_specular":{"specularFactor":0},"KHR_materials_clearcoat":{"clearcoatFactor":1,"clearcoatRoughnessFactor":0}}}"#,
+        "clearcoat",
     );
-    let n = 4096;
-    let mean_f = (0..n)
-        .map(|j| caustica::bsdf::fresnel_dielectric(((j as f32 + 0.5) / n as f32).sqrt(), 1.5))
-        .sum::<f32>()
-        / n as f32;
+    let mean_f = mean_fresnel(1.5);
     let want = 0.04 + 0.96 * 0.5 * (1.0 - mean_f);
     for integrator in ["path", "vcm"] {
         // The quad fills the view (within 22° of its normal, where F moves by 0.0002).
@@ -728,22 +746,13 @@ fn gltf_clear_coat_textures_set_the_coat_point_by_point() {
 /// c the weight times the colour and w its largest channel.
 #[test]
 fn a_gltf_specular_layer_reflects_its_colour_and_weight() {
-    let dir = folder("specular");
-    let image = png(1, 1, &[[255, 255, 255]]);
-    let material = r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":0},
-"extensions":{"KHR_materials_specular":{"specularFactor":0.5,"specularColorFactor":[1,0.5,0.25]}}}"#;
-    let path = quad_gltf(&dir, &image, Holder::File, material, "{}");
-    let scene = load(&path, &LoadSettings::default()).unwrap();
-    assert!(
-        scene.warnings().iter().all(|w| !w.contains("specular")),
-        "{:?}",
-        scene.warnings()
+    let scene = white_quad(
+        "specular",
+        r#"{"pbrMetallicRoughness":{"baseColorFactor":[0.5,0.5,0.5,1],"metallicFactor":0,"roughnessFactor":0},
+"extensions":{"KHR_materials_specular":{"specularFactor":0.5,"specularColorFactor":[1,0.5,0.25]}}}"#,
+        "specular",
     );
-    let n = 4096;
-    let mean_f = (0..n)
-        .map(|j| caustica::bsdf::fresnel_dielectric(((j as f32 + 0.5) / n as f32).sqrt(), 1.5))
-        .sum::<f32>()
-        / n as f32;
+    let mean_f = mean_fresnel(1.5);
     let c = Vec3::new(0.5, 0.25, 0.125);
     let w = 0.5;
     let want = c * 0.04 + Vec3::splat(0.5 * (1.0 - w * 0.04) * (1.0 - w * mean_f));
