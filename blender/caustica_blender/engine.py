@@ -75,6 +75,9 @@ class CausticaRenderEngine(bpy.types.RenderEngine):
             self.report({"WARNING"}, f"caustica: {message}")
         options = render_options(scene.caustica)
         options.update(width=width, height=height)
+        # Blender's Performance › Threads, as Cycles takes it.
+        if scene.render.threads_mode == "FIXED":
+            options["threads"] = scene.render.threads
         result = self.begin_result(0, 0, width, height)
         combined = result.layers[0].passes["Combined"]
         start = time.monotonic()

@@ -110,25 +110,30 @@ def build(principled_glass):
     return scene
 
 
-ref = caustica.read_exr(reference)
-# The reference's particle tracer leaves every pixel that sees a specular ball black: those
-# pixels are left out (metrics.py's mask; the whole image's grown by a pixel).
-keep = ~specular_mask("point")
-regions = {
-    "floor, front (150–159, all)": (np.s_[150:160, :], keep),
-    "back wall (20–80, 20–140)": (np.s_[20:81, 20:141], keep),
-    "focus (135–139, 41–45, 17 px)": (FOCUS, keep),
-    "caustic region (134–142, 36–60, 141 px)": (CAUSTIC, keep),
-    "whole image": (np.s_[:, :], ~dilate(~keep)),
-}
-print("| glass | region | add-on | reference | difference |")
-print("|---|---|---:|---:|---:|")
-for name, principled_glass in [("Glass BSDF", False), ("Principled", True)]:
-    scene = build(principled_glass)
-    scene.render.filepath = os.path.join(out, name.replace(" ", "-") + ".exr")
-    bpy.ops.render.render(write_still=True)
-    image = caustica.read_exr(scene.render.filepath)
-    for region, (where, mask) in regions.items():
-        a = float(image[where][mask[where]].mean())
-        b = float(ref[where][mask[where]].mean())
-        print(f"| {name} | {region} | {a:.4f} | {b:.4f} | {100.0 * (a / b - 1.0):+.1f}% |")
+def main():
+    ref = caustica.read_exr(reference)
+    # The reference's particle tracer leaves every pixel that sees a specular ball black: those
+    # pixels are left out (metrics.py's mask; the whole image's grown by a pixel).
+    keep = ~specular_mask("point")
+    regions = {
+        "floor, front (150–159, all)": (np.s_[150:160, :], keep),
+        "back wall (20–80, 20–140)": (np.s_[20:81, 20:141], keep),
+        "focus (135–139, 41–45, 17 px)": (FOCUS, keep),
+        "caustic region (134–142, 36–60, 141 px)": (CAUSTIC, keep),
+        "whole image": (np.s_[:, :], ~dilate(~keep)),
+    }
+    print("| glass | region | add-on | reference | difference |")
+    print("|---|---|---:|---:|---:|")
+    for name, principled_glass in [("Glass BSDF", False), ("Principled", True)]:
+        scene = build(principled_glass)
+        scene.render.filepath = os.path.join(out, name.replace(" ", "-") + ".exr")
+        bpy.ops.render.render(write_still=True)
+        image = caustica.read_exr(scene.render.filepath)
+        for region, (where, mask) in regions.items():
+            a = float(image[where][mask[where]].mean())
+            b = float(ref[where][mask[where]].mean())
+            print(f"| {name} | {region} | {a:.4f} | {b:.4f} | {100.0 * (a / b - 1.0):+.1f}% |")
+
+
+if __name__ == "__main__":
+    main()
