@@ -218,6 +218,11 @@ class Conversion:
             specular = self.value(i["Specular"], material, "specular")
             if i["Alpha"].is_linked or i["Alpha"].default_value < 1.0:
                 self.warn(f"material {material}: alpha is not rendered")
+            # Inputs with no reading yet: said when they would change the picture.
+            for unread in ["Subsurface", "Sheen", "Clearcoat", "Anisotropic"]:
+                socket = i.get(unread)
+                if socket is not None and (socket.is_linked or socket.default_value > 0.0):
+                    self.warn(f"material {material}: the Principled BSDF's {unread} is not rendered")
             out = rules.principled(base, metallic, roughness, transmission, ior, specular)
             strength = self.value(i["Emission Strength"], material, "emission strength")
             emission = np.array(self.value(i["Emission"], material, "emission")) * strength
