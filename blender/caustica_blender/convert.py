@@ -243,6 +243,15 @@ class Conversion:
                 "alpha": r * r,
                 "tint": self.colour(node.inputs["Color"], material, "the colour"),
             }
+        if kind == "BSDF_TRANSPARENT":
+            # Light passes straight through, tinted: a sheet of index 1.
+            return {"type": "thin_glass", "ior": 1.0, "tint": self.colour(node.inputs["Color"], material, "the colour")}
+        if kind == "MIX_SHADER":
+            fac = self.value(node.inputs[0], material, "the mix factor")
+            parts = []
+            for socket in (node.inputs[1], node.inputs[2]):
+                parts.append(self.shader(socket.links[0].from_node if socket.is_linked else None, material))
+            return {"type": "mix", "amount": min(1.0, max(0.0, fac)), "materials": parts}
         if kind == "EMISSION":
             colour = np.array(self.value(node.inputs["Color"], material, "the colour"))
             strength = self.value(node.inputs["Strength"], material, "the strength")

@@ -3,8 +3,8 @@
 //! (docs/python.md, "Scenes from Python"). Errors name the key and the index at fault.
 
 use caustica::description::{
-    CameraDesc, EmittingFaces, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, NormalMap, ObjectDesc, Param,
-    PhysicalMaterial, RenderHints, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    CameraDesc, EmittingFaces, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc,
+    Param, PhysicalMaterial, RenderHints, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use caustica::math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use caustica::texture::{Encoding, Wrap};
@@ -469,6 +469,31 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
             m.course_gloss(f0, alpha);
             m
         }
+        "mix" => {
+            // At each point one of the two, the second with probability `amount` (pbrt's mix).
+            let amount = t.float("amount", 0.5)?;
+            if !(0.0..=1.0).contains(&amount) {
+                return Err(at.key("amount").error(format!("a share between 0 and 1, not {amount}")));
+            }
+            let parts = t
+                .get("materials")?
+                .ok_or_else(|| at.key("materials").error("required"))?;
+            let list = parts
+                .cast::<PyList>()
+                .map_err(|_| at.key("materials").type_error("expected a list of two materials"))?;
+            if list.len() != 2 {
+                return Err(at.key("materials").error(format!("two materials, not {}", list.len())));
+            }
+            let first = material(&list.get_item(0)?, at.key("materials").index(0))?;
+            let second = material(&list.get_item(1)?, at.key("materials").index(1))?;
+            // The course model reads the larger part.
+            let mut m = if amount >= 0.5 { second.clone() } else { first.clone() };
+            m.mix = Some(Box::new(MixDesc {
+                materials: [first, second],
+                amount: Param::grey(amount),
+            }));
+            m
+        }
         "coated" => {
             let base = t.param("reflectance", Vec3::splat(0.5))?;
             let (eta, alpha) = (ior(&mut t)?, alpha(&mut t)?);
@@ -476,7 +501,7 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         }
         other => {
             return Err(at.key("type").error(format!(
-                "\"diffuse\", \"glass\", \"thin_glass\", \"conductor\" or \"coated\", not \"{other}\""
+                "\"diffuse\", \"glass\", \"thin_glass\", \"conductor\", \"coated\" or \"mix\", not \"{other}\""
             )))
         }
     };

@@ -164,3 +164,31 @@ def test_a_missing_texture_file_is_named():
     with pytest.raises(ValueError) as e:
         caustica.Scene.from_dict(d)
     assert "materials.floor.reflectance.file: no file `/no/such/image.png`" in str(e.value)
+
+
+def test_a_mix_blends_its_two_materials_in_the_mean():
+    # White 0.8 and black mixed at 0.25 under a uniform sky of radiance 1: the floor seen from
+    # above has radiance 0.8 × 0.75 = 0.6 (each point shows one of the two).
+    scene = caustica.Scene.from_dict(
+        {
+            "camera": {"eye": [0, 0, 2], "look_at": [0, 0, 0], "fov": 30, "width": 16, "height": 16},
+            "materials": {
+                "mixed": {
+                    "type": "mix",
+                    "amount": 0.25,
+                    "materials": [{"type": "diffuse", "reflectance": 0.8}, {"type": "diffuse", "reflectance": 0}],
+                }
+            },
+            "shapes": [
+                {
+                    "type": "mesh",
+                    "positions": [[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]],
+                    "indices": [[0, 1, 2], [0, 2, 3]],
+                    "material": "mixed",
+                }
+            ],
+            "lights": [{"type": "environment", "radiance": 1}],
+        }
+    )
+    image = caustica.render(scene, integrator="path", passes=64, seed=2)
+    assert image.mean() == pytest.approx(0.6, rel=0.02)
