@@ -10,7 +10,6 @@ mod common;
 
 mod absorption;
 mod area_light_faces;
-mod blender_exports;
 mod camera_fit;
 mod caustic_scenes;
 mod caustics;

@@ -303,7 +303,7 @@ const REFERENCE_DEPTH: u32 = 8;
 /// On the Cornell box with a glass and a mirror ball, under the point light and under the
 /// small area light, every region within 2% of the independent reference, and the caustic's
 /// line within 3% (light tracing keeps it whole, no kernel blurs it; its six pixels carry about
-/// 1% noise at this count of light paths; measured 0.97% and 0.41% off).
+/// 1% noise at this count of light paths; measured 0.92% and 0.52% off, the worst region 0.51%).
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn vcm_converges_to_the_cornell_references() {
@@ -331,7 +331,7 @@ fn vcm_converges_to_the_cornell_references() {
     }
 }
 
-const PASSES: u64 = 48;
+const PASSES: u64 = 24;
 
 /// A spot light through a glass ball onto a diffuse floor, seen from the side of the caustic:
 /// vcm, which aims a share of its light subpaths at the ball, against light tracing, which
