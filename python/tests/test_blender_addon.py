@@ -19,33 +19,51 @@ import caustica
 BLENDER = shutil.which("blender")
 ROOT = Path(__file__).resolve().parents[2]
 
-SCRIPT = r"""
+
+# What the scripts below share: the add-on registered, a grey floor, a camera, caustica's settings.
+COMMON = r"""
 import json, math, sys
 import bpy
 sys.path.insert(0, ADDONS)
 import caustica_blender
 caustica_blender.register()
+
+
+def grey_floor(size):
+    bpy.ops.mesh.primitive_plane_add(size=size)
+    floor = bpy.data.materials.new("Floor")
+    floor.use_nodes = True
+    bsdf = floor.node_tree.nodes["Principled BSDF"]
+    bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
+    bsdf.inputs["Specular"].default_value = 0.0
+    bpy.context.object.data.materials.append(floor)
+
+
+def camera(scene, location, rotation=(0.0, 0.0, 0.0)):
+    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    cam.location = location
+    cam.rotation_euler = rotation
+    scene.collection.objects.link(cam)
+    scene.camera = cam
+
+
+def caustica_settings(scene, integrator, passes, width, height):
+    scene.render.engine = "CAUSTICA"
+    scene.caustica.integrator = integrator
+    scene.caustica.time_limit = 0.0
+    scene.caustica.passes = passes
+    scene.render.resolution_x, scene.render.resolution_y = width, height
+    scene.render.resolution_percentage = 100
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+"""
+
+SCRIPT = r"""
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
-bpy.ops.mesh.primitive_plane_add(size=20.0)
-floor = bpy.data.materials.new("Floor")
-floor.use_nodes = True
-bsdf = floor.node_tree.nodes["Principled BSDF"]
-bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-bsdf.inputs["Specular"].default_value = 0.0
-bpy.context.object.data.materials.append(floor)
-cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-cam.location = (0.0, 0.0, 6.0)
-scene.collection.objects.link(cam)
-scene.camera = cam
-scene.render.engine = "CAUSTICA"
-scene.caustica.integrator = "PATH"
-scene.caustica.time_limit = 0.0
-scene.caustica.passes = 4
-scene.render.resolution_x, scene.render.resolution_y = 40, 30
-scene.render.resolution_percentage = 100
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
+grey_floor(20.0)
+camera(scene, (0.0, 0.0, 6.0))
+caustica_settings(scene, "PATH", 4, 40, 30)
 def lamp(kind, **props):
     for o in [o for o in scene.objects if o.type == "LIGHT"]:
         bpy.data.objects.remove(o)
@@ -73,7 +91,7 @@ json.dump({"engine": scene.render.engine}, open(OUT + ".json", "w"))
 def run_blender(tmp_path, script_text):
     out = str(tmp_path / "r-")
     script = tmp_path / "scene.py"
-    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + script_text)
+    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + COMMON + script_text)
     env = dict(os.environ)
     # Blender's own Python finds the caustica package where this test imports it from.
     env["PYTHONPATH"] = os.pathsep.join([str(Path(caustica.__file__).parents[1]), env.get("PYTHONPATH", "")])
@@ -111,23 +129,10 @@ def test_f12_renders_the_floor_under_each_light_as_blender_means_it(tmp_path):
 
 
 GLASS = r"""
-import math, sys
-import bpy
-sys.path.insert(0, ADDONS)
-import caustica_blender
-caustica_blender.register()
-
-
 def build(glass_node):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    bpy.ops.mesh.primitive_plane_add(size=20.0)
-    floor = bpy.data.materials.new("Floor")
-    floor.use_nodes = True
-    bsdf = floor.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    bsdf.inputs["Specular"].default_value = 0.0
-    bpy.context.object.data.materials.append(floor)
+    grey_floor(20.0)
     bpy.ops.mesh.primitive_uv_sphere_add(segments=48, ring_count=24, radius=1.0, location=(0.0, 0.0, 1.5))
     bpy.ops.object.shade_smooth()
     glass = bpy.data.materials.new("Glass")
@@ -152,19 +157,8 @@ def build(glass_node):
     lamp = bpy.data.objects.new("Lamp", light)
     lamp.location = (0.0, 0.0, 6.0)
     scene.collection.objects.link(lamp)
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    cam.location = (0.0, -7.0, 6.0)
-    cam.rotation_euler = (math.radians(45.0), 0.0, 0.0)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
-    scene.render.engine = "CAUSTICA"
-    scene.caustica.integrator = "VCM"
-    scene.caustica.time_limit = 0.0
-    scene.caustica.passes = 32
-    scene.render.resolution_x, scene.render.resolution_y = 64, 48
-    scene.render.resolution_percentage = 100
-    scene.render.image_settings.file_format = "OPEN_EXR"
-    scene.render.image_settings.color_depth = "32"
+    camera(scene, (0.0, -7.0, 6.0), (math.radians(45.0), 0.0, 0.0))
+    caustica_settings(scene, "VCM", 32, 64, 48)
     return scene
 
 
@@ -199,18 +193,8 @@ sun.data.energy = 3.0
 sun.data.angle = 0.0
 sun.rotation_euler = (math.radians(30.0), 0.0, 0.0)
 scene.collection.objects.link(sun)
-cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-cam.location = (0.0, 0.0, 3.0)
-scene.collection.objects.link(cam)
-scene.camera = cam
-scene.render.engine = "CAUSTICA"
-scene.caustica.integrator = "PATH"
-scene.caustica.time_limit = 0.0
-scene.caustica.passes = 2
-scene.render.resolution_x, scene.render.resolution_y = 40, 40
-scene.render.resolution_percentage = 100
-scene.render.image_settings.file_format = "OPEN_EXR"
-scene.render.image_settings.color_depth = "32"
+camera(scene, (0.0, 0.0, 3.0))
+caustica_settings(scene, "PATH", 2, 40, 40)
 scene.render.filepath = OUT + "checker.exr"
 bpy.ops.render.render(write_still=True)
 """
