@@ -26,7 +26,7 @@ use std::time::{Duration, Instant};
 /// Cases of the default run; it also stops after `DEFAULT_BUDGET` (CI's ten minutes on two
 /// cores hold the whole suite: a longer run takes `CAUSTICA_FUZZ_CASES`).
 const DEFAULT_CASES: u64 = 40_000;
-const DEFAULT_BUDGET: Duration = Duration::from_secs(15);
+const DEFAULT_BUDGET: Duration = Duration::from_secs(8);
 /// Files larger than this are left out of the pool: one case must stay well under a second.
 const MAX_SOURCE_BYTES: usize = 160_000;
 /// A case slower than this is reported; one this slow fails the run.

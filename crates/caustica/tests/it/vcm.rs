@@ -303,7 +303,7 @@ const REFERENCE_DEPTH: u32 = 8;
 /// On the Cornell box with a glass and a mirror ball, under the point light and under the
 /// small area light, every region within 2% of the independent reference, and the caustic's
 /// line within 3% (light tracing keeps it whole, no kernel blurs it; its six pixels carry about
-/// 1% noise at this count of light paths; measured 0.92% and 0.52% off, the worst region 0.51%).
+/// 1.4% noise at this count of light paths; measured 1.39% and 0.64% off, the worst region 0.86%).
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn vcm_converges_to_the_cornell_references() {
@@ -331,7 +331,7 @@ fn vcm_converges_to_the_cornell_references() {
     }
 }
 
-const PASSES: u64 = 24;
+const PASSES: u64 = 16;
 
 /// A spot light through a glass ball onto a diffuse floor, seen from the side of the caustic:
 /// vcm, which aims a share of its light subpaths at the ball, against light tracing, which
@@ -444,7 +444,7 @@ rotate(1, 0, 0, -1.5707963, scale(6, square {{ material = {{ diffuse = (0.6, 0.6
 /// Directional lights, suns and the course forks' lights with a size (a ball, a
 /// parallelogram) start light subpaths too — the far ones from a plane across their beam:
 /// the caustic they cast through the ball, and the floor's light, within 5% of light tracing
-/// in every block lit at least 0.05 (measured −1.3% to +1.5%; the dimmer blocks, in the
+/// in every block lit at least 0.05 (measured −1.6% to +4.3%; the dimmer blocks, in the
 /// ball's shadow, carry several percent of light tracing's noise at these counts). Without
 /// them vcm had no caustic at all from these lights.
 #[test]
@@ -602,8 +602,8 @@ fn block_means(film: &Film, blocks: &[(usize, usize)]) -> Vec<f32> {
 
 /// The pixels that see the focus take [`VcmSettings::focus_samples`] camera samples a pass.
 /// On the Cornell box under the point light, the mean of the race's 5×5 box at the caustic's
-/// focus (rows 135–139, columns 41–45, all 25 pixels; scripts/race/metrics.py) over 24 seeds
-/// of one pass: with 8 samples its variance is at most 0.7 of that with 1 (measured 0.13),
+/// focus (rows 135–139, columns 41–45, all 25 pixels; scripts/race/metrics.py) over 16 seeds
+/// of one pass: with 8 samples its variance is at most 0.7 of that with 1 (measured 0.15),
 /// around the same mean (within three standard errors).
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
@@ -611,7 +611,7 @@ fn focus_pixels_take_more_camera_samples() {
     let (text, reference) = load_reference("cornell_caustics_point");
     let (w, h) = (reference.width, reference.height);
     let s = scene(&text);
-    let seeds = 24;
+    let seeds = 16;
     let spread = |focus_samples: usize| -> (f64, f64) {
         let values: Vec<f64> = (1..=seeds)
             .map(|seed| {
