@@ -14,12 +14,17 @@ from . import rules
 
 
 class Conversion:
-    def __init__(self, depsgraph, width, height):
+    def __init__(self, depsgraph, width, height, crop=None):
         self.depsgraph = depsgraph
         self.scene = depsgraph.scene_eval
         self.width, self.height = width, height
+        # The border's pixels [x begin, x end, y begin, y end], rows from the top; None: all.
+        self.crop = crop
         self.warnings = []
         self.materials = {}
+        self.meshes = {}
+        # Each mesh's parts by material, converted once however many instances place it.
+        self.mesh_parts = {}
         self.shapes = []
         self.lights = []
 
@@ -32,12 +37,13 @@ class Conversion:
             obj = instance.object
             matrix = np.array(instance.matrix_world, dtype=np.float64)
             if obj.type == "MESH":
-                self.mesh(obj, matrix)
+                self.mesh(obj, self.mesh_key(instance, obj), matrix)
             elif obj.type == "LIGHT":
                 self.light(obj.data, matrix)
         description = {
             "camera": self.camera(),
             "materials": self.materials,
+            "meshes": self.meshes,
             "shapes": self.shapes,
             "lights": self.lights + self.world(),
         }
@@ -52,20 +58,42 @@ class Conversion:
         cam = cam_obj.data
         if cam.type != "PERSP":
             self.warn(f"camera {cam_obj.name}: only perspective cameras are rendered")
-        if cam.shift_x != 0.0 or cam.shift_y != 0.0:
-            self.warn(f"camera {cam_obj.name}: lens shift is not applied")
         fov = rules.vertical_fov(cam.sensor_fit, cam.sensor_width, cam.sensor_height, cam.lens, self.width, self.height)
-        return {
+        out = {
             "matrix": np.array(cam_obj.matrix_world, dtype=np.float64),
             "fov": fov,
             "fov_axis": "vertical",
             "width": self.width,
             "height": self.height,
         }
+        if cam.shift_x != 0.0 or cam.shift_y != 0.0:
+            out["shift"] = rules.lens_shift(cam.sensor_fit, cam.shift_x, cam.shift_y, self.width, self.height)
+        if self.crop is not None:
+            out["crop"] = list(self.crop)
+        return out
 
     # ---- meshes -----------------------------------------------------------------------------
 
-    def mesh(self, obj, matrix):
+    @staticmethod
+    def mesh_key(instance, obj):
+        """What makes two placed meshes one: instances (collection instances, particles,
+        geometry nodes) and objects without modifiers that share a mesh (linked duplicates)
+        and their materials share its arrays; an object with modifiers has its own."""
+        materials = tuple(s.material.name if s.material else "" for s in obj.material_slots)
+        if instance.is_instance or not obj.original.modifiers:
+            return f"{obj.data.name}|{materials}"
+        return f"{obj.name}@object"
+
+    def mesh(self, obj, key, matrix):
+        parts = self.mesh_parts.get(key)
+        if parts is None:
+            parts = self.mesh_parts[key] = self.mesh_data(obj, key)
+        for name, material in parts:
+            self.shapes.append({"type": "instance", "mesh": name, "matrix": matrix, "material": material})
+
+    def mesh_data(self, obj, key):
+        """The mesh's triangles by material, into `meshes`: [(mesh name, material name)]."""
+        parts = []
         mesh = obj.to_mesh()
         try:
             mesh.calc_loop_triangles()
@@ -73,7 +101,7 @@ class Conversion:
                 mesh.calc_normals_split()
             n_tris = len(mesh.loop_triangles)
             if n_tris == 0:
-                return
+                return parts
             tri_loops = np.empty(n_tris * 3, dtype=np.int32)
             mesh.loop_triangles.foreach_get("loops", tri_loops)
             tri_material = np.empty(n_tris, dtype=np.int32)
@@ -98,19 +126,19 @@ class Conversion:
                 name = self.material(material)
                 picked = np.nonzero(tri_material == index)[0]
                 corners = (picked[:, None] * 3 + np.arange(3)[None, :]).ravel()
-                shape = {
-                    "type": "mesh",
+                data = {
                     "positions": positions[corners],
                     "normals": normals[corners],
                     "indices": np.arange(len(corners), dtype=np.int64).reshape(-1, 3),
-                    "matrix": matrix,
-                    "material": name,
                 }
                 if uvs is not None:
-                    shape["uvs"] = uvs[corners]
-                self.shapes.append(shape)
+                    data["uvs"] = uvs[corners]
+                mesh_name = f"{key}#{index}"
+                self.meshes[mesh_name] = data
+                parts.append((mesh_name, name))
         finally:
             obj.to_mesh_clear()
+        return parts
 
     # ---- materials --------------------------------------------------------------------------
 
@@ -194,6 +222,55 @@ class Conversion:
         self.warn(f"material {material}: the {n.name} node on the normal is not read")
         return None
 
+    def scalar(self, socket, material, what):
+        """A number input: its value, or an image's pixels linked into it — the image's colour
+        (its luminance), its alpha, or one channel through a Separate RGB/XYZ/Color node (as
+        Blender's glTF importer links a metallic-roughness texture) — as a linear texture."""
+        if not socket.is_linked:
+            return float(socket.default_value)
+        link = socket.links[0]
+        node, output = link.from_node, link.from_socket.name
+        channel = None
+        if node.type in {"SEPRGB", "SEPXYZ", "SEPARATE_COLOR"} and node.inputs[0].is_linked:
+            channel = {"R": 0, "Red": 0, "X": 0, "G": 1, "Green": 1, "Y": 1, "B": 2, "Blue": 2, "Z": 2}.get(output)
+            link = node.inputs[0].links[0]
+            node, output = link.from_node, link.from_socket.name
+            if node.type != "TEX_IMAGE" or output != "Color" or channel is None:
+                node = None
+        if node is not None and node.type == "TEX_IMAGE" and node.image is not None and not node.inputs["Vector"].is_linked:
+            if channel is None:
+                channel = "alpha" if output == "Alpha" else "luminance"
+            pixels = self.image_pixels(node.image, channel)
+            if pixels is not None:
+                return {
+                    "array": pixels,
+                    "encoding": "linear",
+                    "filter": "nearest" if node.interpolation == "Closest" else "linear",
+                    "wrap": {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat"),
+                }
+        self.warn(f"material {material}: {what} from the {socket.links[0].from_node.name} node is read by the input's own value")
+        return float(socket.default_value)
+
+    def image_pixels(self, image, channel):
+        """One channel of an image's pixels as linear values (rows from the top): 0–2, "alpha",
+        or "luminance"; an sRGB image's colour is decoded first, as Cycles reads it into a number."""
+        w, h = image.size
+        if w == 0 or h == 0:
+            return None
+        buf = np.empty(w * h * image.channels, dtype=np.float32)
+        image.pixels.foreach_get(buf)
+        px = buf.reshape(h, w, image.channels)[::-1]
+        if channel == "alpha":
+            return np.ascontiguousarray(px[..., 3] if image.channels == 4 else np.ones((h, w), np.float32))
+        rgb = px[..., :3] if image.channels >= 3 else np.repeat(px[..., :1], 3, axis=2)
+        if image.colorspace_settings.name == "sRGB" and not image.is_float:
+            rgb = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+        if channel == "rgb":
+            return np.ascontiguousarray(rgb)
+        if channel == "luminance":
+            return np.ascontiguousarray(rgb @ np.array([0.2126, 0.7152, 0.0722], dtype=np.float32))
+        return np.ascontiguousarray(rgb[..., channel])
+
     def value(self, socket, material, what):
         """A number input's value; a linked one is read by its own value, with a warning."""
         if socket.is_linked:
@@ -211,51 +288,73 @@ class Conversion:
         if kind == "BSDF_PRINCIPLED":
             i = node.inputs
             base = self.colour(i["Base Color"], material, "the base colour")
-            metallic = self.value(i["Metallic"], material, "metallic")
-            roughness = self.value(i["Roughness"], material, "roughness")
-            transmission = self.value(i["Transmission"], material, "transmission")
+            metallic = self.scalar(i["Metallic"], material, "metallic")
+            roughness = self.scalar(i["Roughness"], material, "roughness")
+            transmission = self.scalar(i["Transmission"], material, "transmission")
             ior = self.value(i["IOR"], material, "the IOR")
             specular = self.value(i["Specular"], material, "specular")
-            if i["Alpha"].is_linked or i["Alpha"].default_value < 1.0:
-                self.warn(f"material {material}: alpha is not rendered")
+            clearcoat = self.scalar(i["Clearcoat"], material, "clearcoat")
+            clearcoat_roughness = self.scalar(i["Clearcoat Roughness"], material, "the clearcoat roughness")
             # Inputs with no reading yet: said when they would change the picture.
-            for unread in ["Subsurface", "Sheen", "Clearcoat", "Anisotropic"]:
+            for unread in ["Subsurface", "Sheen", "Anisotropic"]:
                 socket = i.get(unread)
                 if socket is not None and (socket.is_linked or socket.default_value > 0.0):
                     self.warn(f"material {material}: the Principled BSDF's {unread} is not rendered")
-            out = rules.principled(base, metallic, roughness, transmission, ior, specular)
+            if i["Clearcoat Normal"].is_linked:
+                self.warn(f"material {material}: the clearcoat's normal is not read (the coat follows the surface)")
+            out = rules.principled(
+                base, metallic, roughness, transmission, ior, specular, clearcoat, clearcoat_roughness
+            )
+            coverage = self.scalar(i["Alpha"], material, "alpha")
+            if rules.is_texture(coverage) or coverage < 1.0:
+                out["coverage"] = coverage
             strength = self.value(i["Emission Strength"], material, "emission strength")
-            emission = np.array(self.value(i["Emission"], material, "emission")) * strength
-            if emission.max() > 0.0:
-                out["emission"] = list(emission)
+            emission = self.colour(i["Emission"], material, "the emission")
+            if rules.is_texture(emission):
+                if strength > 0.0:
+                    out["emission"] = dict(emission, scale=strength)
+                    out["two_sided"] = True
+            elif max(emission) * strength > 0.0:
+                out["emission"] = [c * strength for c in emission]
                 out["two_sided"] = True
             return out
         if kind == "BSDF_DIFFUSE":
             return {"type": "diffuse", "reflectance": self.colour(node.inputs["Color"], material, "the colour")}
         if kind == "BSDF_GLOSSY":
-            r = self.value(node.inputs["Roughness"], material, "roughness")
-            return {"type": "conductor", "reflectance": self.colour(node.inputs["Color"], material, "the colour"), "alpha": r * r}
+            r = self.scalar(node.inputs["Roughness"], material, "roughness")
+            return {"type": "conductor", "reflectance": self.colour(node.inputs["Color"], material, "the colour"), "roughness": r}
         if kind in {"BSDF_GLASS", "BSDF_REFRACTION"}:
-            r = self.value(node.inputs["Roughness"], material, "roughness")
+            r = self.scalar(node.inputs["Roughness"], material, "roughness")
             return {
                 "type": "glass",
                 "ior": max(1.0, self.value(node.inputs["IOR"], material, "the IOR")),
-                "alpha": r * r,
+                "roughness": r,
                 "tint": self.colour(node.inputs["Color"], material, "the colour"),
             }
         if kind == "BSDF_TRANSPARENT":
             # Light passes straight through, tinted: a sheet of index 1.
             return {"type": "thin_glass", "ior": 1.0, "tint": self.colour(node.inputs["Color"], material, "the colour")}
         if kind == "MIX_SHADER":
-            fac = self.value(node.inputs[0], material, "the mix factor")
+            fac = self.scalar(node.inputs[0], material, "the mix factor")
+            if not rules.is_texture(fac):
+                fac = min(1.0, max(0.0, fac))
             parts = []
             for socket in (node.inputs[1], node.inputs[2]):
                 parts.append(self.shader(socket.links[0].from_node if socket.is_linked else None, material))
-            return {"type": "mix", "amount": min(1.0, max(0.0, fac)), "materials": parts}
+            return {"type": "mix", "amount": fac, "materials": parts}
+        if kind == "ADD_SHADER":
+            parts = []
+            for socket in (node.inputs[0], node.inputs[1]):
+                parts.append(self.shader(socket.links[0].from_node if socket.is_linked else None, material))
+            return rules.added(*parts)
         if kind == "EMISSION":
-            colour = np.array(self.value(node.inputs["Color"], material, "the colour"))
+            colour = self.colour(node.inputs["Color"], material, "the colour")
             strength = self.value(node.inputs["Strength"], material, "the strength")
-            return {"type": "diffuse", "reflectance": 0.0, "emission": list(colour * strength), "two_sided": True}
+            if rules.is_texture(colour):
+                emission = dict(colour, scale=strength)
+            else:
+                emission = [c * strength for c in colour]
+            return {"type": "diffuse", "reflectance": 0.0, "emission": emission, "two_sided": True}
         self.warn(f"material {material}: the {node.name} node ({kind}) is not read: grey diffuse instead")
         return {"type": "diffuse", "reflectance": 0.5}
 
@@ -303,18 +402,15 @@ class Conversion:
     def area_light(self, light, matrix, colour):
         sx = light.size
         sy = light.size_y if light.shape in {"RECTANGLE", "ELLIPSE"} else light.size
-        area = sx * sy
-        if light.shape in {"DISK", "ELLIPSE"}:
-            # A rectangle of the same area and proportions: the same light, differently shaped
-            # at close range.
-            area = math.pi * 0.25 * sx * sy
-            sx, sy = sx * math.sqrt(math.pi) / 2.0, sy * math.sqrt(math.pi) / 2.0
-            self.warn(f"light {light.name}: a {light.shape.lower()} is rendered as a rectangle of its area")
+        round_light = light.shape in {"DISK", "ELLIPSE"}
+        # A disk or ellipse is the one inscribed in its size's rectangle.
+        area = sx * sy * (math.pi / 4.0 if round_light else 1.0)
         m = matrix[:3, :3]
         # Lit down its −z: u × v points there.
         self.lights.append(
             {
                 "type": "area",
+                "shape": "ellipse" if round_light else "rectangle",
                 "corner": matrix[:3, 3] + m @ np.array([-sx / 2.0, -sy / 2.0, 0.0]),
                 "u": m @ np.array([0.0, sy, 0.0]),
                 "v": m @ np.array([sx, 0.0, 0.0]),
@@ -336,11 +432,51 @@ class Conversion:
             if node.type != "BACKGROUND":
                 self.warn(f"world: the {node.name} node is not read: no world light")
                 return []
-            if node.inputs["Color"].is_linked:
-                self.warn("world: an environment texture is not yet converted: its colour's value is used")
-            colour = np.array(node.inputs["Color"].default_value[:3])
             strength = node.inputs["Strength"].default_value
+            if node.inputs["Strength"].is_linked:
+                self.warn("world: the strength from a node link is read by the input's own value")
+            if node.inputs["Color"].is_linked:
+                sky = self.environment_texture(node.inputs["Color"].links[0].from_node)
+                if sky is not None:
+                    sky["radiance"] = [strength] * 3
+                    return [sky]
+            colour = np.array(node.inputs["Color"].default_value[:3])
         radiance = colour * strength
         if radiance.max() <= 0.0:
             return []
         return [{"type": "environment", "radiance": list(radiance)}]
+
+    def environment_texture(self, node):
+        """An Environment Texture node (equirectangular, its vector from nothing or a Mapping
+        node's rotation) as an environment light's image and rotation; None, with a warning,
+        for anything else."""
+        if node.type != "TEX_ENVIRONMENT" or node.image is None:
+            self.warn(f"world: the {node.name} node on the colour is not read: its colour's value is used")
+            return None
+        if node.projection != "EQUIRECTANGULAR":
+            self.warn(f"world: the {node.name} node's {node.projection} projection is not read: no world light")
+            return None
+        rotation = None
+        if node.inputs["Vector"].is_linked:
+            mapping = node.inputs["Vector"].links[0].from_node
+            ok = mapping.type == "MAPPING" and mapping.vector_type in {"POINT", "VECTOR"}
+            if ok:
+                scale = list(mapping.inputs["Scale"].default_value)
+                ok = not any(s.is_linked for s in mapping.inputs[1:]) and all(abs(x - 1.0) < 1e-6 for x in scale)
+            if not ok:
+                self.warn(f"world: the {mapping.name} node on the environment is not read (a Mapping node's rotation is)")
+            else:
+                rotation = [list(row) for row in mapping.inputs["Rotation"].default_value.to_matrix()]
+        sky = {"type": "environment", "rotation": np.array(rules.environment_rotation(rotation))}
+        if node.image.is_float:
+            path = self.image_file(node.image)
+            if path is not None:
+                sky["file"] = path
+                return sky
+        # 8-bit images (decoded as Cycles decodes them), and float images without a file.
+        pixels = self.image_pixels(node.image, "rgb")
+        if pixels is None:
+            self.warn(f"world: the environment image {node.image.name} has no pixels")
+            return None
+        sky["array"] = pixels
+        return sky

@@ -7,6 +7,7 @@ import time
 import bpy
 import numpy as np
 
+from . import rules
 from .convert import Conversion
 
 
@@ -62,23 +63,33 @@ class CausticaRenderEngine(bpy.types.RenderEngine):
         scale = scene.render.resolution_percentage / 100.0
         width = int(scene.render.resolution_x * scale)
         height = int(scene.render.resolution_y * scale)
+        # With a render border, Blender's result is the border's pixels alone: only they are
+        # rendered, through the same camera.
+        result = self.begin_result(0, 0, width, height)
+        crop = None
         if scene.render.use_border:
-            self.report({"WARNING"}, "caustica: border render is not applied; the whole frame is rendered")
-        conversion = Conversion(depsgraph, width, height)
+            r = scene.render
+            crop = rules.border(r.border_min_x, r.border_max_x, r.border_min_y, r.border_max_y, width, height)
+            # The result's size is Blender's own rounding of the border.
+            crop[1] = crop[0] + result.resolution_x
+            crop[2] = crop[3] - result.resolution_y
+        conversion = Conversion(depsgraph, width, height, crop)
         try:
             description = conversion.run()
             built = caustica.Scene.from_dict(description)
         except (ValueError, TypeError) as e:
             self.report({"ERROR"}, f"caustica: {e}")
+            self.end_result(result)
             return
         for message in conversion.warnings + list(built.warnings):
             self.report({"WARNING"}, f"caustica: {message}")
         options = render_options(scene.caustica)
+        if crop is not None:
+            width, height = crop[1] - crop[0], crop[3] - crop[2]
         options.update(width=width, height=height)
         # Blender's Performance › Threads, as Cycles takes it.
         if scene.render.threads_mode == "FIXED":
             options["threads"] = scene.render.threads
-        result = self.begin_result(0, 0, width, height)
         combined = result.layers[0].passes["Combined"]
         start = time.monotonic()
         planned = options.get("passes")

@@ -18,6 +18,22 @@ def vertical_fov(sensor_fit, sensor_width, sensor_height, lens, width, height):
     return math.degrees(2.0 * half)
 
 
+def lens_shift(sensor_fit, shift_x, shift_y, width, height):
+    """Blender's lens shift (in units of the sensor's fitted side: AUTO the image's longer
+    side) in units of the image's longer side, as `Scene.from_dict` reads it."""
+    side = {"HORIZONTAL": width, "VERTICAL": height}.get(sensor_fit, max(width, height))
+    f = side / max(width, height)
+    return [shift_x * f, shift_y * f]
+
+
+def border(min_x, max_x, min_y, max_y, width, height):
+    """Blender's render border (fractions, y from the bottom) in pixels [x begin, x end, y begin,
+    y end], rows from the top, as Blender's render result sizes it."""
+    x0, x1 = int(min_x * width), int(max_x * width)
+    y0, y1 = int(min_y * height), int(max_y * height)
+    return [x0, max(x1, x0 + 1), height - max(y1, y0 + 1), height - y0]
+
+
 def point_intensity(energy):
     """A point or spot light of `energy` watts: its intensity in W/sr, P/(4π)."""
     return energy / (4.0 * math.pi)
@@ -44,14 +60,91 @@ def coat_ior(specular):
     return (1.0 + math.sqrt(f0)) / (1.0 - math.sqrt(f0))
 
 
-def principled(base, metallic, roughness, transmission, ior, specular):
-    """The Principled BSDF's reading: metal from metallic ½, glass from transmission ½, else the
-    base colour under a coat of `coat_ior(specular)` (none at Specular 0); GGX α = roughness²."""
-    alpha = roughness * roughness
-    if metallic >= 0.5:
-        return {"type": "conductor", "reflectance": base, "alpha": alpha}
-    if transmission >= 0.5:
-        return {"type": "glass", "ior": max(1.0, ior), "alpha": alpha, "tint": base}
+def is_texture(value):
+    return isinstance(value, dict)
+
+
+def mix(first, second, amount):
+    """`second` with the share `amount` (a number or a texture), else `first`; the ends alone
+    where the share is a number at 0 or 1."""
+    if not is_texture(amount):
+        if amount <= 0.0:
+            return first
+        if amount >= 1.0:
+            return second
+    return {"type": "mix", "amount": amount, "materials": [first, second]}
+
+
+def principled(base, metallic, roughness, transmission, ior, specular, clearcoat=0.0, clearcoat_roughness=0.03):
+    """The Principled BSDF as Cycles blends it: metal with the share `metallic`; the rest glass
+    with the share `transmission`, else the base colour under a coat of `coat_ior(specular)`
+    (bare at Specular 0). Shares are mixes (numbers or textures); roughness r (a number or a
+    texture) is GGX α = r². A clear coat of weight ¼·`clearcoat` (Cycles' Disney coat) covers it."""
+    opaque = {"type": "diffuse", "reflectance": base}
     if specular > 0.0:
-        return {"type": "coated", "reflectance": base, "ior": coat_ior(specular), "alpha": alpha}
-    return {"type": "diffuse", "reflectance": base}
+        opaque = {"type": "coated", "reflectance": base, "ior": coat_ior(specular), "roughness": roughness}
+    glass = {"type": "glass", "ior": max(1.0, ior), "roughness": roughness, "tint": base}
+    metal = {"type": "conductor", "reflectance": base, "roughness": roughness}
+    out = mix(mix(opaque, glass, transmission), metal, metallic)
+    if is_texture(clearcoat) or clearcoat > 0.0:
+        weight = clearcoat if is_texture(clearcoat) else min(1.0, 0.25 * clearcoat)
+        if is_texture(weight):
+            weight = dict(weight, scale=0.25)
+        out = dict(out, clearcoat={"weight": weight, "roughness": clearcoat_roughness, "ior": 1.5})
+    return out
+
+
+def added(first, second):
+    """Cycles' Add Shader: the sum of two closures. An emission added to a surface is that
+    surface emitting; two surfaces are a half-and-half mix of each at twice its colours (the
+    same sum in the mean)."""
+    for a, b in ((first, second), (second, first)):
+        if a == {"type": "diffuse", "reflectance": 0.0}:
+            # Nothing linked: adds nothing.
+            return b
+    for a, b in ((first, second), (second, first)):
+        if a.get("type") == "diffuse" and a.get("reflectance") in (0.0, [0.0, 0.0, 0.0]) and "emission" in a:
+            out = dict(b)
+            emission = a["emission"]
+            if "emission" in b and not is_texture(b["emission"]) and not is_texture(emission):
+                emission = [x + y for x, y in zip(_rgb(b["emission"]), _rgb(emission))]
+            out["emission"] = emission
+            out["two_sided"] = True
+            return out
+    return {"type": "mix", "amount": 0.5, "materials": [scaled(first, 2.0), scaled(second, 2.0)]}
+
+
+def _rgb(value):
+    return [float(value)] * 3 if isinstance(value, (int, float)) else list(value)
+
+
+def scaled(material, factor):
+    """`material` with its colours (reflectance, tint, emission) times `factor`; a metal's
+    reflectance is at most 1."""
+    out = dict(material)
+    if out.get("type") == "mix":
+        out["materials"] = [scaled(m, factor) for m in out["materials"]]
+    for key in ("reflectance", "tint", "emission"):
+        if key not in out:
+            continue
+        value = out[key]
+        if is_texture(value):
+            scale = _rgb(value.get("scale", 1.0))
+            out[key] = dict(value, scale=[factor * s for s in scale])
+        else:
+            limit = 1.0 if out.get("type") == "conductor" and key == "reflectance" else float("inf")
+            out[key] = [min(limit, factor * x) for x in _rgb(value)]
+    return out
+
+
+def environment_rotation(mapping_rotation=None):
+    """The world-from-map rotation of Blender's equirectangular environment (z up, the image's
+    centre towards +x, its u turning towards −y) in caustica's map frame (+y up, the centre
+    towards −z, u towards +x); `mapping_rotation` is a Mapping node's 3×3 rotation applied to
+    the lookup direction."""
+    blender_from_map = [[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    if mapping_rotation is None:
+        return blender_from_map
+    # The texture is looked up at R·d: the world direction is Rᵀ times the map's.
+    rt = [[mapping_rotation[j][i] for j in range(3)] for i in range(3)]
+    return [[sum(rt[i][k] * blender_from_map[k][j] for k in range(3)) for j in range(3)] for i in range(3)]

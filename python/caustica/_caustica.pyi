@@ -91,9 +91,11 @@ class Scene:
     ) -> None: ...
     @staticmethod
     def from_dict(description: dict[str, Any]) -> Scene:
-        """A scene described in memory: `camera`, `materials` by name, `shapes` (meshes from
-        numpy arrays, spheres) and `lights`, in radiometric units (docs/python.md, "Scenes from
-        Python"). A key or value that cannot be used raises ValueError or TypeError naming it."""
+        """A scene described in memory: `camera`, `materials` by name (images from files or
+        numpy arrays), `meshes` by name, `shapes` (meshes from numpy arrays, instances of
+        `meshes`, spheres), `lights` and `render` settings, in radiometric units (docs/python.md,
+        "Scenes from Python"). A key or value that cannot be used raises ValueError or TypeError
+        naming it."""
     def info(self) -> dict[str, Any]:
         """What was read: the same dict as `caustica info --json` prints."""
     @property

@@ -3,8 +3,9 @@
 //! (docs/python.md, "Scenes from Python"). Errors name the key and the index at fault.
 
 use caustica::description::{
-    CameraDesc, EmittingFaces, FovAxis, ImageMap, ImageSource, LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc,
-    Param, PhysicalMaterial, RenderHints, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    Alpha, CameraDesc, ClearCoat, ClearCoatMaps, EmittingFaces, FovAxis, ImageMap, ImageSource, IntegratorHint,
+    LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RenderHints, RoughnessMap,
+    RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use caustica::math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use caustica::texture::{Encoding, Wrap};
@@ -90,15 +91,33 @@ impl<'py> Table<'py> {
         }
     }
 
-    /// A colour that may be a texture: a number, three, or an image (`image_map`).
+    /// A colour that may be a texture: a number, three, or an image (`image_map`, sRGB unless
+    /// it says otherwise).
     fn param(&mut self, key: &str, default: Vec3) -> PyResult<Param> {
+        self.param_encoded(key, default, Encoding::Srgb)
+    }
+
+    /// A value that may be a texture, its image read as `encoding` unless it says otherwise.
+    fn param_encoded(&mut self, key: &str, default: Vec3, encoding: Encoding) -> PyResult<Param> {
         match self.get(key)? {
             Some(v) if v.cast::<PyDict>().is_ok() => {
-                image_map(&v, self.at.key(key), Encoding::Srgb).map(|m| Param::Texture(Box::new(m)))
+                image_map(&v, self.at.key(key), encoding).map(|m| Param::Texture(Box::new(m)))
             }
             Some(v) => colour(&v, &self.at.key(key)).map(Param::Constant),
             None => Ok(Param::Constant(default)),
         }
+    }
+
+    /// A share in [0, 1]: a number, or a texture (linear, its first channel).
+    fn share(&mut self, key: &str, default: f32) -> PyResult<Param> {
+        let p = self.param_encoded(key, Vec3::splat(default), Encoding::Linear)?;
+        if let Param::Constant(c) = p {
+            if !(0.0..=1.0).contains(&c.x) {
+                return Err(self.at.key(key).error(format!("a share between 0 and 1, not {}", c.x)));
+            }
+            return Ok(Param::grey(c.x));
+        }
+        Ok(p)
     }
 
     fn vec3(&mut self, key: &str) -> PyResult<Option<Vec3>> {
@@ -171,27 +190,24 @@ fn vec3(value: &Bound<'_, PyAny>, at: &At) -> PyResult<Vec3> {
     }
 }
 
-/// An image from a file: `{"file": path, "encoding": "srgb" | "linear", "scale": colour,
-/// "wrap": "repeat" | "clamp" | "mirror", "filter": "linear" | "nearest"}`; the encoding
-/// defaults to `encoding` (sRGB for colours), wrap to repeat, filter to linear.
+/// An image: `{"file": path}` or `{"array": pixels}` (`image_source`), with `"encoding":
+/// "srgb" | "linear" | "alpha"` (the alpha channel, as coverage), `"scale": colour`, `"wrap":
+/// "repeat" | "clamp" | "mirror"`, `"filter": "linear" | "nearest"`; the encoding defaults to
+/// `encoding` (sRGB for colours), wrap to repeat, filter to linear.
 fn image_map(value: &Bound<'_, PyAny>, at: At, encoding: Encoding) -> PyResult<ImageMap> {
     let mut t = Table::new(value, at.clone())?;
-    let file: PathBuf = t
-        .string("file")?
-        .ok_or_else(|| at.key("file").error("required (an image file: PNG, JPEG, EXR, HDR, …)"))?
-        .into();
-    if !file.is_file() {
-        return Err(at.key("file").error(format!("no file `{}`", file.display())));
-    }
-    let mut map = ImageMap::colour(ImageSource::File(file), 0..0);
+    let source = image_source(&mut t, &at)?
+        .ok_or_else(|| at.error("an image is a `file` (PNG, JPEG, EXR, HDR, …) or an `array` of pixels"))?;
+    let mut map = ImageMap::colour(source, 0..0);
     map.encoding = match t.string("encoding")?.as_deref() {
         None => encoding,
         Some("srgb") => Encoding::Srgb,
         Some("linear") => Encoding::Linear,
+        Some("alpha") => Encoding::Coverage,
         Some(other) => {
             return Err(at
                 .key("encoding")
-                .error(format!("\"srgb\" or \"linear\", not \"{other}\"")))
+                .error(format!("\"srgb\", \"linear\" or \"alpha\", not \"{other}\"")))
         }
     };
     map.sampler.scale = t.colour("scale", Vec3::ONE)?;
@@ -217,6 +233,81 @@ fn image_map(value: &Bound<'_, PyAny>, at: At, encoding: Encoding) -> PyResult<I
     };
     t.done()?;
     Ok(map)
+}
+
+/// The image a table names: its `file`, or its `array` of pixels (numpy, shape (h, w) or
+/// (h, w, c) with c from 1 to 4, rows from the top; 8- and 16-bit integers are stored values
+/// decoded by the encoding, floats linear values); `None` when it names neither.
+fn image_source(t: &mut Table, at: &At) -> PyResult<Option<ImageSource>> {
+    let file = t.string("file")?;
+    let array = t.get("array")?;
+    match (file, array) {
+        (Some(_), Some(_)) => Err(at.error("an image is a `file` or an `array`, not both")),
+        (Some(file), None) => {
+            let file = PathBuf::from(file);
+            if !file.is_file() {
+                return Err(at.key("file").error(format!("no file `{}`", file.display())));
+            }
+            Ok(Some(ImageSource::File(file)))
+        }
+        (None, Some(a)) => pixels(&a, &at.key("array")).map(Some),
+        (None, None) => Ok(None),
+    }
+}
+
+/// Pixels from a numpy array, named for messages by where they are in the dict.
+fn pixels(value: &Bound<'_, PyAny>, at: &At) -> PyResult<ImageSource> {
+    let np = value.py().import("numpy")?;
+    let a = np
+        .call_method1("asarray", (value,))
+        .map_err(|e| at.type_error(format!("not an array ({e})")))?;
+    let shape: Vec<usize> = a.getattr("shape")?.extract()?;
+    let (height, width, channels) = match shape.as_slice() {
+        [h, w] => (*h, *w, 1),
+        [h, w, c] if (1..=4).contains(c) => (*h, *w, *c),
+        _ => {
+            return Err(at.error(format!(
+                "expected an array of shape (h, w) or (h, w, c) with 1 to 4 channels, not {shape:?}"
+            )))
+        }
+    };
+    if width == 0 || height == 0 {
+        return Err(at.error("the image is empty"));
+    }
+    let dtype = a.getattr("dtype")?;
+    let kind: String = dtype.getattr("kind")?.extract()?;
+    let size: usize = dtype.getattr("itemsize")?.extract()?;
+    let largest = match (kind.as_str(), size) {
+        ("u", 1) => Some(255.0),
+        ("u", 2) => Some(65535.0),
+        ("f", _) => None,
+        _ => {
+            return Err(at.type_error(format!(
+                "pixels are 8- or 16-bit unsigned integers or floats, not {}",
+                dtype.str()?
+            )))
+        }
+    };
+    let flat = np.call_method1("ascontiguousarray", (a.call_method0("ravel")?, "float32"))?;
+    let flat = flat
+        .cast_into::<numpy::PyArray1<f32>>()
+        .map_err(|_| at.error("not an array of numbers"))?;
+    let ro = flat.readonly();
+    let mut values = ro.as_slice().map_err(|_| at.error("not contiguous"))?.to_vec();
+    if let Some(i) = values.iter().position(|v| !v.is_finite()) {
+        return Err(at.error(format!("value {i} is not finite")));
+    }
+    if let Some(largest) = largest {
+        values.iter_mut().for_each(|v| *v /= largest);
+    }
+    Ok(ImageSource::Pixels {
+        name: at.0.clone(),
+        width,
+        height,
+        channels,
+        values: values.into(),
+        integer: largest.is_some(),
+    })
 }
 
 /// An array of shape (n, `columns`), as float32 (anything numpy turns into numbers).
@@ -257,6 +348,22 @@ fn matrix(value: &Bound<'_, PyAny>, at: &At) -> PyResult<Mat4> {
     Ok(m)
 }
 
+/// A rotation: a 3×3 matrix (numpy's rows) whose columns are orthonormal, turning right-handed
+/// frames into right-handed ones.
+fn rotation(value: &Bound<'_, PyAny>, at: &At) -> PyResult<Mat3> {
+    let a = array(value, 3, at)?;
+    let s = a.as_slice().map_err(|_| at.error("not contiguous"))?;
+    if s.len() != 9 {
+        return Err(at.error("expected a 3×3 matrix"));
+    }
+    let m = Mat3::from_cols_array(&[s[0], s[3], s[6], s[1], s[4], s[7], s[2], s[5], s[8]]);
+    let off = (m.transpose() * m - Mat3::IDENTITY).to_cols_array();
+    if !m.is_finite() || off.iter().any(|x| x.abs() > 1e-4) || (m.determinant() - 1.0).abs() > 1e-4 {
+        return Err(at.error("not a rotation (orthonormal columns, determinant 1)"));
+    }
+    Ok(m)
+}
+
 /// Reads `dict` into a scene description.
 pub fn description(dict: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
     let mut top = Table::new(dict, At(String::new()))?;
@@ -284,11 +391,26 @@ pub fn description(dict: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
             materials.insert(name, material);
         }
     }
+    // Meshes by name, for shapes that place them (instances of one mesh share its arrays).
+    let mut meshes: HashMap<String, TrimeshDesc> = HashMap::new();
+    if let Some(m) = top.get("meshes")? {
+        let at = At("meshes".into());
+        let m = m
+            .cast::<PyDict>()
+            .map_err(|_| at.type_error("expected a dict of meshes by name"))?;
+        for (name, value) in m.iter() {
+            let name: String = name.extract().map_err(|_| at.type_error("names are strings"))?;
+            let mut t = Table::new(&value, at.key(&name))?;
+            let mesh = mesh(&mut t, &at.key(&name))?;
+            t.done()?;
+            meshes.insert(name, mesh);
+        }
+    }
     if let Some(shapes) = top.get("shapes")? {
         let at = At("shapes".into());
         let list = shapes.cast::<PyList>().map_err(|_| at.type_error("expected a list"))?;
         for (i, s) in list.iter().enumerate() {
-            desc.objects.push(shape(&s, at.index(i), &materials)?);
+            desc.objects.push(shape(&s, at.index(i), &materials, &meshes)?);
         }
     }
     if let Some(lights) = top.get("lights")? {
@@ -298,8 +420,48 @@ pub fn description(dict: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
             desc.lights.push(light(&l, at.index(i))?);
         }
     }
+    if let Some(r) = top.get("render")? {
+        render_hints(&r, At("render".into()), &mut desc.hints)?;
+    }
     top.done()?;
     Ok(desc)
+}
+
+/// How the scene asks to be rendered, as a file's `Integrator` and `Sampler` do: `integrator`
+/// ("path", "ppm", "lt" or "vcm"), `passes`, `max_depth` (scattering events on a path),
+/// `photons` per pass and the gather `radius`. A call's own options win.
+fn render_hints(value: &Bound<'_, PyAny>, at: At, hints: &mut RenderHints) -> PyResult<()> {
+    let mut t = Table::new(value, at.clone())?;
+    hints.integrator = match t.string("integrator")?.as_deref() {
+        None => None,
+        Some("path") => Some(IntegratorHint::Path),
+        Some("ppm") => Some(IntegratorHint::Ppm),
+        Some("lt") => Some(IntegratorHint::LightTracer),
+        Some("vcm") => Some(IntegratorHint::Bidirectional),
+        Some(other) => {
+            return Err(at
+                .key("integrator")
+                .error(format!("\"path\", \"ppm\", \"lt\" or \"vcm\", not \"{other}\"")))
+        }
+    };
+    let whole = |t: &mut Table, key: &str| -> PyResult<Option<u64>> {
+        match t.get(key)? {
+            Some(v) => match v.extract::<u64>() {
+                Ok(n) if n > 0 => Ok(Some(n)),
+                _ => Err(at.key(key).error("expected a whole number above 0")),
+            },
+            None => Ok(None),
+        }
+    };
+    hints.samples = whole(&mut t, "passes")?.map(|n| n.min(u64::from(u32::MAX)) as u32);
+    hints.max_depth = whole(&mut t, "max_depth")?.map(|n| n.min(1 << 16) as u32);
+    hints.photons_per_pass = whole(&mut t, "photons")?.map(|n| n as usize);
+    hints.radius = match t.float("radius", 0.0)? {
+        r if r > 0.0 => Some(r),
+        0.0 => None,
+        r => return Err(at.key("radius").error(format!("a radius is above 0, not {r}"))),
+    };
+    t.done()
 }
 
 /// An image size a description asks for: width and height, each optional.
@@ -363,30 +525,93 @@ fn camera(value: &Bound<'_, PyAny>, at: At) -> PyResult<(CameraDesc, Size)> {
             (eye, view, up, None)
         }
     };
+    let shift = match t.get("shift")? {
+        Some(v) => match floats(&v, &at.key("shift"))?.as_slice() {
+            [x, y] => Vec2::new(*x as f32, *y as f32),
+            _ => return Err(at.key("shift").error("expected two numbers")),
+        },
+        None => Vec2::ZERO,
+    };
+    let crop = match t.get("crop")? {
+        Some(v) => {
+            let (Some(w), Some(h)) = (width, height) else {
+                return Err(at.key("crop").error("a crop needs the camera's `width` and `height`"));
+            };
+            let c: [usize; 4] = v
+                .extract()
+                .map_err(|_| at.key("crop").type_error("expected four whole numbers"))?;
+            if !(c[0] < c[1] && c[1] <= w && c[2] < c[3] && c[3] <= h) {
+                return Err(at.key("crop").error(format!(
+                    "[x begin, x end, y begin, y end] within the {w}×{h} image, not {c:?}"
+                )));
+            }
+            Some((c, w, h))
+        }
+        None => None,
+    };
     t.done()?;
+    let plane_height = 2.0 * (fov.to_radians() * 0.5).tan();
+    // The image plane's spans, right and up; shift and crop move its centre off the axis, so
+    // its rightward direction is given rather than worked out from the view.
+    let right = right.unwrap_or_else(|| up.cross(-view));
+    let (span_u, span_v) = (right * plane_height * aspect, up * plane_height);
+    // Blender's lens shift: in units of the plane's larger side.
+    let larger = plane_height * aspect.max(1.0);
+    let mut view = view + right * shift.x * larger + up * shift.y * larger;
+    let (mut height, mut aspect, mut size) = (plane_height, aspect, (width, height));
+    if let Some((c, w, h)) = crop {
+        // Pixels x in c[0]..c[1], rows (from the top) in c[2]..c[3]: the same pixels as in the
+        // whole image.
+        let (x0, x1) = (c[0] as f32 / w as f32, c[1] as f32 / w as f32);
+        let (y0, y1) = (1.0 - c[3] as f32 / h as f32, 1.0 - c[2] as f32 / h as f32);
+        view += span_u * (0.5 * (x0 + x1) - 0.5) + span_v * (0.5 * (y0 + y1) - 0.5);
+        height = plane_height * (y1 - y0);
+        aspect *= (x1 - x0) / (y1 - y0);
+        size = (Some(c[1] - c[0]), Some(c[3] - c[2]));
+    }
     let camera = CameraDesc {
         position,
         view,
         up,
-        height: 2.0 * (fov.to_radians() * 0.5).tan(),
+        height,
         aspect_ratio: aspect,
-        right,
+        right: Some(right),
         fov_axis,
         span: 0..0,
     };
-    Ok((camera, (width, height)))
+    Ok((camera, size))
 }
 
 /// A material: its `type`'s physical reading, with the course fields that go with it.
 fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
     let mut t = Table::new(value, at.clone())?;
     let kind = t.string("type")?.ok_or_else(|| at.key("type").error("required"))?;
-    let alpha = |t: &mut Table| -> PyResult<f32> {
-        let a = t.float("alpha", 0.0)?;
-        if !(0.0..=1.0).contains(&a) {
-            return Err(at.key("alpha").error(format!("GGX α is between 0 and 1, not {a}")));
+    // The GGX α: `alpha` itself, or `roughness` (α = roughness², Blender's and glTF's reading),
+    // which may be a texture (its first channel, linear).
+    let mut roughness_map = None;
+    let mut alpha = |t: &mut Table| -> PyResult<f32> {
+        let a = t.float("alpha", -1.0)?;
+        let r = t.param_encoded("roughness", Vec3::splat(-1.0), Encoding::Linear)?;
+        match (a, r) {
+            (a, Param::Constant(r)) if a >= 0.0 && r.x >= 0.0 => {
+                Err(at.error("a roughness is `alpha` or `roughness`, not both"))
+            }
+            (a, _) if a > 1.0 => Err(at.key("alpha").error(format!("GGX α is between 0 and 1, not {a}"))),
+            (a, Param::Constant(_)) if a >= 0.0 => Ok(a),
+            (_, Param::Constant(r)) if r.x > 1.0 => Err(at
+                .key("roughness")
+                .error(format!("a roughness is between 0 and 1, not {}", r.x))),
+            (_, Param::Constant(r)) => Ok(r.x.max(0.0) * r.x.max(0.0)),
+            (a, _) if a >= 0.0 => Err(at.error("a roughness is `alpha` or `roughness`, not both")),
+            (_, texture) => {
+                roughness_map = Some(RoughnessMap {
+                    texture,
+                    remap: RoughnessRemap::Square,
+                });
+                // Rough where the texture says; the map sets α point by point.
+                Ok(0.25)
+            }
         }
-        Ok(a)
     };
     let ior = |t: &mut Table| -> PyResult<f32> {
         let n = t.float("ior", 1.5)?;
@@ -471,10 +696,7 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         }
         "mix" => {
             // At each point one of the two, the second with probability `amount` (pbrt's mix).
-            let amount = t.float("amount", 0.5)?;
-            if !(0.0..=1.0).contains(&amount) {
-                return Err(at.key("amount").error(format!("a share between 0 and 1, not {amount}")));
-            }
+            let amount = t.share("amount", 0.5)?;
             let parts = t
                 .get("materials")?
                 .ok_or_else(|| at.key("materials").error("required"))?;
@@ -486,11 +708,14 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
             }
             let first = material(&list.get_item(0)?, at.key("materials").index(0))?;
             let second = material(&list.get_item(1)?, at.key("materials").index(1))?;
-            // The course model reads the larger part.
-            let mut m = if amount >= 0.5 { second.clone() } else { first.clone() };
+            // The course model reads the larger part (the first where a texture decides).
+            let mut m = match amount {
+                Param::Constant(a) if a.x >= 0.5 => second.clone(),
+                _ => first.clone(),
+            };
             m.mix = Some(Box::new(MixDesc {
                 materials: [first, second],
-                amount: Param::grey(amount),
+                amount,
             }));
             m
         }
@@ -505,15 +730,54 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
             )))
         }
     };
+    if roughness_map.is_some() {
+        if m.mix.is_some() {
+            return Err(at.key("roughness").error("a mix's roughness is its parts'"));
+        }
+        m.roughness_map = roughness_map;
+    }
+    // What the surface emits, its normal map and coat hold for a mix's parts too: the part
+    // shown at a point is what the light and camera paths see there.
     let emission = t.param("emission", Vec3::ZERO)?;
     if matches!(emission, Param::Constant(e) if e.min_element() < 0.0) {
         return Err(at.key("emission").error("a radiance is not negative"));
     }
     if emission != Param::grey(0.0) {
-        m.emissive = emission;
-        if !t.flag("two_sided", false)? {
-            m.emitting_faces = EmittingFaces::Front;
+        let faces = if t.flag("two_sided", false)? {
+            EmittingFaces::Both
+        } else {
+            EmittingFaces::Front
+        };
+        every_part(&mut m, &mut |p| {
+            p.emissive = emission.clone();
+            p.emitting_faces = faces;
+        });
+    }
+    if let Some(c) = t.get("clearcoat")? {
+        let (coat, maps) = clearcoat(&c, at.key("clearcoat"))?;
+        every_part(&mut m, &mut |p| {
+            p.clearcoat = Some(coat);
+            p.clearcoat_maps = maps.clone();
+        });
+    }
+    let coverage = t.param_encoded("coverage", Vec3::ONE, Encoding::Coverage)?;
+    let cutoff = match t.float("coverage_cutoff", -1.0)? {
+        c if c < 0.0 => None,
+        c if c <= 1.0 => Some(c),
+        c => {
+            return Err(at
+                .key("coverage_cutoff")
+                .error(format!("a cutoff between 0 and 1, not {c}")))
         }
+    };
+    match coverage {
+        Param::Constant(c) if c.x >= 1.0 => {}
+        Param::Constant(c) if c.x < 0.0 => {
+            return Err(at
+                .key("coverage")
+                .error(format!("a share between 0 and 1, not {}", c.x)))
+        }
+        coverage => m.alpha = Some(Alpha { coverage, cutoff }),
     }
     if let Some(n) = t.get("normal_map")? {
         let at = at.key("normal_map");
@@ -525,13 +789,60 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         spec.set_item("file", file)?;
         // Tangent-space normals are data: linear.
         let map = image_map(&spec, at.clone(), Encoding::Linear)?;
-        m.normal_map = Some(NormalMap { map, scale });
+        let normal_map = NormalMap { map, scale };
+        every_part(&mut m, &mut |p| p.normal_map = Some(normal_map.clone()));
     }
     t.done()?;
     Ok(m)
 }
 
-fn shape(value: &Bound<'_, PyAny>, at: At, materials: &HashMap<String, MaterialDesc>) -> PyResult<ObjectDesc> {
+/// Applies `f` to a material and, for a mix, to each of its parts.
+fn every_part(m: &mut MaterialDesc, f: &mut dyn FnMut(&mut MaterialDesc)) {
+    f(m);
+    if let Some(mix) = m.mix.as_mut() {
+        for part in &mut mix.materials {
+            every_part(part, f);
+        }
+    }
+}
+
+/// A clear coat: `{"weight": share, "roughness": r (α = r²), "ior": n}`, weight and roughness
+/// numbers or textures (linear; the weight's first channel, the roughness's second).
+fn clearcoat(value: &Bound<'_, PyAny>, at: At) -> PyResult<(ClearCoat, Option<ClearCoatMaps>)> {
+    let mut t = Table::new(value, at.clone())?;
+    let weight = t.share("weight", 1.0)?;
+    let roughness = t.share("roughness", 0.0)?;
+    let eta = t.float("ior", 1.5)?;
+    if eta < 1.0 {
+        return Err(at
+            .key("ior")
+            .error(format!("an index of refraction is at least 1, not {eta}")));
+    }
+    t.done()?;
+    let constant = |p: &Param| match p {
+        Param::Constant(c) => Some(c.x),
+        _ => None,
+    };
+    let r = constant(&roughness).unwrap_or(0.5);
+    let coat = ClearCoat {
+        weight: constant(&weight).unwrap_or(1.0),
+        eta,
+        alpha: r * r,
+    };
+    let maps = ClearCoatMaps {
+        weight: constant(&weight).is_none().then_some(weight),
+        roughness: constant(&roughness).is_none().then_some(roughness),
+    };
+    let any = maps.weight.is_some() || maps.roughness.is_some();
+    Ok((coat, any.then_some(maps)))
+}
+
+fn shape(
+    value: &Bound<'_, PyAny>,
+    at: At,
+    materials: &HashMap<String, MaterialDesc>,
+    meshes: &HashMap<String, TrimeshDesc>,
+) -> PyResult<ObjectDesc> {
     let mut t = Table::new(value, at.clone())?;
     let kind = t.string("type")?.ok_or_else(|| at.key("type").error("required"))?;
     let name = t
@@ -556,7 +867,18 @@ fn shape(value: &Bound<'_, PyAny>, at: At, materials: &HashMap<String, MaterialD
             (ShapeDesc::Sphere, placed * local)
         }
         "mesh" => (ShapeDesc::Trimesh(Box::new(mesh(&mut t, &at)?)), placed),
-        other => return Err(at.key("type").error(format!("\"mesh\" or \"sphere\", not \"{other}\""))),
+        "instance" => {
+            let name = t.string("mesh")?.ok_or_else(|| at.key("mesh").error("required"))?;
+            let mesh = meshes
+                .get(&name)
+                .ok_or_else(|| at.key("mesh").error(format!("no mesh named \"{name}\" in `meshes`")))?;
+            (ShapeDesc::Trimesh(Box::new(mesh.clone())), placed)
+        }
+        other => {
+            return Err(at
+                .key("type")
+                .error(format!("\"mesh\", \"instance\" or \"sphere\", not \"{other}\"")))
+        }
     };
     t.done()?;
     Ok(ObjectDesc {
@@ -631,13 +953,30 @@ fn mesh(t: &mut Table, at: &At) -> PyResult<TrimeshDesc> {
         }
         None => None,
     };
+    let tangents = match t.get("tangents")? {
+        Some(v) => {
+            let a = array(&v, 4, &at.key("tangents"))?;
+            let s = a.as_slice().map_err(|_| at.key("tangents").error("not contiguous"))?;
+            let tangents: Vec<Vec4> = s.chunks_exact(4).map(Vec4::from_slice).collect();
+            if tangents.len() != n {
+                return Err(at
+                    .key("tangents")
+                    .error(format!("{} rows for {n} vertices", tangents.len())));
+            }
+            if let Some(i) = tangents.iter().position(|v| !v.is_finite()) {
+                return Err(at.key("tangents").index(i).error("not finite"));
+            }
+            Some(tangents)
+        }
+        None => None,
+    };
     Ok(TrimeshDesc {
         points,
         triangles,
         normals,
         materials: None,
         uvs,
-        tangents: None,
+        tangents,
     })
 }
 
@@ -711,20 +1050,37 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
             if u.cross(v).length_squared() == 0.0 {
                 return Err(at.error("the edges `u` and `v` span no area"));
             }
+            let shape = match t.string("shape")?.as_deref() {
+                None | Some("rectangle") => SoftShapeDesc::Parallelogram { corner, u, v },
+                Some("ellipse") => SoftShapeDesc::Ellipse { corner, u, v },
+                Some(other) => {
+                    return Err(at
+                        .key("shape")
+                        .error(format!("\"rectangle\" or \"ellipse\", not \"{other}\"")))
+                }
+            };
             LightDesc::Soft {
-                shape: SoftShapeDesc::Parallelogram { corner, u, v },
+                shape,
                 color: t.colour("radiance", Vec3::ONE)?,
                 attenuation: [0.0, 0.0, 1.0],
                 span,
             }
         }
-        "environment" => LightDesc::Environment {
-            color: t.colour("radiance", Vec3::ONE)?,
-            map: t.string("file")?.map(Into::into),
-            rotation: Mat3::IDENTITY,
-            equal_area: false,
-            span,
-        },
+        "environment" => {
+            let color = t.colour("radiance", Vec3::ONE)?;
+            let map = image_source(&mut t, &at)?;
+            let rotation = match t.get("rotation")? {
+                Some(r) => rotation(&r, &at.key("rotation"))?,
+                None => Mat3::IDENTITY,
+            };
+            LightDesc::Environment {
+                color,
+                map,
+                rotation,
+                equal_area: false,
+                span,
+            }
+        }
         other => {
             return Err(at.key("type").error(format!(
                 "\"point\", \"spot\", \"sun\", \"area\" or \"environment\", not \"{other}\""

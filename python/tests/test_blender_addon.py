@@ -231,3 +231,177 @@ def test_a_glass_ball_built_in_blender_renders_as_its_gltf_export_and_a_textured
     quarters = {"bottom-left": checker[30:36, 4:10], "bottom-right": checker[30:36, 30:36]}
     assert quarters["bottom-left"].mean() == pytest.approx(srgb(200) / math.pi * e, rel=0.01)
     assert quarters["bottom-right"].mean() == pytest.approx(srgb(50) / math.pi * e, rel=0.01)
+
+
+# The sky and the camera: an equirectangular HDR whose red grows with u and green with v, seen
+# through a camera turned off the axes, by caustica and by Cycles; then with lens shift, and a
+# render border.
+SKY = r"""
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+w, h = 256, 128
+sky = bpy.data.images.new("sky", width=w, height=h, float_buffer=True)
+px = []
+for j in range(h):
+    for i in range(w):
+        px += [0.2 + (i + 0.5) / w, 0.2 + (j + 0.5) / h, 0.5, 1.0]
+sky.pixels = px
+sky.filepath_raw = OUT + "sky.exr"
+sky.file_format = "OPEN_EXR"
+sky.save()
+world = bpy.data.worlds.new("World")
+world.use_nodes = True
+scene.world = world
+nodes = world.node_tree.nodes
+env = nodes.new("ShaderNodeTexEnvironment")
+env.image = bpy.data.images.load(OUT + "sky.exr")
+mapping = nodes.new("ShaderNodeMapping")
+mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30.0))
+coords = nodes.new("ShaderNodeTexCoord")
+world.node_tree.links.new(coords.outputs["Generated"], mapping.inputs["Vector"])
+world.node_tree.links.new(mapping.outputs["Vector"], env.inputs["Vector"])
+world.node_tree.links.new(env.outputs["Color"], nodes["Background"].inputs["Color"])
+nodes["Background"].inputs["Strength"].default_value = 2.0
+camera(scene, (0.0, 0.0, 0.0), (math.radians(80.0), 0.0, math.radians(20.0)))
+caustica_settings(scene, "PATH", 16, 48, 32)
+for shift in (0.0, 0.2):
+    scene.camera.data.shift_x = shift
+    for engine in ("CAUSTICA", "CYCLES"):
+        scene.render.engine = engine
+        scene.cycles.samples = 64
+        scene.cycles.filter_width = 0.01
+        scene.cycles.use_denoising = False
+        scene.render.filepath = OUT + f"sky-{engine}-{shift}.exr"
+        bpy.ops.render.render(write_still=True)
+scene.render.engine = "CAUSTICA"
+scene.camera.data.shift_x = 0.0
+scene.render.use_border = True
+scene.render.use_crop_to_border = True
+scene.render.border_min_x, scene.render.border_max_x = 0.25, 0.75
+scene.render.border_min_y, scene.render.border_max_y = 0.5, 1.0
+scene.render.filepath = OUT + "sky-border.exr"
+bpy.ops.render.render(write_still=True)
+"""
+
+
+@pytest.mark.skipif(BLENDER is None, reason="blender is not on the PATH")
+def test_the_world_texture_lens_shift_and_border_match_cycles_and_the_whole_frame(tmp_path):
+    out = run_blender(tmp_path, SKY)
+    for shift in ("0.0", "0.2"):
+        ours = caustica.read_exr(out + f"sky-CAUSTICA-{shift}.exr")
+        cycles = caustica.read_exr(out + f"sky-CYCLES-{shift}.exr")
+        assert ours.shape == cycles.shape == (32, 48, 3)
+        # 4×4 blocks: both read the texture at each pixel's jittered points.
+        blocks = lambda a: a.reshape(8, 4, 12, 4, 3).mean(axis=(1, 3))  # noqa: E731
+        np.testing.assert_allclose(blocks(ours), blocks(cycles), rtol=0.01)
+    # The border's pixels are the whole frame's: columns 12–36, the top 16 rows.
+    border = caustica.read_exr(out + "sky-border.exr")
+    whole = caustica.read_exr(out + "sky-CAUSTICA-0.0.exr")
+    assert border.shape == (16, 24, 3)
+    np.testing.assert_allclose(border.mean(axis=(0, 1)), whole[:16, 12:36].mean(axis=(0, 1)), rtol=0.002)
+    np.testing.assert_allclose(border, whole[:16, 12:36], rtol=0.03)
+
+
+# Principled inputs beyond the base: alpha, clear coat, a roughness texture through Separate
+# RGB (as the glTF importer links one); the Add shader; linked duplicates sharing one mesh.
+MATERIALS = r"""
+def plane_scene(setup):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    scene.world = world
+    bpy.ops.mesh.primitive_plane_add(size=40.0)
+    m = bpy.data.materials.new("M")
+    m.use_nodes = True
+    setup(m.node_tree)
+    bpy.context.object.data.materials.append(m)
+    camera(scene, (0.0, 0.0, 3.0))
+    scene.camera.data.lens = 200.0
+    caustica_settings(scene, "PATH", 16, 16, 16)
+    return scene
+
+def principled(tree, **inputs):
+    p = tree.nodes["Principled BSDF"]
+    for k, v in inputs.items():
+        p.inputs[k].default_value = v
+    return p
+
+def alpha(tree):
+    principled(tree, **{"Base Color": (0, 0, 0, 1), "Specular": 0.0, "Alpha": 0.25})
+
+def clearcoat(tree):
+    principled(tree, **{"Base Color": (0, 0, 0, 1), "Specular": 0.0, "Clearcoat": 1.0, "Clearcoat Roughness": 0.0})
+
+def added(tree):
+    nodes = tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    d = nodes.new("ShaderNodeBsdfDiffuse")
+    d.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1)
+    e = nodes.new("ShaderNodeEmission")
+    e.inputs["Strength"].default_value = 1.0
+    a = nodes.new("ShaderNodeAddShader")
+    tree.links.new(d.outputs[0], a.inputs[0])
+    tree.links.new(e.outputs[0], a.inputs[1])
+    tree.links.new(a.outputs[0], nodes["Material Output"].inputs["Surface"])
+
+def metal(tree, textured):
+    p = principled(tree, **{"Base Color": (0.9, 0.6, 0.3, 1), "Metallic": 1.0, "Roughness": 0.4})
+    if textured:
+        image = bpy.data.images.new("mr", width=4, height=4)
+        image.colorspace_settings.name = "Non-Color"
+        image.pixels = [0.0, 0.4, 1.0, 1.0] * 16
+        t = tree.nodes.new("ShaderNodeTexImage")
+        t.image = image
+        s = tree.nodes.new("ShaderNodeSeparateRGB")
+        tree.links.new(t.outputs["Color"], s.inputs[0])
+        tree.links.new(s.outputs["G"], p.inputs["Roughness"])
+        tree.links.new(s.outputs["B"], p.inputs["Metallic"])
+
+for name, setup in [("alpha", alpha), ("clearcoat", clearcoat), ("add", added),
+                    ("metal", lambda t: metal(t, False)), ("metal-textured", lambda t: metal(t, True))]:
+    scene = plane_scene(setup)
+    if name.startswith("metal"):
+        sun = bpy.data.objects.new("Sun", bpy.data.lights.new("Sun", type="SUN"))
+        sun.data.energy = 3.0
+        sun.rotation_euler = (math.radians(5.0), 0.0, 0.0)
+        scene.collection.objects.link(sun)
+        scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.1, 0.1, 0.1, 1.0)
+    scene.render.filepath = OUT + name + ".exr"
+    bpy.ops.render.render(write_still=True)
+
+# Linked duplicates: three objects, one mesh.
+from caustica_blender.convert import Conversion
+bpy.ops.wm.read_factory_settings(use_empty=True)
+scene = bpy.context.scene
+bpy.ops.mesh.primitive_ico_sphere_add(radius=0.5, location=(-1.5, 0.0, 0.0))
+first = bpy.context.object
+for x in (0.0, 1.5):
+    copy = first.copy()
+    copy.location.x = x
+    scene.collection.objects.link(copy)
+camera(scene, (0.0, 0.0, 6.0))
+depsgraph = bpy.context.evaluated_depsgraph_get()
+d = Conversion(depsgraph, 16, 16).run()
+json.dump({"meshes": len(d["meshes"]), "shapes": len(d["shapes"])}, open(OUT + "instances.json", "w"))
+"""
+
+
+@pytest.mark.skipif(BLENDER is None, reason="blender is not on the PATH")
+def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_blender_means_them(tmp_path):
+    out = run_blender(tmp_path, MATERIALS)
+    centre = lambda name: caustica.read_exr(out + name + ".exr")[4:12, 4:12].mean()  # noqa: E731
+    # A black plane of alpha ¼ over a white world: ¾ of the world through it.
+    assert centre("alpha") == pytest.approx(0.75, rel=0.02)
+    # A clear coat of index 1.5 on black, head-on under a white world: ¼ · F(0) = 0.01 (Cycles'
+    # Disney coat is a quarter of its input).
+    assert centre("clearcoat") == pytest.approx(0.01, rel=0.02)
+    # Diffuse ½ plus emission 1 under a white world: 1 + ½.
+    assert centre("add") == pytest.approx(1.5, rel=0.02)
+    # Roughness 0.4 and metal 1 from an image's green and blue render as the same inputs set.
+    np.testing.assert_allclose(
+        caustica.read_exr(out + "metal-textured.exr"), caustica.read_exr(out + "metal.exr"), rtol=1e-4, atol=1e-6
+    )
+    # Three objects of one mesh: its arrays once, three shapes placing them.
+    assert json.load(open(out + "instances.json")) == {"meshes": 1, "shapes": 3}

@@ -192,3 +192,214 @@ def test_a_mix_blends_its_two_materials_in_the_mean():
     )
     image = caustica.render(scene, integrator="path", passes=64, seed=2)
     assert image.mean() == pytest.approx(0.6, rel=0.02)
+
+
+def quad(material, size=5.0, z=0.0):
+    s = size
+    return {
+        "type": "mesh",
+        "positions": [[-s, -s, z], [s, -s, z], [s, s, z], [-s, s, z]],
+        "uvs": [[0, 0], [1, 0], [1, 1], [0, 1]],
+        "indices": [[0, 1, 2], [0, 2, 3]],
+        "material": material,
+    }
+
+
+def looking_down(materials, shapes, lights, size=16, fov=30):
+    return {
+        "camera": {"eye": [0, 0, 2], "look_at": [0, 0, 0], "up": [0, 1, 0], "fov": fov, "width": size, "height": size},
+        "materials": materials,
+        "shapes": shapes,
+        "lights": lights,
+    }
+
+
+SKY = [{"type": "environment", "radiance": 1}]
+
+
+def test_textures_from_arrays_render_as_the_same_image_files(tmp_path):
+    rows = [[(200, 30, 30), (30, 30, 200)], [(10, 220, 10), (250, 250, 250)]]
+    png(tmp_path / "tex.png", rows)
+    pixels = np.array(rows, dtype=np.uint8)
+    options = dict(integrator="path", passes=2, seed=1, threads=1)
+
+    def render(reflectance):
+        d = looking_down({"t": {"type": "diffuse", "reflectance": reflectance}}, [quad("t", 0.5)], SKY)
+        return caustica.render(caustica.Scene.from_dict(d), **options)
+
+    from_file = render({"file": str(tmp_path / "tex.png"), "filter": "nearest"})
+    # 8-bit arrays are stored values, sRGB-decoded as a colour file's are: the same pixels.
+    np.testing.assert_array_equal(render({"array": pixels, "filter": "nearest"}), from_file)
+    # Float arrays are linear values: the decoded texels give the same pixels again.
+    c = pixels / 255.0
+    linear = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4).astype(np.float32)
+    np.testing.assert_allclose(render({"array": linear, "filter": "nearest"}), from_file, rtol=1e-5, atol=1e-7)
+
+
+@pytest.mark.parametrize(
+    "texture, words",
+    [
+        ({"array": np.zeros((2, 2, 5))}, "1 to 4 channels"),
+        ({"array": np.zeros((2, 2), dtype=np.int32)}, "8- or 16-bit unsigned integers or floats"),
+        ({"array": np.full((2, 2), np.inf)}, "value 0 is not finite"),
+        ({"array": np.zeros((2, 2)), "file": "x.png"}, "a `file` or an `array`, not both"),
+    ],
+)
+def test_bad_pixel_arrays_are_named(texture, words):
+    d = looking_down({"t": {"type": "diffuse", "reflectance": texture}}, [quad("t")], SKY)
+    with pytest.raises((ValueError, TypeError)) as e:
+        caustica.Scene.from_dict(d)
+    assert "materials.t.reflectance" in str(e.value) and words in str(e.value)
+
+
+def test_instances_of_a_mesh_render_as_copies_of_its_arrays():
+    tri = {"positions": [[-1, -1, 0], [1, -1, 0], [0, 1, 0]], "indices": [[0, 1, 2]]}
+    left = np.array([[1, 0, 0, -1.2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+    right = np.array([[0.5, 0, 0, 1.2], [0, 0.5, 0, 0], [0, 0, 0.5, 0], [0, 0, 0, 1]])
+    materials = {"white": {"type": "diffuse", "reflectance": 0.8}}
+    lights = [{"type": "point", "position": [0, 0, 3], "intensity": 5}]
+    copies = looking_down(materials, [dict(tri, type="mesh", matrix=m, material="white") for m in (left, right)], lights, fov=80)
+    instances = looking_down(
+        materials, [{"type": "instance", "mesh": "tri", "matrix": m, "material": "white"} for m in (left, right)], lights, fov=80
+    )
+    instances["meshes"] = {"tri": tri}
+    options = dict(integrator="path", passes=2, seed=1, threads=1)
+    a = caustica.render(caustica.Scene.from_dict(copies), **options)
+    assert a.max() > 0
+    np.testing.assert_array_equal(caustica.render(caustica.Scene.from_dict(instances), **options), a)
+    instances["shapes"][0]["mesh"] = "square"
+    with pytest.raises(ValueError, match=r'shapes\[0\]\.mesh: no mesh named "square"'):
+        caustica.Scene.from_dict(instances)
+
+
+def sky_array():
+    """A smooth latitude–longitude sky: red grows with u, green with v, blue constant."""
+    h, w = 64, 128
+    u = (np.arange(w) + 0.5) / w
+    v = (np.arange(h) + 0.5) / h
+    sky = np.empty((h, w, 3), dtype=np.float32)
+    sky[..., 0] = 0.2 + u[None, :]
+    sky[..., 1] = 0.2 + v[:, None]
+    sky[..., 2] = 0.5
+    return sky
+
+
+def sky_at(direction):
+    """The sky's value along a world direction (caustica's map frame: +y up, the centre −z, u
+    = 0.75 towards +x), bilinear as the texture reads it (away from the seam)."""
+    d = direction / np.linalg.norm(direction)
+    u = (0.5 + np.arctan2(d[0], -d[2]) / (2 * np.pi)) % 1.0
+    v = np.arccos(np.clip(d[1], -1, 1)) / np.pi
+    return np.array([0.2 + u, 0.2 + v, 0.5])
+
+
+def test_an_environment_from_an_array_is_seen_along_each_pixels_direction_turned_by_its_rotation():
+    # A quarter turn about y: the map's −z looks along −x.
+    rotation = np.array([[0, 0, 1], [0, 1, 0], [-1, 0, 0]], dtype=np.float64)
+    for r in (None, rotation):
+        light = {"type": "environment", "array": sky_array()}
+        if r is not None:
+            light["rotation"] = r
+        d = {
+            "camera": {"eye": [0, 0, 0], "look_at": [0.3, 0.2, -1], "fov": 40, "width": 24, "height": 16},
+            "lights": [light],
+        }
+        image = caustica.render(caustica.Scene.from_dict(d), integrator="path", passes=16, seed=1, threads=1)
+        # The pixel centres' directions, as the camera spans them (right-handed, +y up).
+        view = np.array([0.3, 0.2, -1.0]) / np.linalg.norm([0.3, 0.2, -1.0])
+        right = np.cross(view, [0, 1, 0])
+        right /= np.linalg.norm(right)
+        up = np.cross(right, view)
+        h = 2 * np.tan(np.radians(20))
+        for y, x in [(2, 3), (8, 12), (13, 20)]:
+            sx, sy = (x + 0.5) / 24 - 0.5, 0.5 - (y + 0.5) / 16
+            world = view + right * sx * h * 1.5 + up * sy * h
+            local = world if r is None else r.T @ world
+            np.testing.assert_allclose(image[y, x], sky_at(local), rtol=0.01)
+
+
+def test_lens_shift_and_crop_show_the_pixels_of_a_wider_and_a_whole_image():
+    sky = {"type": "environment", "array": sky_array()}
+
+    def render(**camera):
+        d = {"camera": dict({"eye": [0, 0, 0], "look_at": [0, 0.1, -1], "fov": 40}, **camera), "lights": [sky]}
+        return caustica.render(caustica.Scene.from_dict(d), integrator="path", passes=16, seed=1, threads=1)
+
+    def same_view(a, b):
+        # The sky's texels are read unfiltered: a pixel across a texel edge shows each side
+        # in the share its jittered samples fall on, up to a few percent apart in 16 passes;
+        # a view off by a pixel would be off by its gradient, 4% in red across the image.
+        np.testing.assert_allclose(a, b, rtol=0.02)
+        np.testing.assert_allclose(a.mean(axis=(0, 1)), b.mean(axis=(0, 1)), rtol=0.002)
+
+    wide = render(width=64, height=24)
+    # A quarter of the image's width to the right: pixels 24–56 of an image twice as wide.
+    same_view(render(width=32, height=24, shift=[0.25, 0.0]), wide[:, 24:56])
+    # A crop: the same pixels as the whole image's.
+    cropped = render(width=64, height=24, crop=[10, 30, 4, 20])
+    assert cropped.shape == (16, 20, 3)
+    same_view(cropped, wide[4:20, 10:30])
+    with pytest.raises(ValueError, match=r"camera\.crop: \[x begin, x end, y begin, y end\] within the 64×24 image"):
+        render(width=64, height=24, crop=[10, 70, 4, 20])
+
+
+def test_coverage_lets_the_sky_through_in_proportion():
+    # A black quad of coverage ¼ over a sky of radiance 1, seen from above: ¾ of the sky.
+    for coverage in (0.25, {"array": np.full((4, 4), 0.25, dtype=np.float32), "encoding": "linear"}):
+        d = looking_down({"black": {"type": "diffuse", "reflectance": 0, "coverage": coverage}}, [quad("black")], SKY)
+        image = caustica.render(caustica.Scene.from_dict(d), integrator="path", passes=64, seed=2)
+        assert image.mean() == pytest.approx(0.75, rel=0.02)
+
+
+def test_roughness_and_mix_shares_from_textures_are_their_values_point_by_point():
+    options = dict(integrator="path", passes=4, seed=3, threads=1)
+    lights = [{"type": "point", "position": [0.5, 0.3, 1.5], "intensity": 3}]
+
+    def render(material):
+        d = looking_down({"m": material}, [quad("m")], lights)
+        return caustica.render(caustica.Scene.from_dict(d), **options)
+
+    flat = lambda v: {"array": np.full((4, 4), v, dtype=np.float32), "encoding": "linear"}  # noqa: E731
+    metal = {"type": "conductor", "reflectance": 0.9}
+    a = render(dict(metal, roughness=0.5))
+    assert a.max() > 0
+    np.testing.assert_allclose(render(dict(metal, roughness=flat(0.5))), a, rtol=1e-5, atol=1e-7)
+    parts = [{"type": "diffuse", "reflectance": 0.8}, dict(metal, roughness=0.3)]
+    b = render({"type": "mix", "amount": 0.25, "materials": parts})
+    np.testing.assert_array_equal(render({"type": "mix", "amount": flat(0.25), "materials": parts}), b)
+
+
+def test_a_clear_coat_reflects_its_weight_times_fresnel():
+    # Black under a smooth coat of index 1.5, seen head-on under a sky of radiance 1: it
+    # reflects F(0) = 0.04 of the sky times the weight (the view's 5° off the normal change F
+    # by under 0.1%).
+    for weight in (1.0, 0.5):
+        m = {"type": "diffuse", "reflectance": 0, "clearcoat": {"weight": weight, "roughness": 0, "ior": 1.5}}
+        d = looking_down({"m": m}, [quad("m")], SKY, fov=10)
+        image = caustica.render(caustica.Scene.from_dict(d), integrator="path", passes=16, seed=2)
+        assert image.mean() == pytest.approx(0.04 * weight, rel=0.01)
+
+
+def test_a_mix_emits_what_it_says_whichever_part_a_point_shows():
+    parts = [{"type": "diffuse", "reflectance": 0}, {"type": "conductor", "reflectance": 0.0}]
+    m = {"type": "mix", "amount": 0.5, "materials": parts, "emission": 2.0, "two_sided": True}
+    d = looking_down({"m": m}, [quad("m")], [])
+    image = caustica.render(caustica.Scene.from_dict(d), integrator="path", passes=4, seed=2)
+    np.testing.assert_allclose(image, 2.0, rtol=1e-6)
+
+
+def test_render_settings_in_the_dict_are_the_renders_defaults():
+    d = description()
+    d["render"] = {"integrator": "ppm", "passes": 3, "photons": 20_000, "max_depth": 4}
+    scene = caustica.Scene.from_dict(d)
+    with caustica.progressive(scene, threads=1, seed=1) as run:
+        images = list(run)
+    assert len(images) == 3
+    plain = caustica.Scene.from_dict(description())
+    np.testing.assert_array_equal(
+        images[-1],
+        caustica.render(plain, integrator="ppm", passes=3, photons=20_000, depth=3, threads=1, seed=1),
+    )
+    d["render"]["integrator"] = "bdpt"
+    with pytest.raises(ValueError, match=r'render\.integrator: "path", "ppm", "lt" or "vcm", not "bdpt"'):
+        caustica.Scene.from_dict(d)

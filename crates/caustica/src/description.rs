@@ -184,8 +184,9 @@ pub enum LightDesc {
     Environment {
         /// Radiance scale.
         color: Vec3,
-        /// The image (EXR or Radiance HDR), resolved against the scene's folder.
-        map: Option<PathBuf>,
+        /// The image (EXR, Radiance HDR or PFM, or pixels given as numbers), a file resolved
+        /// against the scene's folder.
+        map: Option<ImageSource>,
         /// The image's frame turned into the world's (a rotation; identity: +y up, the image's
         /// centre towards −z).
         rotation: glam::Mat3,
@@ -212,6 +213,17 @@ pub enum SoftShapeDesc {
         /// One corner.
         corner: Vec3,
         /// First edge.
+        u: Vec3,
+        /// Second edge.
+        v: Vec3,
+    },
+    /// The ellipse inscribed in the parallelogram `corner + s·u + t·v`: its centre
+    /// `corner + (u + v)/2`, its half-axes u/2 and v/2; lit on the side u × v points to
+    /// (Blender's disk and ellipse area lights).
+    Ellipse {
+        /// The parallelogram's corner.
+        corner: Vec3,
+        /// First edge (a diameter's length and direction).
         u: Vec3,
         /// Second edge.
         v: Vec3,
@@ -388,8 +400,31 @@ impl<P> ClearCoatMaps<P> {
 pub struct RoughnessMap<P = Param> {
     /// The texture (its x channel).
     pub texture: P,
-    /// α = √value rather than the value.
-    pub remap: bool,
+    /// How the value becomes α.
+    pub remap: RoughnessRemap,
+}
+
+/// How a roughness texture's value r becomes the GGX α.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RoughnessRemap {
+    /// α = r (pbrt without `remaproughness`).
+    Alpha,
+    /// α = √r (pbrt's `remaproughness`).
+    Sqrt,
+    /// α = r² (Blender's and glTF's perceptual roughness).
+    Square,
+}
+
+impl RoughnessRemap {
+    /// The α of a texture value `r` (≥ 0).
+    #[inline]
+    pub fn alpha(self, r: f32) -> f32 {
+        match self {
+            RoughnessRemap::Alpha => r,
+            RoughnessRemap::Sqrt => r.sqrt(),
+            RoughnessRemap::Square => r * r,
+        }
+    }
 }
 
 /// pbrt's `mix` material: at each point the second material with probability `amount` (its

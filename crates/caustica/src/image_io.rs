@@ -23,16 +23,34 @@ pub fn load_texture(path: &Path) -> Result<Texture> {
     Ok(Texture::sampled(Arc::new(image), Sampler::default()))
 }
 
+/// Loads an environment map (a file, bytes or pixels given as numbers) as [`load_texture`] does.
+pub fn load_environment(source: &ImageSource) -> Result<Texture> {
+    let image = load_image(source, Encoding::Linear)?;
+    Ok(Texture::sampled(Arc::new(image), Sampler::default()))
+}
+
 /// Decodes an image from a file or from bytes held in a scene file into linear values:
 /// integer images through `encoding`, float images (EXR, HDR) as stored.
 pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
     let image_error = |message: String| Error::Image {
         path: match source {
             ImageSource::File(path) => path.clone(),
-            ImageSource::Memory { name, .. } => PathBuf::from(name),
+            ImageSource::Memory { name, .. } | ImageSource::Pixels { name, .. } => PathBuf::from(name),
         },
         message,
     };
+    if let ImageSource::Pixels {
+        width,
+        height,
+        channels,
+        values,
+        integer,
+        ..
+    } = source
+    {
+        let texels = pixels(*width, *height, *channels, values, *integer, encoding).map_err(image_error)?;
+        return Image::new(*width, *height, texels).ok_or_else(|| image_error("the image is empty".into()));
+    }
     // PFM, which the image crate does not read: floats, linear as they are.
     let pfm = match source {
         ImageSource::File(path) => {
@@ -45,6 +63,7 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
             }
         }
         ImageSource::Memory { bytes, .. } => pfm::is_pfm(bytes).then(|| bytes.to_vec()),
+        ImageSource::Pixels { .. } => None,
     };
     let (w, h, texels) = match pfm {
         Some(bytes) => {
@@ -64,6 +83,62 @@ pub fn load_image(source: &ImageSource, encoding: Encoding) -> Result<Image> {
         _ => texels,
     };
     Image::new(w, h, texels).ok_or_else(|| image_error("the image is empty".into()))
+}
+
+/// Linear texels of pixels given as numbers: integer values (over their largest) through
+/// `encoding`, float values as they are; coverage from the alpha channel (2 or 4 channels),
+/// else 1; a mask's from alpha, else luminance.
+fn pixels(
+    width: usize,
+    height: usize,
+    channels: usize,
+    values: &[f32],
+    integer: bool,
+    encoding: Encoding,
+) -> std::result::Result<Vec<Vec3>, String> {
+    if !(1..=4).contains(&channels) {
+        return Err(format!("an image has 1 to 4 channels, not {channels}"));
+    }
+    if values.len() != width * height * channels {
+        return Err(format!(
+            "{} values for {width}×{height} pixels of {channels} channels",
+            values.len()
+        ));
+    }
+    if (width * height) as u64 > MAX_TEXTURE_PIXELS {
+        return Err(format!(
+            "the image is {width}×{height}, too large: at most {MAX_TEXTURE_PIXELS} pixels are accepted"
+        ));
+    }
+    let alpha = |p: &[f32]| match channels {
+        2 => Some(p[1]),
+        4 => Some(p[3]),
+        _ => None,
+    };
+    let colour = |p: &[f32]| {
+        let c = if channels >= 3 {
+            Vec3::new(p[0], p[1], p[2])
+        } else {
+            Vec3::splat(p[0])
+        };
+        if integer {
+            Vec3::new(
+                encoding.to_linear(c.x),
+                encoding.to_linear(c.y),
+                encoding.to_linear(c.z),
+            )
+        } else {
+            c
+        }
+    };
+    Ok(values
+        .chunks_exact(channels)
+        .map(|p| match encoding {
+            Encoding::Coverage => Vec3::splat(alpha(p).unwrap_or(1.0)),
+            Encoding::Mask => Vec3::splat(alpha(p).unwrap_or_else(|| texel_luminance(colour(p)))),
+            _ => colour(p),
+        })
+        .collect())
 }
 
 /// Decodes the formats the image crate reads: width, height and linear texels (rows from the top).
@@ -91,6 +166,8 @@ fn decode_with_image_crate(
             check_size(reader()?.into_dimensions().map_err(|e| image_error(e.to_string()))?).map_err(image_error)?;
             reader()?.decode()
         }
+        // Read by `pixels`, never here.
+        ImageSource::Pixels { .. } => return Err(image_error("not an encoded image".into())),
     };
     let img = decoded.map_err(|e| image_error(e.to_string()))?;
     let (w, h) = (img.width() as usize, img.height() as usize);

@@ -338,7 +338,7 @@ impl Material {
         let mut physical = physical.try_map(|c| Ok::<Vec3, ()>(c.eval(textures, uv))).ok()?;
         if let Some(map) = &self.roughness_map {
             let r = map.texture.eval(textures, uv).x.max(0.0);
-            let alpha = if map.remap { r.sqrt() } else { r };
+            let alpha = map.remap.alpha(r);
             match &mut physical {
                 PhysicalMaterial::Conductor { roughness, .. } | PhysicalMaterial::CoatedDiffuse { roughness, .. } => {
                     *roughness = alpha

@@ -20,6 +20,23 @@ pub enum ImageSource {
         /// The encoded image (PNG, JPEG, …).
         bytes: std::sync::Arc<[u8]>,
     },
+    /// Pixels given as numbers (an array from Python), rows from the top, `channels` values a
+    /// pixel (1 grey, 2 grey and alpha, 3 RGB, 4 RGBA).
+    Pixels {
+        /// The name messages use.
+        name: String,
+        /// Pixels per row.
+        width: usize,
+        /// Rows.
+        height: usize,
+        /// Values per pixel, 1 to 4.
+        channels: usize,
+        /// The values: for an integer array, stored over its largest value (so in [0, 1]) and
+        /// decoded by the map's encoding; for a float array, linear as they are.
+        values: std::sync::Arc<[f32]>,
+        /// Whether the values came from integers (decoded by the encoding) or floats (linear).
+        integer: bool,
+    },
 }
 
 impl ImageSource {
@@ -27,7 +44,7 @@ impl ImageSource {
     pub fn name(&self) -> String {
         match self {
             ImageSource::File(path) => path.display().to_string(),
-            ImageSource::Memory { name, .. } => name.clone(),
+            ImageSource::Memory { name, .. } | ImageSource::Pixels { name, .. } => name.clone(),
         }
     }
 }

@@ -22,8 +22,8 @@ use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
     Alpha, CameraDesc, ClearCoat, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, MixDesc,
-    NormalMap, ObjectDesc, Param, PhysicalMaterial, RoughnessMap, SceneDescription, ShapeDesc, TrimeshDesc,
-    SMOOTH_ALPHA,
+    NormalMap, ObjectDesc, Param, PhysicalMaterial, RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc,
+    TrimeshDesc, SMOOTH_ALPHA,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
@@ -887,7 +887,11 @@ impl<'f> Reader<'f> {
         }
         Ok(Some(RoughnessMap {
             texture,
-            remap: params.bool_or("remaproughness", true)?,
+            remap: if params.bool_or("remaproughness", true)? {
+                RoughnessRemap::Sqrt
+            } else {
+                RoughnessRemap::Alpha
+            },
         }))
     }
 
@@ -1577,7 +1581,7 @@ impl<'f> Reader<'f> {
                 let map = file.map(|(name, s)| (self.dir.join(name), s));
                 Some(LightDesc::Environment {
                     color,
-                    map: map.as_ref().map(|m| m.0.clone()),
+                    map: map.as_ref().map(|m| ImageSource::File(m.0.clone())),
                     rotation: orthonormal(rotation),
                     equal_area: map.is_some(),
                     span: map.map_or(span.clone(), |m| m.1),

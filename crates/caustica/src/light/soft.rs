@@ -35,7 +35,8 @@ pub enum SoftShape {
         /// Radius (positive).
         radius: f32,
     },
-    /// `corner + s·u + t·v`, lit on the side of `normal` = (u × v)/|u × v|.
+    /// `corner + s·u + t·v`, lit on the side of `normal` = (u × v)/|u × v|; with `ellipse`,
+    /// the ellipse inscribed in it.
     Parallelogram {
         /// One corner.
         corner: Vec3,
@@ -47,6 +48,8 @@ pub enum SoftShape {
         normal: Vec3,
         /// Area.
         area: f32,
+        /// The inscribed ellipse rather than the whole parallelogram.
+        ellipse: bool,
     },
 }
 
@@ -84,10 +87,22 @@ impl SoftLight {
                 v,
                 normal: n / area,
                 area,
+                ellipse: false,
             },
             color,
             attenuation,
         })
+    }
+
+    /// The ellipse inscribed in the parallelogram `corner + s·u + t·v`, lit on the side
+    /// u × v points to; `None` if the edges span no area.
+    pub fn ellipse(corner: Vec3, u: Vec3, v: Vec3, color: Vec3, attenuation: [f32; 3]) -> Option<SoftLight> {
+        let mut light = SoftLight::parallelogram(corner, u, v, color, attenuation)?;
+        if let SoftShape::Parallelogram { area, ellipse, .. } = &mut light.shape {
+            *area *= 0.25 * PI;
+            *ellipse = true;
+        }
+        Some(light)
     }
 
     /// The centre: where the course model shades from.
@@ -160,8 +175,9 @@ impl SoftLight {
                 u: eu,
                 v: ev,
                 normal,
+                ellipse,
                 ..
-            } => (corner + eu * u.x + ev * u.y, normal),
+            } => (parallelogram_point(corner, eu, ev, ellipse, u), normal),
         };
         SoftPoint {
             point,
@@ -233,6 +249,17 @@ impl SoftLight {
     }
 }
 
+/// The point at `s` ∈ [0, 1]² of a parallelogram, or of the ellipse inscribed in it (uniform by
+/// area either way).
+fn parallelogram_point(corner: Vec3, u: Vec3, v: Vec3, ellipse: bool, s: Vec2) -> Vec3 {
+    if ellipse {
+        let d = sample_uniform_disc(s);
+        corner + 0.5 * (u + v) + 0.5 * (u * d.x + v * d.y)
+    } else {
+        corner + u * s.x + v * s.y
+    }
+}
+
 /// The points shadow rays aim at (see [`SoftLight::shadow_targets`]).
 #[derive(Clone, Debug)]
 pub struct ShadowTargets {
@@ -260,8 +287,12 @@ impl Iterator for ShadowTargets {
                 center + self.frame.x * d.x + self.frame.y * d.y
             }
             SoftShape::Parallelogram {
-                corner, u: eu, v: ev, ..
-            } => corner + eu * u.x + ev * u.y,
+                corner,
+                u: eu,
+                v: ev,
+                ellipse,
+                ..
+            } => parallelogram_point(corner, eu, ev, ellipse, u),
         })
     }
 }
@@ -406,5 +437,36 @@ mod tests {
                 .is_none(),
             "back face"
         );
+    }
+
+    /// A disc of radius R and radiance L seen from its axis at height h gives the irradiance
+    /// π L R²/(h² + R²) exactly; its points lie on the disc, and its area is π R².
+    #[test]
+    fn an_ellipse_light_is_the_disc_inscribed_in_its_square() {
+        let (r, h, l) = (1.0f32, 2.0f32, 3.0f32);
+        let light = SoftLight::ellipse(
+            Vec3::new(-r, -r, h),
+            Vec3::new(0.0, 2.0 * r, 0.0),
+            Vec3::new(2.0 * r, 0.0, 0.0),
+            Vec3::splat(l),
+            [0.0, 0.0, 1.0],
+        )
+        .unwrap();
+        assert!((light.area() - PI * r * r).abs() < 1e-5);
+        let mut rng = Rng::new(7, 0);
+        let count = 100_000;
+        let mut sum = 0.0f64;
+        for _ in 0..count {
+            let (s, pdf) = light.sample_towards(Vec3::ZERO, rng.uniform2()).unwrap();
+            assert!(s.point.truncate().length() <= r * 1.0001 && (s.point.z - h).abs() < 1e-6);
+            let wi = s.point.normalize();
+            sum += (s.radiance.x * wi.z / pdf) as f64;
+        }
+        let exact = (PI * l * r * r / (h * h + r * r)) as f64;
+        let estimate = sum / count as f64;
+        assert!((estimate / exact - 1.0).abs() < 0.005, "{estimate} against {exact}");
+        assert!(light
+            .shadow_targets(Vec3::ZERO)
+            .all(|p| p.truncate().length() <= r * 1.0001));
     }
 }

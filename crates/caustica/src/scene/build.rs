@@ -169,13 +169,13 @@ fn convert_light(light: &LightDesc, warnings: &mut Vec<String>) -> Result<Option
         } => {
             let texture = match map {
                 None => None,
-                Some(path) => Some(image_io::load_texture(path).map_err(|e| {
+                Some(source) => Some(image_io::load_environment(source).map_err(|e| {
                     let reason = match e {
                         Error::Image { message, .. } => message,
                         other => other.to_string(),
                     };
                     ParseError::new(
-                        format!("cannot read the environment map `{}`: {reason}", path.display()),
+                        format!("cannot read the environment map `{}`: {reason}", source.name()),
                         span.clone(),
                     )
                     .with_help("environment maps are EXR, Radiance HDR or PFM images in latitude–longitude layout, resolved against the scene file's folder")
@@ -209,6 +209,10 @@ fn convert_light(light: &LightDesc, warnings: &mut Vec<String>) -> Result<Option
             })),
             SoftShapeDesc::Parallelogram { corner, u, v } => Some(Light::Soft(
                 SoftLight::parallelogram(corner, u, v, *color, *attenuation)
+                    .ok_or_else(|| ParseError::new("the area light's edges `u` and `v` span no area", span.clone()))?,
+            )),
+            SoftShapeDesc::Ellipse { corner, u, v } => Some(Light::Soft(
+                SoftLight::ellipse(corner, u, v, *color, *attenuation)
                     .ok_or_else(|| ParseError::new("the area light's edges `u` and `v` span no area", span.clone()))?,
             )),
         },

@@ -337,7 +337,8 @@ impl Scene {
                 Light::Soft(soft) => Some(LightSummary::Soft {
                     shape: match soft.shape {
                         crate::light::soft::SoftShape::Sphere { .. } => "ball",
-                        crate::light::soft::SoftShape::Parallelogram { .. } => "parallelogram",
+                        crate::light::soft::SoftShape::Parallelogram { ellipse: false, .. } => "parallelogram",
+                        crate::light::soft::SoftShape::Parallelogram { ellipse: true, .. } => "ellipse",
                     },
                     center: soft.center().to_array(),
                     area: soft.area(),

@@ -470,7 +470,7 @@ impl LightFields {
         };
         // The parallelogram's fork divides by d² + 0.01 (its LIGHT_EPSILON) whatever the dialect.
         let falloff = match shape {
-            SoftShapeDesc::Parallelogram { .. } => [0.01, 0.0, 1.0],
+            SoftShapeDesc::Parallelogram { .. } | SoftShapeDesc::Ellipse { .. } => [0.01, 0.0, 1.0],
             SoftShapeDesc::Sphere { .. } => falloff,
         };
         Ok(LightDesc::Soft {

@@ -872,7 +872,7 @@ impl<'a> Parser<'a> {
                 p.key_equals()?;
                 if key == "map" {
                     let (file, _) = p.identifier("(the image file, in quotes) for `map`")?;
-                    map = Some(scene_dir.join(file));
+                    map = Some(crate::texture::ImageSource::File(scene_dir.join(file)));
                 } else {
                     color = Some(p.vec3(&format!("for `{key}`"))?);
                 }
