@@ -287,29 +287,44 @@ class Conversion:
         kind = node.type
         if kind == "BSDF_PRINCIPLED":
             i = node.inputs
+            # Blender 4 renamed the inputs and changed what Specular and the coat mean.
+            v4 = "Transmission Weight" in i
+
+            def named(three, four):
+                return i[four if v4 else three]
+
             base = self.colour(i["Base Color"], material, "the base colour")
             metallic = self.scalar(i["Metallic"], material, "metallic")
             roughness = self.scalar(i["Roughness"], material, "roughness")
-            transmission = self.scalar(i["Transmission"], material, "transmission")
+            transmission = self.scalar(named("Transmission", "Transmission Weight"), material, "transmission")
             ior = self.value(i["IOR"], material, "the IOR")
-            specular = self.value(i["Specular"], material, "specular")
-            clearcoat = self.scalar(i["Clearcoat"], material, "clearcoat")
-            clearcoat_roughness = self.scalar(i["Clearcoat Roughness"], material, "the clearcoat roughness")
+            specular = self.value(named("Specular", "Specular IOR Level"), material, "specular")
+            if v4:
+                # Level ½ is the IOR's own reflectance: as Blender 3's Specular of F0 / 0.08.
+                specular = ((ior - 1.0) / (ior + 1.0)) ** 2 * 2.0 * specular / 0.08
+            clearcoat = self.scalar(named("Clearcoat", "Coat Weight"), material, "clearcoat")
+            if v4 and not rules.is_texture(clearcoat):
+                # Blender 3's coat weighs a quarter of its input; Blender 4's its input.
+                clearcoat = 4.0 * clearcoat
+            clearcoat_roughness = self.scalar(
+                named("Clearcoat Roughness", "Coat Roughness"), material, "the clearcoat roughness"
+            )
             # Inputs with no reading yet: said when they would change the picture.
-            for unread in ["Subsurface", "Sheen", "Anisotropic"]:
+            for unread in ["Subsurface", "Subsurface Weight", "Sheen", "Sheen Weight", "Anisotropic"]:
                 socket = i.get(unread)
                 if socket is not None and (socket.is_linked or socket.default_value > 0.0):
                     self.warn(f"material {material}: the Principled BSDF's {unread} is not rendered")
-            if i["Clearcoat Normal"].is_linked:
+            if named("Clearcoat Normal", "Coat Normal").is_linked:
                 self.warn(f"material {material}: the clearcoat's normal is not read (the coat follows the surface)")
+            layering = "fresnel" if v4 else "added"
             out = rules.principled(
-                base, metallic, roughness, transmission, ior, specular, clearcoat, clearcoat_roughness
+                base, metallic, roughness, transmission, ior, specular, clearcoat, clearcoat_roughness, layering
             )
             coverage = self.scalar(i["Alpha"], material, "alpha")
             if rules.is_texture(coverage) or coverage < 1.0:
                 out["coverage"] = coverage
             strength = self.value(i["Emission Strength"], material, "emission strength")
-            emission = self.colour(i["Emission"], material, "the emission")
+            emission = self.colour(named("Emission", "Emission Color"), material, "the emission")
             if rules.is_texture(emission):
                 if strength > 0.0:
                     out["emission"] = dict(emission, scale=strength)

@@ -75,14 +75,26 @@ def mix(first, second, amount):
     return {"type": "mix", "amount": amount, "materials": [first, second]}
 
 
-def principled(base, metallic, roughness, transmission, ior, specular, clearcoat=0.0, clearcoat_roughness=0.03):
+def principled(
+    base, metallic, roughness, transmission, ior, specular, clearcoat=0.0, clearcoat_roughness=0.03, layering="added"
+):
     """The Principled BSDF as Cycles blends it: metal with the share `metallic`; the rest glass
     with the share `transmission`, else the base colour under a coat of `coat_ior(specular)`
-    (bare at Specular 0). Shares are mixes (numbers or textures); roughness r (a number or a
+    (bare at Specular 0), the coat's light added to the base's or taken from it as `layering`
+    says. Shares are mixes (numbers or textures); roughness r (a number or a
     texture) is GGX α = r². A clear coat of weight ¼·`clearcoat` (Cycles' Disney coat) covers it."""
     opaque = {"type": "diffuse", "reflectance": base}
     if specular > 0.0:
-        opaque = {"type": "coated", "reflectance": base, "ior": coat_ior(specular), "roughness": roughness}
+        # Blender 3's Principled adds its specular lobe to the whole diffuse one ("added");
+        # Blender 4's takes the specular's share from it ("fresnel"). A varnish's layered coat
+        # would be a third darker still.
+        opaque = {
+            "type": "coated",
+            "reflectance": base,
+            "ior": coat_ior(specular),
+            "roughness": roughness,
+            "layering": layering,
+        }
     glass = {"type": "glass", "ior": max(1.0, ior), "roughness": roughness, "tint": base}
     metal = {"type": "conductor", "reflectance": base, "roughness": roughness}
     out = mix(mix(opaque, glass, transmission), metal, metallic)

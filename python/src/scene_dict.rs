@@ -3,9 +3,9 @@
 //! (docs/python.md, "Scenes from Python"). Errors name the key and the index at fault.
 
 use caustica::description::{
-    Alpha, CameraDesc, ClearCoat, ClearCoatMaps, EmittingFaces, FovAxis, ImageMap, ImageSource, IntegratorHint,
-    LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RenderHints, RoughnessMap,
-    RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    Alpha, CameraDesc, ClearCoat, ClearCoatMaps, Coating, EmittingFaces, FovAxis, ImageMap, ImageSource,
+    IntegratorHint, LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RenderHints,
+    RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
 use caustica::math::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use caustica::texture::{Encoding, Wrap};
@@ -722,7 +722,17 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         "coated" => {
             let base = t.param("reflectance", Vec3::splat(0.5))?;
             let (eta, alpha) = (ior(&mut t)?, alpha(&mut t)?);
-            MaterialDesc::coated(base, eta, alpha, true)
+            let layering = match t.string("layering")?.as_deref() {
+                None | Some("layered") => Coating::Layered,
+                Some("fresnel") => Coating::Fresnel,
+                Some("added") => Coating::Added,
+                Some(other) => {
+                    return Err(at
+                        .key("layering")
+                        .error(format!("\"layered\", \"fresnel\" or \"added\", not \"{other}\"")))
+                }
+            };
+            MaterialDesc::coated(base, eta, alpha, layering)
         }
         other => {
             return Err(at.key("type").error(format!(

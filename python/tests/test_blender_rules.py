@@ -46,6 +46,8 @@ def test_the_principled_bsdf_reads_as_metal_glass_or_coated_base():
     coated = rules.principled(base, 0.0, 0.2, 0.0, 1.45, 0.5)
     # Specular 0.5 is F0 = 4%, the index 1.5.
     assert coated["type"] == "coated" and coated["ior"] == pytest.approx(1.5) and coated["roughness"] == 0.2
+    # Blender 3's specular lobe adds to the diffuse one.
+    assert coated["layering"] == "added"
     assert rules.principled(base, 0.0, 0.2, 0.0, 1.45, 0.0) == {"type": "diffuse", "reflectance": base}
 
 

@@ -32,7 +32,7 @@
 
 mod rough_dielectric;
 
-use crate::description::ClearCoat;
+use crate::description::{ClearCoat, Coating};
 use crate::material::{Lobes, MaterialRef, MaterialSpectra, PhysicalMaterial, SurfaceParams};
 use crate::math::{reflect, Frame, Vec3, Vec4};
 use crate::sampling::sample_cosine_hemisphere;
@@ -316,21 +316,22 @@ impl Bsdf {
                 eta,
                 roughness,
                 coat_tint,
-                layered,
+                layering,
             } => {
                 let eta = eta.max(1.0);
                 let tint = clamp01(coat_tint);
                 let weight = tint.max_element();
                 let f = weight * fresnel_dielectric(cos_o, eta);
                 b.diffuse = wl.reflectance(clamp01(reflectance));
-                if layered {
+                if layering == Coating::Layered {
                     // The base's light reflected back down by the coat, again and again, and
                     // spread over the wider cone it leaves by (radiance over η²).
                     let inside = internal_diffuse_reflectance(eta);
                     b.diffuse /= (Spectrum::ONE - b.diffuse * inside) * (eta * eta);
                 }
                 b.coat = eta;
-                b.coat_weight = weight;
+                // An added coat takes nothing from the base.
+                b.coat_weight = if layering == Coating::Added { 0.0 } else { weight };
                 b.pick[0] = b.diffuse.max_element() * (1.0 - f);
                 if roughness < SMOOTH_ALPHA {
                     b.mirror = if tint == Vec3::ONE {
@@ -1357,7 +1358,7 @@ mod tests {
                     eta: 1.5,
                     roughness,
                     coat_tint: Vec3::ONE,
-                    layered: false,
+                    layering: Coating::Fresnel,
                 };
                 let bsdf = Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &RGB);
                 let a = albedo(&bsdf, wo, 11);
@@ -1377,7 +1378,7 @@ mod tests {
                     eta: 1.5,
                     roughness: 0.0,
                     coat_tint: Vec3::ONE,
-                    layered: true,
+                    layering: Coating::Layered,
                 };
                 if theta == 0.0 {
                     // A black base shows the coat alone: 4% at normal incidence for η 1.5.
@@ -1405,7 +1406,7 @@ mod tests {
                     eta: 1.5,
                     roughness: 0.0,
                     coat_tint: Vec3::ONE,
-                    layered: true,
+                    layering: Coating::Layered,
                 };
                 let bsdf = Bsdf::physical(&m, Vec3::Z, Vec3::Z, wo, &RGB);
                 let f = fresnel_dielectric(theta.cos(), 1.5);

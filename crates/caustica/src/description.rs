@@ -494,6 +494,22 @@ pub struct Alpha<P = Param> {
     pub cutoff: Option<f32>,
 }
 
+/// How a coated diffuse material's base and coat share the light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Coating {
+    /// The coat's underside sends the base's light back down to it, again and again (pbrt-v4's
+    /// layered `coateddiffuse`): the base's albedo r counts as r / (η²(1 − r·F̄ᵢ)), F̄ᵢ the
+    /// coat's mean reflectance from inside.
+    Layered,
+    /// Light crosses the coat once each way (glTF's Fresnel mix, pbrt-v3's plastic): the base
+    /// is seen times (1 − F(θo))(1 − F(θi)).
+    Fresnel,
+    /// The coat's reflection added to the whole base (Blender 3's Principled BSDF, whose
+    /// specular lobe takes nothing from its diffuse one): brighter than any physical varnish,
+    /// by up to the coat's reflectance at grazing angles.
+    Added,
+}
+
 /// Below this GGX α a surface is smooth: a perfect mirror, or glass that refracts by Snell's law.
 pub const SMOOTH_ALPHA: f32 = 1e-3;
 
@@ -525,11 +541,8 @@ pub enum PhysicalMaterial<P = Param> {
         /// glTF's specular weight times its specular colour (`KHR_materials_specular`). The base
         /// under it loses its largest channel's share.
         coat_tint: P,
-        /// Whether the coat's underside sends the base's light back down to it, again and again
-        /// (pbrt-v4's layered `coateddiffuse`): the base's albedo r counts as r / (η²(1 − r·F̄ᵢ)),
-        /// F̄ᵢ the coat's mean reflectance from inside. Otherwise light crosses the coat once
-        /// each way (glTF's Fresnel mix).
-        layered: bool,
+        /// How the base and the coat share the light.
+        layering: Coating,
     },
     /// Lambertian reflection and Lambertian transmission (leaves, paper, lampshades).
     DiffuseTransmission {
@@ -581,13 +594,13 @@ impl<P> PhysicalMaterial<P> {
                 eta,
                 roughness,
                 coat_tint,
-                layered,
+                layering,
             } => PhysicalMaterial::CoatedDiffuse {
                 reflectance: f(reflectance)?,
                 eta: *eta,
                 roughness: *roughness,
                 coat_tint: f(coat_tint)?,
-                layered: *layered,
+                layering: *layering,
             },
             PhysicalMaterial::DiffuseTransmission {
                 reflectance,
@@ -624,10 +637,9 @@ impl MaterialDesc {
         }
     }
 
-    /// A base of reflectance `base` under a clear coat of index `eta` and GGX α; `layered`:
-    /// light reflected inside the coat goes back to the base (pbrt-v4), not out of the picture
-    /// (pbrt-v3's plastic and substrate add their lobes).
-    pub fn coated(base: Param, eta: f32, alpha: f32, layered: bool) -> MaterialDesc {
+    /// A base of reflectance `base` under a clear coat of index `eta` and GGX α, sharing the
+    /// light as `layering` says.
+    pub fn coated(base: Param, eta: f32, alpha: f32, layering: Coating) -> MaterialDesc {
         let f0 = ((eta - 1.0) / (eta + 1.0)).powi(2);
         let mut m = MaterialDesc::lambert(base.clone());
         m.physical = Some(PhysicalMaterial::CoatedDiffuse {
@@ -635,7 +647,7 @@ impl MaterialDesc {
             eta,
             roughness: alpha,
             coat_tint: Param::grey(1.0),
-            layered,
+            layering,
         });
         m.course_gloss(Vec3::splat(f0), alpha);
         m

@@ -330,7 +330,7 @@ impl Material {
                     eta,
                     roughness: alpha,
                     coat_tint: mr.coat_tint.eval(textures, uv),
-                    layered: false,
+                    layering: crate::description::Coating::Fresnel,
                 })
             };
         }

@@ -161,7 +161,7 @@ fn physical_lobes_sample_their_density() {
         eta: 1.5,
         roughness: 0.3,
         coat_tint: Vec3::ONE,
-        layered: true,
+        layering: crate::description::Coating::Layered,
     };
     let translucent = PhysicalMaterial::DiffuseTransmission {
         reflectance: Vec3::splat(0.3),

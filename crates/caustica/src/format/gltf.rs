@@ -9,7 +9,7 @@
 
 use super::{SceneSource, SourceFiles};
 use crate::description::{
-    repair_vertex_attributes, Alpha, CameraDesc, ClearCoat, ClearCoatMaps, EmittingFaces, FovAxis, ImageMap,
+    repair_vertex_attributes, Alpha, CameraDesc, ClearCoat, ClearCoatMaps, Coating, EmittingFaces, FovAxis, ImageMap,
     ImageSource, LightDesc, MaterialDesc, MetallicRoughness, NormalMap, ObjectDesc, Param, PhysicalMaterial,
     SceneDescription, ShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
@@ -1030,7 +1030,7 @@ impl Reader<'_, '_> {
                     eta: ior,
                     roughness: alpha,
                     coat_tint,
-                    layered: false,
+                    layering: Coating::Fresnel,
                 });
                 let f0 = ((ior - 1.0) / (ior + 1.0)).powi(2) * specular.min(1.0);
                 if alpha < 1e-3 {

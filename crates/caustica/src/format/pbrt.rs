@@ -21,8 +21,8 @@ use self::lexer::{Kind, Lexer, Token};
 use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
-    Alpha, CameraDesc, ClearCoat, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc, MixDesc,
-    NormalMap, ObjectDesc, Param, PhysicalMaterial, RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc,
+    Alpha, CameraDesc, ClearCoat, Coating, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc,
+    MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc,
     TrimeshDesc, SMOOTH_ALPHA,
 };
 use crate::error::{ParseError, Result, Span};
@@ -1000,7 +1000,7 @@ impl<'f> Reader<'f> {
                 let base = self.colour(params, "reflectance", Vec3::splat(0.5))?;
                 let alpha = self.roughness(params, span, 0.0)?;
                 let eta = self.float_slot(params, "eta", 1.5)?.max(1.0);
-                MaterialDesc::coated(base, eta, alpha, true)
+                MaterialDesc::coated(base, eta, alpha, Coating::Layered)
             }
             "matte" | "plastic" | "substrate" | "mirror" | "uber" | "translucent" => {
                 self.v3_material(kind, params, span)?
@@ -1100,7 +1100,7 @@ impl<'f> Reader<'f> {
                         "plastic is read as a diffuse base under a clear coat of index 1.5: Ks does not scale its highlight",
                         span.clone(),
                     );
-                    MaterialDesc::coated(base, 1.5, alpha, false)
+                    MaterialDesc::coated(base, 1.5, alpha, Coating::Fresnel)
                 }
             }
             // Ashikhmin–Shirley: a base under a coat whose normal reflectance is Ks.
@@ -1114,7 +1114,7 @@ impl<'f> Reader<'f> {
                     }
                 };
                 let alpha = self.roughness(params, span, 0.1)?;
-                MaterialDesc::coated(base, (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()), alpha, false)
+                MaterialDesc::coated(base, (1.0 + f0.sqrt()) / (1.0 - f0.sqrt()), alpha, Coating::Fresnel)
             }
             "mirror" => {
                 let kr = self.colour(params, "Kr", Vec3::splat(0.9))?;
@@ -1145,7 +1145,7 @@ impl<'f> Reader<'f> {
                 } else if ks == black {
                     MaterialDesc::lambert(kd)
                 } else {
-                    MaterialDesc::coated(kd, index.max(1.0), alpha, false)
+                    MaterialDesc::coated(kd, index.max(1.0), alpha, Coating::Fresnel)
                 };
                 self.warn_once(
                     "uber",

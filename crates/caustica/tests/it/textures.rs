@@ -543,9 +543,12 @@ fn a_metallic_roughness_texture_decides_metal_and_roughness_point_by_point() {
             eta,
             roughness,
             coat_tint,
-            layered,
+            layering,
         }) => {
-            assert_eq!((reflectance, eta, layered, coat_tint), (base, 1.5, false, Vec3::ONE));
+            assert_eq!(
+                (reflectance, eta, layering, coat_tint),
+                (base, 1.5, caustica::description::Coating::Fresnel, Vec3::ONE)
+            );
             assert!((roughness - alpha(200)).abs() < 1e-6, "{roughness}");
         }
         other => panic!("a dielectric point: {other:?}"),

@@ -1,5 +1,5 @@
 use super::*;
-use crate::description::EmittingFaces;
+use crate::description::{Coating, EmittingFaces};
 use crate::error::Error;
 use crate::progress::NoProgress;
 
@@ -174,10 +174,13 @@ fn pbrt_v3_materials_are_read() {
             eta,
             roughness,
             reflectance,
-            layered,
+            layering,
             ..
         }) => {
-            assert_eq!((*eta, *reflectance == Param::grey(0.5), *layered), (1.5, true, false));
+            assert_eq!(
+                (*eta, *reflectance == Param::grey(0.5), *layering),
+                (1.5, true, Coating::Fresnel)
+            );
             assert!((roughness - 0.2).abs() < 1e-6, "remapped √0.04: {roughness}");
         }
         other => panic!("plastic: {other:?}"),
