@@ -58,6 +58,10 @@ class Conversion:
         cam = cam_obj.data
         if cam.type != "PERSP":
             self.warn(f"camera {cam_obj.name}: only perspective cameras are rendered")
+        if cam.dof.use_dof:
+            self.warn(f"camera {cam_obj.name}: depth of field is not rendered (a pinhole)")
+        if self.scene.render.use_motion_blur:
+            self.warn("motion blur is not rendered")
         fov = rules.vertical_fov(cam.sensor_fit, cam.sensor_width, cam.sensor_height, cam.lens, self.width, self.height)
         out = {
             "matrix": np.array(cam_obj.matrix_world, dtype=np.float64),
@@ -381,12 +385,15 @@ class Conversion:
         # Blender's lights shine down their local −z.
         direction = matrix[:3, :3] @ np.array([0.0, 0.0, -1.0])
         if light.type in {"POINT", "SPOT"}:
-            if light.shadow_soft_size > 0.0:
-                self.warn(f"light {light.name}: its radius is not rendered (a point light)")
             intensity = list(colour * rules.point_intensity(light.energy))
             if light.type == "POINT":
-                self.lights.append({"type": "point", "position": position, "intensity": intensity})
-            else:
+                # A radius makes a ball of the same intensity: soft shadows, the same power.
+                self.lights.append(
+                    {"type": "sphere", "position": position, "radius": light.shadow_soft_size, "intensity": intensity}
+                )
+            elif light.shadow_soft_size > 0.0:
+                self.warn(f"light {light.name}: a spot's radius is not rendered (a point spot)")
+            if light.type == "SPOT":
                 outer, inner = rules.spot_cone(light.spot_size, light.spot_blend)
                 self.lights.append(
                     {
@@ -421,6 +428,11 @@ class Conversion:
         # A disk or ellipse is the one inscribed in its size's rectangle.
         area = sx * sy * (math.pi / 4.0 if round_light else 1.0)
         m = matrix[:3, :3]
+        radiance = list(colour * rules.area_radiance(light.energy, area))
+        settings = getattr(self.scene, "caustica", None)
+        if settings is not None and settings.area_lights == "SURFACE":
+            self.glowing_surface(light, matrix, sx, sy, round_light, radiance)
+            return
         # Lit down its −z: u × v points there.
         self.lights.append(
             {
@@ -429,8 +441,30 @@ class Conversion:
                 "corner": matrix[:3, 3] + m @ np.array([-sx / 2.0, -sy / 2.0, 0.0]),
                 "u": m @ np.array([0.0, sy, 0.0]),
                 "v": m @ np.array([sx, 0.0, 0.0]),
-                "radiance": list(colour * rules.area_radiance(light.energy, area)),
+                "radiance": radiance,
             }
+        )
+
+    def glowing_surface(self, light, matrix, sx, sy, round_light, radiance):
+        """An area light as a one-sided emitting mesh of its shape (a disk or ellipse as a fan
+        of 64 triangles of its area), glowing down its −z."""
+        if round_light:
+            n = 64
+            # The polygon's corners pushed out so its area is the ellipse's.
+            grow = math.sqrt(2.0 * math.pi / (n * math.sin(2.0 * math.pi / n)))
+            angles = -2.0 * math.pi * np.arange(n) / n
+            rim = np.stack([0.5 * sx * grow * np.cos(angles), 0.5 * sy * grow * np.sin(angles), np.zeros(n)], axis=1)
+            positions = np.vstack([[0.0, 0.0, 0.0], rim])
+            indices = [[0, 1 + i, 1 + (i + 1) % n] for i in range(n)]
+        else:
+            hx, hy = sx / 2.0, sy / 2.0
+            # Clockwise seen from +z: the front faces −z.
+            positions = np.array([[-hx, -hy, 0.0], [-hx, hy, 0.0], [hx, hy, 0.0], [hx, -hy, 0.0]])
+            indices = [[0, 1, 2], [0, 2, 3]]
+        name = f"light {light.name}"
+        self.materials[name] = {"type": "diffuse", "reflectance": 0.0, "emission": radiance}
+        self.shapes.append(
+            {"type": "mesh", "positions": positions, "indices": indices, "matrix": matrix, "material": name}
         )
 
     def world(self):

@@ -27,6 +27,18 @@ class CausticaSettings(bpy.types.PropertyGroup):
     radius: FloatProperty(
         name="Radius", description="Photon gather radius in scene units; 0: the integrator's own choice", default=0.0, min=0.0
     )
+    area_lights: EnumProperty(
+        name="Area lights",
+        items=[
+            ("LIGHT", "Lights", "Lights alone: unseen by the camera, as Cycles' are, and unseen in mirrors and glass"),
+            (
+                "SURFACE",
+                "Glowing surfaces",
+                "Surfaces of the same radiance: seen in mirrors and glass (and by the camera), their backs black",
+            ),
+        ],
+        default="LIGHT",
+    )
     spectral: BoolProperty(
         name="Spectral", description="Transport by wavelength (dispersion in glass with an Abbe number)", default=False
     )
@@ -57,6 +69,7 @@ class CAUSTICA_PT_settings(bpy.types.Panel):
             layout.prop(s, "photons")
         if s.integrator in {"VCM", "PPM", "GI"}:
             layout.prop(s, "radius")
+        layout.prop(s, "area_lights")
         layout.prop(s, "spectral")
 
 

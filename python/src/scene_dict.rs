@@ -1055,6 +1055,24 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
                 _ => LightDesc::Directional { direction, color, span },
             }
         }
+        "sphere" => {
+            let radius = t.float("radius", 0.0)?;
+            if radius < 0.0 {
+                return Err(at
+                    .key("radius")
+                    .error(format!("a radius is not negative, not {radius}")));
+            }
+            // A ball of intensity I in every direction: radiance I/(πr²) over its surface.
+            LightDesc::Soft {
+                shape: SoftShapeDesc::Sphere {
+                    center: t.required_vec3("position")?,
+                    radius,
+                },
+                color: t.colour("intensity", Vec3::ONE)?,
+                attenuation: [0.0, 0.0, 1.0],
+                span,
+            }
+        }
         "area" => {
             let (corner, u, v) = (t.required_vec3("corner")?, t.required_vec3("u")?, t.required_vec3("v")?);
             if u.cross(v).length_squared() == 0.0 {
@@ -1093,7 +1111,7 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
         }
         other => {
             return Err(at.key("type").error(format!(
-                "\"point\", \"spot\", \"sun\", \"area\" or \"environment\", not \"{other}\""
+                "\"point\", \"sphere\", \"spot\", \"sun\", \"area\" or \"environment\", not \"{other}\""
             )))
         }
     };

@@ -381,6 +381,29 @@ for engine in ("CAUSTICA", "CYCLES"):
     scene.render.filepath = OUT + f"default-{engine}.exr"
     bpy.ops.render.render(write_still=True)
 
+# A mirror seen at 26.6° from its normal, an area light where it reflects the view: the camera
+# sees the lamp in it when area lights are glowing surfaces, not when they are lights.
+def mirror(tree):
+    nodes = tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    g = nodes.new("ShaderNodeBsdfGlossy")
+    g.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1)
+    g.inputs["Roughness"].default_value = 0.0
+    tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
+
+for mode in ("LIGHT", "SURFACE"):
+    scene = plane_scene(mirror)
+    scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    scene.camera.location = (-1.0, 0.0, 2.0)
+    scene.camera.rotation_euler = (0.0, -math.atan2(1.0, 2.0), 0.0)
+    lamp = bpy.data.objects.new("Lamp", bpy.data.lights.new("Lamp", type="AREA"))
+    lamp.data.energy, lamp.data.size = 500.0, 1.0
+    lamp.location = (0.75, 0.0, 1.5)
+    scene.collection.objects.link(lamp)
+    scene.caustica.area_lights = mode
+    scene.render.filepath = OUT + f"mirror-{mode}.exr"
+    bpy.ops.render.render(write_still=True)
+
 # Linked duplicates: three objects, one mesh.
 from caustica_blender.convert import Conversion
 bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -417,5 +440,9 @@ def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_ble
     # renders it (measured +0.15%; seen 25° above the horizon a layered coat was 39% darker than
     # Cycles, a Fresnel mix 16%).
     assert centre("default-CAUSTICA") == pytest.approx(centre("default-CYCLES"), rel=0.02)
+    # The lamp (radiance 500/(4·1 m²) = 125) in the mirror of reflectance 0.8 (its Fresnel at
+    # 26.6° within 0.1% of that): seen as a glowing surface, unseen as a light.
+    assert centre("mirror-LIGHT") == 0.0
+    assert centre("mirror-SURFACE") == pytest.approx(0.8 * 125, rel=0.01)
     # Three objects of one mesh: its arrays once, three shapes placing them.
     assert json.load(open(out + "instances.json")) == {"meshes": 1, "shapes": 3}

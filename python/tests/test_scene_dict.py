@@ -403,3 +403,19 @@ def test_render_settings_in_the_dict_are_the_renders_defaults():
     d["render"]["integrator"] = "bdpt"
     with pytest.raises(ValueError, match=r'render\.integrator: "path", "ppm", "lt" or "vcm", not "bdpt"'):
         caustica.Scene.from_dict(d)
+
+
+def test_a_sphere_light_lights_the_floor_under_it_as_a_point_of_its_intensity():
+    # A ball of intensity I wholly above a plane gives it the irradiance I·cos/d² of a point at
+    # its centre: under it, ρ/π · I/h², exact; and its shadow edges soften.
+    for light in (
+        {"type": "point", "position": [0, 0, 2], "intensity": 8},
+        {"type": "sphere", "position": [0, 0, 2], "radius": 0.5, "intensity": 8},
+    ):
+        d = looking_down({"floor": {"type": "diffuse", "reflectance": 0.5}}, [quad("floor")], [light], fov=10)
+        d["camera"]["eye"] = [0, 0, 1]
+        image = caustica.render(caustica.Scene.from_dict(d), integrator="path", passes=16, seed=2)
+        assert image[6:10, 6:10].mean() == pytest.approx(0.5 / np.pi * 8 / 4, rel=0.01), light["type"]
+    with pytest.raises(ValueError, match=r"lights\[0\]\.radius: a radius is not negative"):
+        light["radius"] = -1
+        caustica.Scene.from_dict(d)

@@ -66,6 +66,7 @@ def add_light(scene, kind, **props):
 
 def setups():
     yield "point 1000 W", lambda s: add_light(s, "POINT", energy=1000.0, shadow_soft_size=0.0)
+    yield "point 1000 W, radius 0.5 m", lambda s: add_light(s, "POINT", energy=1000.0, shadow_soft_size=0.5)
     yield "spot 1000 W, 60°, blend 0", lambda s: add_light(
         s, "SPOT", energy=1000.0, shadow_soft_size=0.0, spot_size=math.radians(60.0), spot_blend=0.0
     )
@@ -77,6 +78,16 @@ def setups():
     yield "sun 3 W/m², 30° from zenith", sun
     yield "square area 1 m, 500 W", lambda s: add_light(s, "AREA", energy=500.0, shape="SQUARE", size=1.0)
     yield "disk area 1 m, 500 W", lambda s: add_light(s, "AREA", energy=500.0, shape="DISK", size=1.0)
+
+    def as_surface(shape):
+        def setup(s):
+            s.caustica.area_lights = "SURFACE"
+            add_light(s, "AREA", energy=500.0, shape=shape, size=1.0)
+
+        return setup
+
+    yield "square area 1 m, 500 W, as a glowing surface", as_surface("SQUARE")
+    yield "disk area 1 m, 500 W, as a glowing surface", as_surface("DISK")
 
     yield "spot 1000 W, 60°, blend 0.5", lambda s: add_light(
         s, "SPOT", energy=1000.0, shadow_soft_size=0.0, spot_size=math.radians(60.0), spot_blend=0.5
