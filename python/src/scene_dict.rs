@@ -150,6 +150,33 @@ impl<'py> Table<'py> {
         }
     }
 
+    /// One of the names `options` gives, as its value; `None` when the key is absent.
+    fn choice<T: Copy>(&mut self, key: &str, options: &[(&str, T)]) -> PyResult<Option<T>> {
+        let Some(name) = self.string(key)? else {
+            return Ok(None);
+        };
+        if let Some((_, value)) = options.iter().find(|(n, _)| *n == name) {
+            return Ok(Some(*value));
+        }
+        let quoted: Vec<String> = options.iter().map(|(n, _)| format!("\"{n}\"")).collect();
+        let listed = match quoted.split_last() {
+            Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+            _ => quoted.join(""),
+        };
+        Err(self.at.key(key).error(format!("{listed}, not \"{name}\"")))
+    }
+
+    /// A whole number above 0 (`what` says of what, for the message).
+    fn whole(&mut self, key: &str, what: &str) -> PyResult<Option<u64>> {
+        match self.get(key)? {
+            Some(v) => match v.extract::<u64>() {
+                Ok(n) if n > 0 => Ok(Some(n)),
+                _ => Err(self.at.key(key).error(format!("expected a whole number {what}above 0"))),
+            },
+            None => Ok(None),
+        }
+    }
+
     /// Refuses keys that were not read.
     fn done(self) -> PyResult<()> {
         for key in self.dict.keys() {
@@ -199,38 +226,22 @@ fn image_map(value: &Bound<'_, PyAny>, at: At, encoding: Encoding) -> PyResult<I
     let source = image_source(&mut t, &at)?
         .ok_or_else(|| at.error("an image is a `file` (PNG, JPEG, EXR, HDR, …) or an `array` of pixels"))?;
     let mut map = ImageMap::colour(source, 0..0);
-    map.encoding = match t.string("encoding")?.as_deref() {
-        None => encoding,
-        Some("srgb") => Encoding::Srgb,
-        Some("linear") => Encoding::Linear,
-        Some("alpha") => Encoding::Coverage,
-        Some(other) => {
-            return Err(at
-                .key("encoding")
-                .error(format!("\"srgb\", \"linear\" or \"alpha\", not \"{other}\"")))
-        }
-    };
+    let encodings = [
+        ("srgb", Encoding::Srgb),
+        ("linear", Encoding::Linear),
+        ("alpha", Encoding::Coverage),
+    ];
+    map.encoding = t.choice("encoding", &encodings)?.unwrap_or(encoding);
     map.sampler.scale = t.colour("scale", Vec3::ONE)?;
-    let wrap = match t.string("wrap")?.as_deref() {
-        None | Some("repeat") => Wrap::Repeat,
-        Some("clamp") => Wrap::Clamp,
-        Some("mirror") => Wrap::Mirror,
-        Some(other) => {
-            return Err(at
-                .key("wrap")
-                .error(format!("\"repeat\", \"clamp\" or \"mirror\", not \"{other}\"")))
-        }
-    };
-    map.sampler.wrap = [wrap; 2];
-    map.sampler.nearest = match t.string("filter")?.as_deref() {
-        None | Some("linear") => false,
-        Some("nearest") => true,
-        Some(other) => {
-            return Err(at
-                .key("filter")
-                .error(format!("\"linear\" or \"nearest\", not \"{other}\"")))
-        }
-    };
+    let wraps = [
+        ("repeat", Wrap::Repeat),
+        ("clamp", Wrap::Clamp),
+        ("mirror", Wrap::Mirror),
+    ];
+    map.sampler.wrap = [t.choice("wrap", &wraps)?.unwrap_or(Wrap::Repeat); 2];
+    map.sampler.nearest = t
+        .choice("filter", &[("linear", false), ("nearest", true)])?
+        .unwrap_or(false);
     t.done()?;
     Ok(map)
 }
@@ -379,33 +390,14 @@ pub fn description(dict: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
         desc.camera = Some(camera);
         (desc.hints.width, desc.hints.height) = size;
     }
-    let mut materials: HashMap<String, MaterialDesc> = HashMap::new();
-    if let Some(m) = top.get("materials")? {
-        let at = At("materials".into());
-        let m = m
-            .cast::<PyDict>()
-            .map_err(|_| at.type_error("expected a dict of materials by name"))?;
-        for (name, value) in m.iter() {
-            let name: String = name.extract().map_err(|_| at.type_error("names are strings"))?;
-            let material = material(&value, at.key(&name))?;
-            materials.insert(name, material);
-        }
-    }
+    let materials = by_name(&mut top, "materials", material)?;
     // Meshes by name, for shapes that place them (instances of one mesh share its arrays).
-    let mut meshes: HashMap<String, TrimeshDesc> = HashMap::new();
-    if let Some(m) = top.get("meshes")? {
-        let at = At("meshes".into());
-        let m = m
-            .cast::<PyDict>()
-            .map_err(|_| at.type_error("expected a dict of meshes by name"))?;
-        for (name, value) in m.iter() {
-            let name: String = name.extract().map_err(|_| at.type_error("names are strings"))?;
-            let mut t = Table::new(&value, at.key(&name))?;
-            let mesh = mesh(&mut t, &at.key(&name))?;
-            t.done()?;
-            meshes.insert(name, mesh);
-        }
-    }
+    let meshes = by_name(&mut top, "meshes", |value, at| {
+        let mut t = Table::new(value, at.clone())?;
+        let mesh = mesh(&mut t, &at)?;
+        t.done()?;
+        Ok(mesh)
+    })?;
     if let Some(shapes) = top.get("shapes")? {
         let at = At("shapes".into());
         let list = shapes.cast::<PyList>().map_err(|_| at.type_error("expected a list"))?;
@@ -432,36 +424,45 @@ pub fn description(dict: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
 /// `photons` per pass and the gather `radius`. A call's own options win.
 fn render_hints(value: &Bound<'_, PyAny>, at: At, hints: &mut RenderHints) -> PyResult<()> {
     let mut t = Table::new(value, at.clone())?;
-    hints.integrator = match t.string("integrator")?.as_deref() {
-        None => None,
-        Some("path") => Some(IntegratorHint::Path),
-        Some("ppm") => Some(IntegratorHint::Ppm),
-        Some("lt") => Some(IntegratorHint::LightTracer),
-        Some("vcm") => Some(IntegratorHint::Bidirectional),
-        Some(other) => {
-            return Err(at
-                .key("integrator")
-                .error(format!("\"path\", \"ppm\", \"lt\" or \"vcm\", not \"{other}\"")))
-        }
-    };
-    let whole = |t: &mut Table, key: &str| -> PyResult<Option<u64>> {
-        match t.get(key)? {
-            Some(v) => match v.extract::<u64>() {
-                Ok(n) if n > 0 => Ok(Some(n)),
-                _ => Err(at.key(key).error("expected a whole number above 0")),
-            },
-            None => Ok(None),
-        }
-    };
-    hints.samples = whole(&mut t, "passes")?.map(|n| n.min(u64::from(u32::MAX)) as u32);
-    hints.max_depth = whole(&mut t, "max_depth")?.map(|n| n.min(1 << 16) as u32);
-    hints.photons_per_pass = whole(&mut t, "photons")?.map(|n| n as usize);
+    hints.integrator = t.choice(
+        "integrator",
+        &[
+            ("path", IntegratorHint::Path),
+            ("ppm", IntegratorHint::Ppm),
+            ("lt", IntegratorHint::LightTracer),
+            ("vcm", IntegratorHint::Bidirectional),
+        ],
+    )?;
+    hints.samples = t.whole("passes", "")?.map(|n| n.min(u64::from(u32::MAX)) as u32);
+    hints.max_depth = t.whole("max_depth", "")?.map(|n| n.min(1 << 16) as u32);
+    hints.photons_per_pass = t.whole("photons", "")?.map(|n| n as usize);
     hints.radius = match t.float("radius", 0.0)? {
         r if r > 0.0 => Some(r),
         0.0 => None,
         r => return Err(at.key("radius").error(format!("a radius is above 0, not {r}"))),
     };
     t.done()
+}
+
+/// A dict of things by name at `key`, each read by `read` at its place.
+fn by_name<T>(
+    top: &mut Table,
+    key: &str,
+    read: impl Fn(&Bound<'_, PyAny>, At) -> PyResult<T>,
+) -> PyResult<HashMap<String, T>> {
+    let mut out = HashMap::new();
+    if let Some(m) = top.get(key)? {
+        let at = At(key.into());
+        let m = m
+            .cast::<PyDict>()
+            .map_err(|_| at.type_error(format!("expected a dict of {key} by name")))?;
+        for (name, value) in m.iter() {
+            let name: String = name.extract().map_err(|_| at.type_error("names are strings"))?;
+            let item = read(&value, at.key(&name))?;
+            out.insert(name, item);
+        }
+    }
+    Ok(out)
 }
 
 /// An image size a description asks for: width and height, each optional.
@@ -474,25 +475,14 @@ fn camera(value: &Bound<'_, PyAny>, at: At) -> PyResult<(CameraDesc, Size)> {
     if !(fov > 0.0 && fov < 179.0) {
         return Err(at.key("fov").error(format!("{fov}° is not between 0 and 179")));
     }
-    let fov_axis = match t.string("fov_axis")?.as_deref() {
-        None | Some("vertical") => FovAxis::Vertical,
-        Some("shorter") => FovAxis::Shorter,
-        Some(other) => {
-            return Err(at
-                .key("fov_axis")
-                .error(format!("\"vertical\" or \"shorter\", not \"{other}\"")))
-        }
-    };
-    let size = |t: &mut Table, key: &str| -> PyResult<Option<usize>> {
-        match t.get(key)? {
-            Some(v) => match v.extract::<usize>() {
-                Ok(n) if n > 0 => Ok(Some(n)),
-                _ => Err(at.key(key).error("expected a whole number of pixels above 0")),
-            },
-            None => Ok(None),
-        }
-    };
-    let (width, height) = (size(&mut t, "width")?, size(&mut t, "height")?);
+    let fov_axis = t
+        .choice(
+            "fov_axis",
+            &[("vertical", FovAxis::Vertical), ("shorter", FovAxis::Shorter)],
+        )?
+        .unwrap_or(FovAxis::Vertical);
+    let width = t.whole("width", "of pixels ")?.map(|n| n as usize);
+    let height = t.whole("height", "of pixels ")?.map(|n| n as usize);
     let aspect = match (t.float("aspect", 0.0)?, width, height) {
         (a, _, _) if a > 0.0 => a,
         (_, Some(w), Some(h)) => w as f32 / h as f32,
@@ -722,16 +712,12 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         "coated" => {
             let base = t.param("reflectance", Vec3::splat(0.5))?;
             let (eta, alpha) = (ior(&mut t)?, alpha(&mut t)?);
-            let layering = match t.string("layering")?.as_deref() {
-                None | Some("layered") => Coating::Layered,
-                Some("fresnel") => Coating::Fresnel,
-                Some("added") => Coating::Added,
-                Some(other) => {
-                    return Err(at
-                        .key("layering")
-                        .error(format!("\"layered\", \"fresnel\" or \"added\", not \"{other}\"")))
-                }
-            };
+            let layerings = [
+                ("layered", Coating::Layered),
+                ("fresnel", Coating::Fresnel),
+                ("added", Coating::Added),
+            ];
+            let layering = t.choice("layering", &layerings)?.unwrap_or(Coating::Layered);
             MaterialDesc::coated(base, eta, alpha, layering)
         }
         other => {
@@ -1078,14 +1064,11 @@ fn light(value: &Bound<'_, PyAny>, at: At) -> PyResult<LightDesc> {
             if u.cross(v).length_squared() == 0.0 {
                 return Err(at.error("the edges `u` and `v` span no area"));
             }
-            let shape = match t.string("shape")?.as_deref() {
-                None | Some("rectangle") => SoftShapeDesc::Parallelogram { corner, u, v },
-                Some("ellipse") => SoftShapeDesc::Ellipse { corner, u, v },
-                Some(other) => {
-                    return Err(at
-                        .key("shape")
-                        .error(format!("\"rectangle\" or \"ellipse\", not \"{other}\"")))
-                }
+            let ellipse = t.choice("shape", &[("rectangle", false), ("ellipse", true)])?;
+            let shape = if ellipse == Some(true) {
+                SoftShapeDesc::Ellipse { corner, u, v }
+            } else {
+                SoftShapeDesc::Parallelogram { corner, u, v }
             };
             LightDesc::Soft {
                 shape,
