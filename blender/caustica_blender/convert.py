@@ -430,7 +430,13 @@ class Conversion:
         m = matrix[:3, :3]
         radiance = list(colour * rules.area_radiance(light.energy, area))
         settings = getattr(self.scene, "caustica", None)
-        if settings is not None and settings.area_lights == "SURFACE":
+        mode = settings.area_lights if settings is not None else "AUTO"
+        corners = [matrix[:3, 3] + m @ np.array([x * sx / 2.0, y * sy / 2.0, 0.0]) for x in (-1, 1) for y in (-1, 1)]
+        if mode == "AUTO" and self.in_view(corners):
+            self.warn(
+                f"light {light.name}: in the camera's view, so a light the camera does not see (and not seen in mirrors and glass either)"
+            )
+        elif mode != "LIGHT":
             self.glowing_surface(light, matrix, sx, sy, round_light, radiance)
             return
         # Lit down its −z: u × v points there.
@@ -444,6 +450,22 @@ class Conversion:
                 "radiance": radiance,
             }
         )
+
+    def in_view(self, points):
+        """Whether any of `points` lies in the camera's view (with a margin of a tenth)."""
+        cam_obj = self.scene.camera
+        if cam_obj is None:
+            return False
+        cam = cam_obj.data
+        fov = math.radians(rules.vertical_fov(cam.sensor_fit, cam.sensor_width, cam.sensor_height, cam.lens, self.width, self.height))
+        half_h = math.tan(fov / 2.0) * 1.1 + abs(cam.shift_y) * 2.0
+        half_w = half_h * self.width / self.height + abs(cam.shift_x) * 2.0
+        to_camera = np.linalg.inv(np.array(cam_obj.matrix_world, dtype=np.float64))
+        for p in points:
+            x, y, z = (to_camera @ np.append(p, 1.0))[:3]
+            if z < 0.0 and abs(x) <= half_w * -z and abs(y) <= half_h * -z:
+                return True
+        return False
 
     def glowing_surface(self, light, matrix, sx, sy, round_light, radiance):
         """An area light as a one-sided emitting mesh of its shape (a disk or ellipse as a fan

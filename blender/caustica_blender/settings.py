@@ -30,6 +30,11 @@ class CausticaSettings(bpy.types.PropertyGroup):
     area_lights: EnumProperty(
         name="Area lights",
         items=[
+            (
+                "AUTO",
+                "Automatic",
+                "Glowing surfaces, seen in mirrors and glass as Cycles' lamps are; a lamp in the camera's view is a light, unseen by it",
+            ),
             ("LIGHT", "Lights", "Lights alone: unseen by the camera, as Cycles' are, and unseen in mirrors and glass"),
             (
                 "SURFACE",
@@ -37,7 +42,7 @@ class CausticaSettings(bpy.types.PropertyGroup):
                 "Surfaces of the same radiance: seen in mirrors and glass (and by the camera), their backs black",
             ),
         ],
-        default="LIGHT",
+        default="AUTO",
     )
     spectral: BoolProperty(
         name="Spectral", description="Transport by wavelength (dispersion in glass with an Abbe number)", default=False

@@ -382,7 +382,8 @@ for engine in ("CAUSTICA", "CYCLES"):
     bpy.ops.render.render(write_still=True)
 
 # A mirror seen at 26.6° from its normal, an area light where it reflects the view: the camera
-# sees the lamp in it when area lights are glowing surfaces, not when they are lights.
+# sees the lamp in it when area lights are glowing surfaces (the default, for a lamp out of
+# view), not when they are lights.
 def mirror(tree):
     nodes = tree.nodes
     nodes.remove(nodes["Principled BSDF"])
@@ -391,7 +392,7 @@ def mirror(tree):
     g.inputs["Roughness"].default_value = 0.0
     tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
 
-for mode in ("LIGHT", "SURFACE"):
+for mode in ("LIGHT", "SURFACE", "AUTO"):
     scene = plane_scene(mirror)
     scene.world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     scene.camera.location = (-1.0, 0.0, 2.0)
@@ -444,5 +445,8 @@ def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_ble
     # 26.6° within 0.1% of that): seen as a glowing surface, unseen as a light.
     assert centre("mirror-LIGHT") == 0.0
     assert centre("mirror-SURFACE") == pytest.approx(0.8 * 125, rel=0.01)
+    # Out of the camera's view, the default makes the lamp a glowing surface. (In view it makes
+    # it a light: the floors under the lamps above, which the camera looks down past, show it.)
+    assert centre("mirror-AUTO") == centre("mirror-SURFACE")
     # Three objects of one mesh: its arrays once, three shapes placing them.
     assert json.load(open(out + "instances.json")) == {"meshes": 1, "shapes": 3}
