@@ -190,20 +190,64 @@ class Conversion:
         """The image texture linked straight into `socket`, as the dict reads it; None (with a
         warning) for any other link."""
         node = socket.links[0].from_node
-        if node.type == "TEX_IMAGE" and node.image is not None and not node.inputs["Vector"].is_linked:
-            path = self.image_file(node.image)
-            if path is None:
-                self.warn(f"material {material}: the image {node.image.name} of {what} has no file")
+        if node.type == "TEX_IMAGE" and node.image is not None:
+            uv = self.uv_transform(node, material, what)
+            if uv is False:
                 return None
+            path = self.image_file(node.image)
             linear = node.image.colorspace_settings.name in {"Non-Color", "Linear", "Raw"}
-            return {
-                "file": path,
-                "encoding": "linear" if linear else "srgb",
+            if path is not None:
+                source = {"file": path, "encoding": "linear" if linear else "srgb"}
+            else:
+                # An image with no file (generated, or painted and not saved): its pixels,
+                # decoded here.
+                pixels = self.image_pixels(node.image, "rgb")
+                if pixels is None:
+                    self.warn(f"material {material}: the image {node.image.name} of {what} has no pixels")
+                    return None
+                source = {"array": pixels, "encoding": "linear"}
+            out = {
+                **source,
                 "filter": "nearest" if node.interpolation == "Closest" else "linear",
                 "wrap": {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat"),
             }
+            if uv is not None:
+                out["uv_transform"] = uv
+            return out
         self.warn(f"material {material}: {what} from the {node.name} node is read by the input's own value")
         return None
+
+    def uv_transform(self, image_node, material, what):
+        """How an Image Texture node's coordinates come from the active UV map: None for
+        straight, a 3×3 matrix for a Mapping node's scale, rotation about z and location
+        (Point, Texture or Vector type) on them; False, with a warning, for anything else."""
+        vector = image_node.inputs["Vector"]
+        if not vector.is_linked:
+            return None
+        node = vector.links[0].from_node
+
+        def is_uv(link_node, output):
+            return (link_node.type == "TEX_COORD" and output == "UV") or link_node.type == "UVMAP"
+
+        if is_uv(node, vector.links[0].from_socket.name):
+            return None
+        inputs = node.inputs if node.type == "MAPPING" else None
+        ok = (
+            inputs is not None
+            and node.vector_type in {"POINT", "TEXTURE", "VECTOR"}
+            and inputs["Vector"].is_linked
+            and is_uv(inputs["Vector"].links[0].from_node, inputs["Vector"].links[0].from_socket.name)
+            and not any(i.is_linked for i in list(inputs)[1:])
+        )
+        rotation = list(inputs["Rotation"].default_value) if ok else [0.0, 0.0, 0.0]
+        if not ok or abs(rotation[0]) > 1e-6 or abs(rotation[1]) > 1e-6:
+            self.warn(
+                f"material {material}: the coordinates of {what} ({node.name}) are not the UV map or a Mapping node's scale, z rotation and location on it: the image is not read"
+            )
+            return False
+        scale = list(inputs["Scale"].default_value)
+        location = list(inputs["Location"].default_value) if node.vector_type != "VECTOR" else [0.0, 0.0, 0.0]
+        return rules.uv_mapping(node.vector_type, location[:2], rotation[2], scale[:2])
 
     def colour(self, socket, material, what):
         """A colour input: an image texture straight into it, else its value."""
@@ -241,17 +285,23 @@ class Conversion:
             node, output = link.from_node, link.from_socket.name
             if node.type != "TEX_IMAGE" or output != "Color" or channel is None:
                 node = None
-        if node is not None and node.type == "TEX_IMAGE" and node.image is not None and not node.inputs["Vector"].is_linked:
+        if node is not None and node.type == "TEX_IMAGE" and node.image is not None:
+            uv = self.uv_transform(node, material, what)
+            if uv is False:
+                return float(socket.default_value)
             if channel is None:
                 channel = "alpha" if output == "Alpha" else "luminance"
             pixels = self.image_pixels(node.image, channel)
             if pixels is not None:
-                return {
+                out = {
                     "array": pixels,
                     "encoding": "linear",
                     "filter": "nearest" if node.interpolation == "Closest" else "linear",
                     "wrap": {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat"),
                 }
+                if uv is not None:
+                    out["uv_transform"] = uv
+                return out
         self.warn(f"material {material}: {what} from the {socket.links[0].from_node.name} node is read by the input's own value")
         return float(socket.default_value)
 

@@ -149,6 +149,26 @@ def scaled(material, factor):
     return out
 
 
+def uv_mapping(kind, location, angle, scale):
+    """A Mapping node on texture coordinates as a 3×3 matrix on (u, v, 1): Point and Vector
+    map uv to R(S·uv) + L (Vector without L), Texture is the inverse of Point."""
+    c, s = math.cos(angle), math.sin(angle)
+    sx, sy = scale
+    lx, ly = location if kind != "VECTOR" else (0.0, 0.0)
+    point = [[c * sx, -s * sy, lx], [s * sx, c * sy, ly], [0.0, 0.0, 1.0]]
+    if kind != "TEXTURE":
+        return point
+    # Inverse: S⁻¹ Rᵀ (uv − L).
+    if sx == 0.0 or sy == 0.0:
+        return [[0.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    rt = [[c / sx, s / sx], [-s / sy, c / sy]]
+    return [
+        [rt[0][0], rt[0][1], -(rt[0][0] * lx + rt[0][1] * ly)],
+        [rt[1][0], rt[1][1], -(rt[1][0] * lx + rt[1][1] * ly)],
+        [0.0, 0.0, 1.0],
+    ]
+
+
 def environment_rotation(mapping_rotation=None):
     """The world-from-map rotation of Blender's equirectangular environment (z up, the image's
     centre towards +x, its u turning towards −y) in caustica's map frame (+y up, the centre

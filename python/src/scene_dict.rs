@@ -7,7 +7,7 @@ use caustica::description::{
     IntegratorHint, LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RenderHints,
     RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
 };
-use caustica::math::{Mat3, Mat4, Vec2, Vec3, Vec4};
+use caustica::math::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 use caustica::texture::{Encoding, Wrap};
 use numpy::{PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -242,6 +242,16 @@ fn image_map(value: &Bound<'_, PyAny>, at: At, encoding: Encoding) -> PyResult<I
     map.sampler.nearest = t
         .choice("filter", &[("linear", false), ("nearest", true)])?
         .unwrap_or(false);
+    if let Some(m) = t.get("uv_transform")? {
+        let at = at.key("uv_transform");
+        let m = array(&m, 3, &at)?;
+        let m = m.as_slice().map_err(|_| at.error("not contiguous"))?;
+        if m.len() != 9 || m[6..] != [0.0, 0.0, 1.0] || m.iter().any(|x| !x.is_finite()) {
+            return Err(at.error("expected a 3×3 affine matrix of numbers (its last row 0, 0, 1)"));
+        }
+        // numpy's rows: (u', v') = m · (u, v, 1).
+        map.sampler.transform = Affine2::from_cols(Vec2::new(m[0], m[3]), Vec2::new(m[1], m[4]), Vec2::new(m[2], m[5]));
+    }
     t.done()?;
     Ok(map)
 }

@@ -405,6 +405,39 @@ for mode in ("LIGHT", "SURFACE", "AUTO"):
     scene.render.filepath = OUT + f"mirror-{mode}.exr"
     bpy.ops.render.render(write_still=True)
 
+# A 2×2 checker through a Mapping node (scale 2 and 3, 30° about z, moved by (0.25, 0.1)),
+# against the same checker on UVs moved so by hand.
+def checker(tree, mapped):
+    p = principled(tree, **{"Specular": 0.0})
+    image = bpy.data.images.new("checker", width=2, height=2)
+    image.pixels = [0.8, 0.8, 0.8, 1, 0.1, 0.1, 0.1, 1, 0.1, 0.1, 0.1, 1, 0.8, 0.8, 0.8, 1]
+    t = tree.nodes.new("ShaderNodeTexImage")
+    t.image = image
+    t.interpolation = "Closest"
+    tree.links.new(t.outputs["Color"], p.inputs["Base Color"])
+    if mapped:
+        m = tree.nodes.new("ShaderNodeMapping")
+        m.inputs["Scale"].default_value = (2.0, 3.0, 1.0)
+        m.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(30.0))
+        m.inputs["Location"].default_value = (0.25, 0.1, 0.0)
+        coords = tree.nodes.new("ShaderNodeTexCoord")
+        tree.links.new(coords.outputs["UV"], m.inputs["Vector"])
+        tree.links.new(m.outputs["Vector"], t.inputs["Vector"])
+
+for mapped in (True, False):
+    scene = plane_scene(lambda t: checker(t, mapped))
+    scene.camera.data.lens = 50.0
+    plane = [o for o in scene.objects if o.type == "MESH"][0]
+    plane.scale = (0.05, 0.05, 1.0)
+    if not mapped:
+        uv = plane.data.uv_layers.active.data
+        c, s = math.cos(math.radians(30.0)), math.sin(math.radians(30.0))
+        for loop in uv:
+            u, v = 2.0 * loop.uv[0], 3.0 * loop.uv[1]
+            loop.uv = (c * u - s * v + 0.25, s * u + c * v + 0.1)
+    scene.render.filepath = OUT + f"checker-{mapped}.exr"
+    bpy.ops.render.render(write_still=True)
+
 # Linked duplicates: three objects, one mesh.
 from caustica_blender.convert import Conversion
 bpy.ops.wm.read_factory_settings(use_empty=True)
@@ -448,5 +481,9 @@ def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_ble
     # Out of the camera's view, the default makes the lamp a glowing surface. (In view it makes
     # it a light: the floors under the lamps above, which the camera looks down past, show it.)
     assert centre("mirror-AUTO") == centre("mirror-SURFACE")
+    # A Mapping node on the UVs reads the image where moved UVs would.
+    mapped, moved = (caustica.read_exr(out + f"checker-{m}.exr") for m in (True, False))
+    np.testing.assert_allclose(mapped, moved, rtol=1e-4, atol=1e-6)
+    assert mapped.max() > 3 * mapped.min()
     # Three objects of one mesh: its arrays once, three shapes placing them.
     assert json.load(open(out + "instances.json")) == {"meshes": 1, "shapes": 3}

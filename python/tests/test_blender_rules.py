@@ -107,3 +107,13 @@ def test_the_environment_rotation_points_the_image_centre_along_blenders_x():
     centre = [sum(r[i][j] * d for j, d in enumerate([0.0, 0.0, -1.0])) for i in range(3)]
     # Looked up at R·d: the image's centre (+x in Blender's frame) is seen along Rᵀ·x = −y.
     assert centre == [0.0, -1.0, 0.0]
+
+
+def test_a_texture_mapping_is_the_inverse_of_a_point_mapping():
+    point = rules.uv_mapping("POINT", [0.3, -0.2], 0.4, [2.0, 0.5])
+    texture = rules.uv_mapping("TEXTURE", [0.3, -0.2], 0.4, [2.0, 0.5])
+    product = [[sum(point[i][k] * texture[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+    flat = [x for row in product for x in row]
+    assert flat == pytest.approx([1, 0, 0, 0, 1, 0, 0, 0, 1], abs=1e-12)
+    # Vector mappings ignore the location.
+    assert rules.uv_mapping("VECTOR", [5.0, 5.0], 0.0, [2.0, 3.0]) == [[2.0, -0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 1.0]]

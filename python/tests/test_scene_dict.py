@@ -419,3 +419,26 @@ def test_a_sphere_light_lights_the_floor_under_it_as_a_point_of_its_intensity():
     with pytest.raises(ValueError, match=r"lights\[0\]\.radius: a radius is not negative"):
         light["radius"] = -1
         caustica.Scene.from_dict(d)
+
+
+def test_a_uv_transform_reads_the_image_where_transformed_coordinates_would():
+    rows = [[(200, 30, 30), (30, 30, 200)], [(10, 220, 10), (250, 250, 250)]]
+    texture = {"array": np.array(rows, dtype=np.uint8), "filter": "nearest"}
+    # uv' = R(30°)·(2u, 3v) + (0.25, 0.1), as numpy rows on (u, v, 1).
+    c, s = np.cos(np.radians(30)), np.sin(np.radians(30))
+    m = np.array([[2 * c, -3 * s, 0.25], [2 * s, 3 * c, 0.1], [0, 0, 1]])
+    options = dict(integrator="path", passes=2, seed=1, threads=1)
+
+    def render(texture, uvs):
+        q = dict(quad("t", 0.5), uvs=uvs)
+        d = looking_down({"t": {"type": "diffuse", "reflectance": texture}}, [q], SKY)
+        return caustica.render(caustica.Scene.from_dict(d), **options)
+
+    uvs = np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=np.float64)
+    moved = (m @ np.c_[uvs, np.ones(4)].T).T[:, :2]
+    a = render(dict(texture, uv_transform=m), uvs)
+    np.testing.assert_allclose(a, render(texture, moved), rtol=1e-4, atol=1e-6)
+    # Not the untransformed image.
+    assert np.abs(a - render(texture, uvs)).max() > 0.05
+    with pytest.raises(ValueError, match="uv_transform: expected a 3×3 affine matrix"):
+        render(dict(texture, uv_transform=np.eye(3) * 2), uvs)
