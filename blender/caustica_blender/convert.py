@@ -13,6 +13,19 @@ import numpy as np
 from . import rules
 
 
+def sampled(source, node, uv):
+    """An image (`source`: its file or pixels) sampled as the Image Texture `node` says, through
+    the uv transform `uv` if there is one."""
+    out = dict(
+        source,
+        filter="nearest" if node.interpolation == "Closest" else "linear",
+        wrap={"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat"),
+    )
+    if uv is not None:
+        out["uv_transform"] = uv
+    return out
+
+
 class Conversion:
     def __init__(self, depsgraph, width, height, crop=None):
         self.depsgraph = depsgraph
@@ -206,14 +219,7 @@ class Conversion:
                     self.warn(f"material {material}: the image {node.image.name} of {what} has no pixels")
                     return None
                 source = {"array": pixels, "encoding": "linear"}
-            out = {
-                **source,
-                "filter": "nearest" if node.interpolation == "Closest" else "linear",
-                "wrap": {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat"),
-            }
-            if uv is not None:
-                out["uv_transform"] = uv
-            return out
+            return sampled(source, node, uv)
         self.warn(f"material {material}: {what} from the {node.name} node is read by the input's own value")
         return None
 
@@ -293,15 +299,7 @@ class Conversion:
                 channel = "alpha" if output == "Alpha" else "luminance"
             pixels = self.image_pixels(node.image, channel)
             if pixels is not None:
-                out = {
-                    "array": pixels,
-                    "encoding": "linear",
-                    "filter": "nearest" if node.interpolation == "Closest" else "linear",
-                    "wrap": {"REPEAT": "repeat", "EXTEND": "clamp", "MIRROR": "mirror"}.get(node.extension, "repeat"),
-                }
-                if uv is not None:
-                    out["uv_transform"] = uv
-                return out
+                return sampled({"array": pixels, "encoding": "linear"}, node, uv)
         self.warn(f"material {material}: {what} from the {socket.links[0].from_node.name} node is read by the input's own value")
         return float(socket.default_value)
 
