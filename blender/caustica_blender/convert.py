@@ -256,12 +256,42 @@ class Conversion:
         return rules.uv_mapping(node.vector_type, location[:2], rotation[2], scale[:2])
 
     def colour(self, socket, material, what):
-        """A colour input: an image texture straight into it, else its value."""
+        """A colour input: an image texture straight into it, or times a colour by a Mix
+        node's Multiply; else its value."""
         if socket.is_linked:
-            t = self.texture(socket, material, what)
+            node = socket.links[0].from_node
+            if node.type in {"MIX_RGB", "MIX"} and getattr(node, "blend_type", "") == "MULTIPLY":
+                t = self.multiplied(node, material, what)
+            else:
+                t = self.texture(socket, material, what)
             if t is not None:
                 return t
         return list(socket.default_value)[:3]
+
+    def multiplied(self, node, material, what):
+        """A Mix node multiplying an image texture by a colour (Fac f): the texture A gives
+        A·(1 − f + f·B); a texture B at f = 1 gives A·B."""
+        if node.type == "MIX":
+            if node.data_type != "RGBA":
+                return None
+            fac, a, b = node.inputs[0], node.inputs[6], node.inputs[7]
+        else:
+            fac, a, b = node.inputs["Fac"], node.inputs["Color1"], node.inputs["Color2"]
+        if fac.is_linked or a.is_linked == b.is_linked:
+            self.warn(f"material {material}: {what} from the {node.name} node is read by the input's own value")
+            return None
+        f = fac.default_value
+        if a.is_linked:
+            t, factor = self.texture(a, material, what), [1.0 - f + f * c for c in b.default_value[:3]]
+        elif f == 1.0:
+            t, factor = self.texture(b, material, what), list(a.default_value[:3])
+        else:
+            self.warn(f"material {material}: {what} from the {node.name} node is read by the input's own value")
+            return None
+        if t is None:
+            return None
+        scale = rules.rgb(t.get("scale", 1.0))
+        return dict(t, scale=[x * y for x, y in zip(scale, factor)])
 
     def normal_map(self, node, material):
         """The tangent-space normal map behind a shader's Normal input, if there is one."""
@@ -361,8 +391,17 @@ class Conversion:
             clearcoat_roughness = self.scalar(
                 named("Clearcoat Roughness", "Coat Roughness"), material, "the clearcoat roughness"
             )
+            # Subsurface scattering as diffuse reflection of its colour (light does not travel
+            # under the surface): Cycles 3 blends the base towards the subsurface colour so.
+            sss = i.get("Subsurface")
+            if not v4 and sss is not None and (sss.is_linked or sss.default_value > 0.0):
+                self.warn(f"material {material}: subsurface scattering is rendered as diffuse reflection of its colour")
+                w = self.value(sss, material, "subsurface")
+                sss_colour = self.value(i["Subsurface Color"], material, "the subsurface colour")
+                if not rules.is_texture(base):
+                    base = [(1.0 - w) * b + w * c for b, c in zip(base, sss_colour)]
             # Inputs with no reading yet: said when they would change the picture.
-            for unread in ["Subsurface", "Subsurface Weight", "Sheen", "Sheen Weight", "Anisotropic"]:
+            for unread in ["Subsurface Weight", "Sheen", "Sheen Weight", "Anisotropic"]:
                 socket = i.get(unread)
                 if socket is not None and (socket.is_linked or socket.default_value > 0.0):
                     self.warn(f"material {material}: the Principled BSDF's {unread} is not rendered")

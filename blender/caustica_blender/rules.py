@@ -119,14 +119,14 @@ def added(first, second):
             out = dict(b)
             emission = a["emission"]
             if "emission" in b and not is_texture(b["emission"]) and not is_texture(emission):
-                emission = [x + y for x, y in zip(_rgb(b["emission"]), _rgb(emission))]
+                emission = [x + y for x, y in zip(rgb(b["emission"]), rgb(emission))]
             out["emission"] = emission
             out["two_sided"] = True
             return out
     return {"type": "mix", "amount": 0.5, "materials": [scaled(first, 2.0), scaled(second, 2.0)]}
 
 
-def _rgb(value):
+def rgb(value):
     return [float(value)] * 3 if isinstance(value, (int, float)) else list(value)
 
 
@@ -141,11 +141,11 @@ def scaled(material, factor):
             continue
         value = out[key]
         if is_texture(value):
-            scale = _rgb(value.get("scale", 1.0))
+            scale = rgb(value.get("scale", 1.0))
             out[key] = dict(value, scale=[factor * s for s in scale])
         else:
             limit = 1.0 if out.get("type") == "conductor" and key == "reflectance" else float("inf")
-            out[key] = [min(limit, factor * x) for x in _rgb(value)]
+            out[key] = [min(limit, factor * x) for x in rgb(value)]
     return out
 
 

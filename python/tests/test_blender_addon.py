@@ -334,6 +334,10 @@ def alpha(tree):
 def clearcoat(tree):
     principled(tree, **{"Base Color": (0, 0, 0, 1), "Specular": 0.0, "Clearcoat": 1.0, "Clearcoat Roughness": 0.0})
 
+def subsurface(tree):
+    principled(tree, **{"Base Color": (1, 1, 1, 1), "Specular": 0.0, "Subsurface": 1.0,
+                        "Subsurface Color": (0.2, 0.4, 0.8, 1)})
+
 def added(tree):
     nodes = tree.nodes
     nodes.remove(nodes["Principled BSDF"])
@@ -359,7 +363,7 @@ def metal(tree, textured):
         tree.links.new(s.outputs["G"], p.inputs["Roughness"])
         tree.links.new(s.outputs["B"], p.inputs["Metallic"])
 
-for name, setup in [("alpha", alpha), ("clearcoat", clearcoat), ("add", added),
+for name, setup in [("alpha", alpha), ("clearcoat", clearcoat), ("add", added), ("subsurface", subsurface),
                     ("metal", lambda t: metal(t, False)), ("metal-textured", lambda t: metal(t, True))]:
     scene = plane_scene(setup)
     if name.startswith("metal"):
@@ -407,7 +411,7 @@ for mode in ("LIGHT", "SURFACE", "AUTO"):
 
 # A 2×2 checker through a Mapping node (scale 2 and 3, 30° about z, moved by (0.25, 0.1)),
 # against the same checker on UVs moved so by hand.
-def checker(tree, mapped):
+def checker(tree, mapped, tint=None):
     p = principled(tree, **{"Specular": 0.0})
     image = bpy.data.images.new("checker", width=2, height=2)
     image.pixels = [0.8, 0.8, 0.8, 1, 0.1, 0.1, 0.1, 1, 0.1, 0.1, 0.1, 1, 0.8, 0.8, 0.8, 1]
@@ -415,6 +419,13 @@ def checker(tree, mapped):
     t.image = image
     t.interpolation = "Closest"
     tree.links.new(t.outputs["Color"], p.inputs["Base Color"])
+    if tint is not None:
+        mix = tree.nodes.new("ShaderNodeMixRGB")
+        mix.blend_type = "MULTIPLY"
+        mix.inputs["Fac"].default_value = 1.0
+        mix.inputs["Color2"].default_value = tint
+        tree.links.new(t.outputs["Color"], mix.inputs["Color1"])
+        tree.links.new(mix.outputs["Color"], p.inputs["Base Color"])
     if mapped:
         m = tree.nodes.new("ShaderNodeMapping")
         m.inputs["Scale"].default_value = (2.0, 3.0, 1.0)
@@ -424,12 +435,12 @@ def checker(tree, mapped):
         tree.links.new(coords.outputs["UV"], m.inputs["Vector"])
         tree.links.new(m.outputs["Vector"], t.inputs["Vector"])
 
-for mapped in (True, False):
-    scene = plane_scene(lambda t: checker(t, mapped))
+for mapped in (True, False, "tinted"):
+    scene = plane_scene(lambda t: checker(t, mapped is True, (0.5, 1.0, 1.0, 1.0) if mapped == "tinted" else None))
     scene.camera.data.lens = 50.0
     plane = [o for o in scene.objects if o.type == "MESH"][0]
     plane.scale = (0.05, 0.05, 1.0)
-    if not mapped:
+    if mapped is not True:
         uv = plane.data.uv_layers.active.data
         c, s = math.cos(math.radians(30.0)), math.sin(math.radians(30.0))
         for loop in uv:
@@ -464,6 +475,9 @@ def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_ble
     # A clear coat of index 1.5 on black, head-on under a white world: ¼ · F(0) = 0.01 (Cycles'
     # Disney coat is a quarter of its input).
     assert centre("clearcoat") == pytest.approx(0.01, rel=0.02)
+    # Subsurface 1 renders as diffuse reflection of its colour: under a white world, that colour.
+    sss = caustica.read_exr(out + "subsurface.exr")[4:12, 4:12].mean(axis=(0, 1))
+    np.testing.assert_allclose(sss, [0.2, 0.4, 0.8], rtol=0.02)
     # Diffuse ½ plus emission 1 under a white world: 1 + ½.
     assert centre("add") == pytest.approx(1.5, rel=0.02)
     # Roughness 0.4 and metal 1 from an image's green and blue render as the same inputs set.
@@ -485,5 +499,10 @@ def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_ble
     mapped, moved = (caustica.read_exr(out + f"checker-{m}.exr") for m in (True, False))
     np.testing.assert_allclose(mapped, moved, rtol=1e-4, atol=1e-6)
     assert mapped.max() > 3 * mapped.min()
+    # A Mix node multiplying the image by (½, 1, 1): half its red, under a white world.
+    tinted = caustica.read_exr(out + "checker-tinted.exr")
+    tinted, moved = tinted[3:13, 3:13], moved[3:13, 3:13]
+    assert tinted[..., 0].mean() == pytest.approx(0.5 * moved[..., 0].mean(), rel=0.02)
+    assert tinted[..., 1].mean() == pytest.approx(moved[..., 1].mean(), rel=0.02)
     # Three objects of one mesh: its arrays once, three shapes placing them.
     assert json.load(open(out + "instances.json")) == {"meshes": 1, "shapes": 3}
