@@ -71,8 +71,6 @@ class Conversion:
         cam = cam_obj.data
         if cam.type != "PERSP":
             self.warn(f"camera {cam_obj.name}: only perspective cameras are rendered")
-        if cam.dof.use_dof:
-            self.warn(f"camera {cam_obj.name}: depth of field is not rendered (a pinhole)")
         if self.scene.render.use_motion_blur:
             self.warn("motion blur is not rendered")
         fov = rules.vertical_fov(cam.sensor_fit, cam.sensor_width, cam.sensor_height, cam.lens, self.width, self.height)
@@ -87,7 +85,29 @@ class Conversion:
             out["shift"] = rules.lens_shift(cam.sensor_fit, cam.shift_x, cam.shift_y, self.width, self.height)
         if self.crop is not None:
             out["crop"] = list(self.crop)
+        if cam.dof.use_dof:
+            out.update(self.depth_of_field(cam_obj))
         return out
+
+    def depth_of_field(self, cam_obj):
+        """Blender's depth of field as a thin lens: radius = focal length / (2 f-stop), in
+        scene units as Cycles takes it, focused at the focus object's depth or the distance."""
+        cam = cam_obj.data
+        dof = cam.dof
+        if dof.aperture_blades > 0 or abs(dof.aperture_ratio - 1.0) > 1e-6 or abs(dof.aperture_rotation) > 1e-6:
+            self.warn(f"camera {cam_obj.name}: the aperture is rendered round (blades, ratio and rotation are not read)")
+        focus = dof.focus_distance
+        if dof.focus_object is not None:
+            m = np.array(cam_obj.matrix_world, dtype=np.float64)
+            forward = -m[:3, 2] / np.linalg.norm(m[:3, 2])
+            target = np.array(dof.focus_object.matrix_world.translation, dtype=np.float64)
+            focus = float((target - m[:3, 3]) @ forward)
+        unit = self.scene.unit_settings.scale_length or 1.0
+        radius = rules.aperture_radius(cam.lens, dof.aperture_fstop, unit)
+        if focus <= 0.0:
+            self.warn(f"camera {cam_obj.name}: the focus is behind the camera: no depth of field")
+            return {}
+        return {"aperture": radius, "focus_distance": focus}
 
     # ---- meshes -----------------------------------------------------------------------------
 

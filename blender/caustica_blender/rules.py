@@ -34,6 +34,12 @@ def border(min_x, max_x, min_y, max_y, width, height):
     return [x0, max(x1, x0 + 1), height - max(y1, y0 + 1), height - y0]
 
 
+def aperture_radius(lens_mm, fstop, unit_scale=1.0):
+    """The aperture radius in scene units of a lens of `lens_mm` at f-stop `fstop`: half the
+    focal length over the f-stop, the millimetres in metres over the scene's unit scale."""
+    return 0.5 * lens_mm * 1e-3 / max(fstop, 1e-6) / unit_scale
+
+
 def point_intensity(energy):
     """A point or spot light of `energy` watts: its intensity in W/sr, P/(4π)."""
     return energy / (4.0 * math.pi)

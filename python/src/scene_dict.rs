@@ -5,7 +5,7 @@
 use caustica::description::{
     Alpha, CameraDesc, ClearCoat, ClearCoatMaps, Coating, EmittingFaces, FovAxis, ImageMap, ImageSource,
     IntegratorHint, LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RenderHints,
-    RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc, TrimeshDesc, SMOOTH_ALPHA,
+    RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc, ThinLens, TrimeshDesc, SMOOTH_ALPHA,
 };
 use caustica::math::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 use caustica::texture::{Encoding, Wrap};
@@ -532,6 +532,17 @@ fn camera(value: &Bound<'_, PyAny>, at: At) -> PyResult<(CameraDesc, Size)> {
         },
         None => Vec2::ZERO,
     };
+    let aperture = t.float("aperture", 0.0)?;
+    let focus = t.float("focus_distance", 0.0)?;
+    let lens = match (aperture, focus) {
+        (a, _) if a < 0.0 => return Err(at.key("aperture").error(format!("a radius is not negative, not {a}"))),
+        (a, f) if a > 0.0 && f <= 0.0 => {
+            return Err(at
+                .key("focus_distance")
+                .error("an aperture needs a focus distance above 0"))
+        }
+        (a, f) => (a > 0.0).then_some(ThinLens { radius: a, focus: f }),
+    };
     let crop = match t.get("crop")? {
         Some(v) => {
             let (Some(w), Some(h)) = (width, height) else {
@@ -577,6 +588,7 @@ fn camera(value: &Bound<'_, PyAny>, at: At) -> PyResult<(CameraDesc, Size)> {
         aspect_ratio: aspect,
         right: Some(right),
         fov_axis,
+        lens,
         span: 0..0,
     };
     Ok((camera, size))

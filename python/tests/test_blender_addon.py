@@ -322,6 +322,24 @@ def plane_scene(setup):
     caustica_settings(scene, "PATH", 16, 16, 16)
     return scene
 
+# The tree's Principled BSDF replaced by a new node of `kind`, linked to the output.
+def replaced(tree, kind):
+    nodes = tree.nodes
+    nodes.remove(nodes["Principled BSDF"])
+    node = nodes.new(kind)
+    tree.links.new(node.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return node
+
+# `name`-CAUSTICA.exr and `name`-CYCLES.exr: the scene by caustica and by Cycles.
+def both_engines(scene, name, samples):
+    for engine in ("CAUSTICA", "CYCLES"):
+        scene.render.engine = engine
+        scene.cycles.samples = samples
+        scene.cycles.use_denoising = False
+        scene.caustica.passes = samples
+        scene.render.filepath = OUT + f"{name}-{engine}.exr"
+        bpy.ops.render.render(write_still=True)
+
 def principled(tree, **inputs):
     p = tree.nodes["Principled BSDF"]
     for k, v in inputs.items():
@@ -339,16 +357,13 @@ def subsurface(tree):
                         "Subsurface Color": (0.2, 0.4, 0.8, 1)})
 
 def added(tree):
-    nodes = tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    d = nodes.new("ShaderNodeBsdfDiffuse")
+    a = replaced(tree, "ShaderNodeAddShader")
+    d = tree.nodes.new("ShaderNodeBsdfDiffuse")
     d.inputs["Color"].default_value = (0.5, 0.5, 0.5, 1)
-    e = nodes.new("ShaderNodeEmission")
+    e = tree.nodes.new("ShaderNodeEmission")
     e.inputs["Strength"].default_value = 1.0
-    a = nodes.new("ShaderNodeAddShader")
     tree.links.new(d.outputs[0], a.inputs[0])
     tree.links.new(e.outputs[0], a.inputs[1])
-    tree.links.new(a.outputs[0], nodes["Material Output"].inputs["Surface"])
 
 def metal(tree, textured):
     p = principled(tree, **{"Base Color": (0.9, 0.6, 0.3, 1), "Metallic": 1.0, "Roughness": 0.4})
@@ -378,23 +393,15 @@ for name, setup in [("alpha", alpha), ("clearcoat", clearcoat), ("add", added), 
 # Blender's default Principled (Specular 0.5, roughness 0.5) on a grey plane under the white
 # world, by caustica and by Cycles.
 scene = plane_scene(lambda t: principled(t, **{"Base Color": (0.6, 0.6, 0.6, 1), "Roughness": 0.5}))
-for engine in ("CAUSTICA", "CYCLES"):
-    scene.render.engine = engine
-    scene.cycles.samples = 64
-    scene.cycles.use_denoising = False
-    scene.render.filepath = OUT + f"default-{engine}.exr"
-    bpy.ops.render.render(write_still=True)
+both_engines(scene, "default", 64)
 
 # A mirror seen at 26.6° from its normal, an area light where it reflects the view: the camera
 # sees the lamp in it when area lights are glowing surfaces (the default, for a lamp out of
 # view), not when they are lights.
 def mirror(tree):
-    nodes = tree.nodes
-    nodes.remove(nodes["Principled BSDF"])
-    g = nodes.new("ShaderNodeBsdfGlossy")
+    g = replaced(tree, "ShaderNodeBsdfGlossy")
     g.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1)
     g.inputs["Roughness"].default_value = 0.0
-    tree.links.new(g.outputs[0], nodes["Material Output"].inputs["Surface"])
 
 for mode in ("LIGHT", "SURFACE", "AUTO"):
     scene = plane_scene(mirror)
@@ -448,6 +455,28 @@ for mapped in (True, False, "tinted"):
             loop.uv = (c * u - s * v + 0.25, s * u + c * v + 0.1)
     scene.render.filepath = OUT + f"checker-{mapped}.exr"
     bpy.ops.render.render(write_still=True)
+
+# Depth of field: a 4×4 checker (Diffuse BSDF) seen at an angle through f/0.2 focused 1 m
+# away, by caustica and by Cycles.
+def diffuse_checker(tree):
+    d = replaced(tree, "ShaderNodeBsdfDiffuse")
+    image = bpy.data.images.new("checker4", width=4, height=4)
+    image.pixels = [v for j in range(4) for i in range(4) for v in ([0.9] * 3 if (i + j) % 2 else [0.15] * 3) + [1.0]]
+    t = tree.nodes.new("ShaderNodeTexImage")
+    t.image = image
+    t.interpolation = "Closest"
+    tree.links.new(t.outputs["Color"], d.inputs["Color"])
+
+scene = plane_scene(diffuse_checker)
+[o for o in scene.objects if o.type == "MESH"][0].scale = (0.1, 0.1, 1.0)
+scene.camera.location = (0.0, -2.5, 2.5)
+scene.camera.rotation_euler = (math.radians(45.0), 0.0, 0.0)
+scene.camera.data.lens = 50.0
+scene.camera.data.dof.use_dof = True
+scene.camera.data.dof.focus_distance = 1.0
+scene.camera.data.dof.aperture_fstop = 0.2
+scene.render.resolution_x = scene.render.resolution_y = 32
+both_engines(scene, "dof", 256)
 
 # Linked duplicates: three objects, one mesh.
 from caustica_blender.convert import Conversion
@@ -504,5 +533,10 @@ def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_ble
     tinted, moved = tinted[3:13, 3:13], moved[3:13, 3:13]
     assert tinted[..., 0].mean() == pytest.approx(0.5 * moved[..., 0].mean(), rel=0.02)
     assert tinted[..., 1].mean() == pytest.approx(moved[..., 1].mean(), rel=0.02)
+    # Depth of field as Cycles renders it: 8×8-pixel blocks of the blurred checker (measured
+    # within 1.25%).
+    blocks = lambda a: a.mean(axis=2).reshape(4, 8, 4, 8).mean(axis=(1, 3))  # noqa: E731
+    ours, cycles = (blocks(caustica.read_exr(out + f"dof-{e}.exr")) for e in ("CAUSTICA", "CYCLES"))
+    np.testing.assert_allclose(ours, cycles, rtol=0.03)
     # Three objects of one mesh: its arrays once, three shapes placing them.
     assert json.load(open(out + "instances.json")) == {"meshes": 1, "shapes": 3}

@@ -117,3 +117,9 @@ def test_a_texture_mapping_is_the_inverse_of_a_point_mapping():
     assert flat == pytest.approx([1, 0, 0, 0, 1, 0, 0, 0, 1], abs=1e-12)
     # Vector mappings ignore the location.
     assert rules.uv_mapping("VECTOR", [5.0, 5.0], 0.0, [2.0, 3.0]) == [[2.0, -0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 1.0]]
+
+
+def test_the_aperture_is_half_the_focal_length_over_the_f_stop():
+    # 50 mm at f/2: a radius of 12.5 mm, in metres; in a scene whose unit is a centimetre, 1.25.
+    assert rules.aperture_radius(50.0, 2.0) == pytest.approx(0.0125)
+    assert rules.aperture_radius(50.0, 2.0, 0.01) == pytest.approx(1.25)

@@ -1,8 +1,8 @@
 //! The camera: a pinhole whose image plane is spanned by `u` and `v` (the course's camera, §4;
 //! every scene format describes one of these, see [`CameraDesc`]).
 
-use crate::description::{CameraDesc, FovAxis};
-use crate::math::{Ray, Vec3};
+use crate::description::{CameraDesc, FovAxis, ThinLens};
+use crate::math::{Ray, Vec2, Vec3};
 
 /// A pinhole camera.
 #[derive(Clone, Debug, PartialEq)]
@@ -19,6 +19,8 @@ pub struct Camera {
     pub aspect_ratio: f32,
     /// Which span keeps its field of view in an image of another aspect ([`Camera::fitted`]).
     pub fov_axis: FovAxis,
+    /// A thin lens (depth of field); `None`: a pinhole at `eye`.
+    pub lens: Option<ThinLens>,
 }
 
 impl Default for Camera {
@@ -36,6 +38,7 @@ impl Camera {
             camera.u = right * desc.height * desc.aspect_ratio;
         }
         camera.fov_axis = desc.fov_axis;
+        camera.lens = desc.lens.filter(|l| l.radius > 0.0 && l.focus > 0.0);
         camera
     }
 
@@ -49,6 +52,7 @@ impl Camera {
             v: up * h,
             aspect_ratio,
             fov_axis: FovAxis::Vertical,
+            lens: None,
         }
     }
 
@@ -118,7 +122,31 @@ impl Camera {
     #[inline]
     pub fn generate_ray(&self, sx: f32, sy: f32) -> Ray {
         let dir = self.look + (sx - 0.5) * self.u + (sy - 0.5) * self.v;
-        Ray::new(self.eye, dir.normalize_or_zero())
+        let Some(lens) = self.lens else {
+            return Ray::new(self.eye, dir.normalize_or_zero());
+        };
+        // Through the point of the focus plane the pinhole ray meets, from a lens point drawn
+        // from the screen point's bits (the same screen point, the same lens point).
+        let axis = self.axis();
+        let focus_point = self.eye + dir * (lens.focus / dir.dot(axis));
+        let origin = self.lens_point(lens, hash_point(&[sx, sy]));
+        Ray::new(origin, (focus_point - origin).normalize_or_zero())
+    }
+
+    /// The unit normal of the image plane, on the side the camera looks to.
+    pub fn axis(&self) -> Vec3 {
+        let n = self.u.cross(self.v).normalize_or_zero();
+        if n.dot(self.look) < 0.0 {
+            -n
+        } else {
+            n
+        }
+    }
+
+    /// The lens point at `s` ∈ [0, 1)² (uniform over the aperture's disc).
+    pub fn lens_point(&self, lens: ThinLens, s: Vec2) -> Vec3 {
+        let d = crate::sampling::sample_uniform_disc(s) * lens.radius;
+        self.eye + self.u.normalize_or_zero() * d.x + self.v.normalize_or_zero() * d.y
     }
 
     /// Where a world point lands on the screen, as (sx, sy) in [0, 1]² when visible; `None`
@@ -140,4 +168,16 @@ impl Camera {
     pub fn height_for_width(&self, width: usize) -> usize {
         ((width as f32 / self.aspect_ratio).round() as usize).max(1)
     }
+}
+
+/// Two numbers in [0, 1) from the bits of `values`: the lens point of a screen point or of a
+/// point seen through the lens, the same each time the same point is asked for.
+pub fn hash_point(values: &[f32]) -> Vec2 {
+    let h = values.iter().fold(0x9e37_79b9_7f4a_7c15u64, |h, v| {
+        crate::sampling::mix64(h ^ u64::from(v.to_bits()))
+    });
+    Vec2::new(
+        (h >> 40) as f32 / (1u64 << 24) as f32,
+        ((h >> 16) & 0xff_ffff) as f32 / (1u64 << 24) as f32,
+    )
 }

@@ -86,8 +86,22 @@ pub struct CameraDesc {
     pub right: Option<Vec3>,
     /// Which span keeps its field of view when the image's aspect differs from `aspect_ratio`.
     pub fov_axis: FovAxis,
+    /// A thin lens for depth of field; `None`: a pinhole.
+    pub lens: Option<ThinLens>,
     /// Where the camera is described.
     pub span: Span,
+}
+
+/// A thin lens: the camera's rays leave a disc of `radius` around the eye, across the image
+/// plane, and those through one point of the image meet again at the distance `focus` along
+/// the view (pbrt's `lensradius` and `focaldistance`; Blender's focal length over twice the
+/// f-stop, and its focus distance).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    /// The aperture's radius, in scene units.
+    pub radius: f32,
+    /// The distance in focus, along the view.
+    pub focus: f32,
 }
 
 /// The axis whose field of view a format fixes: an image of another aspect than the camera's

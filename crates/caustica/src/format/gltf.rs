@@ -1334,6 +1334,7 @@ impl Reader<'_, '_> {
             aspect_ratio: aspect,
             right: Some(right),
             fov_axis: FovAxis::Vertical,
+            lens: None,
             span: locate(&self.files.main().text, &format!("cameras[{index}]")),
         });
     }

@@ -819,6 +819,7 @@ pub fn look_at(eye: Vec3, target: Vec3, up: Vec3, fov_degrees: f32, aspect_ratio
         aspect_ratio,
         right: None,
         fov_axis: FovAxis::Vertical,
+        lens: None,
         span: 0..0,
     }
 }

@@ -23,7 +23,7 @@ use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
     Alpha, CameraDesc, ClearCoat, Coating, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc,
     MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc,
-    TrimeshDesc, SMOOTH_ALPHA,
+    ThinLens, TrimeshDesc, SMOOTH_ALPHA,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
@@ -767,10 +767,13 @@ impl<'f> Reader<'f> {
             let s = params.span_of("fov").unwrap_or(span.clone());
             return Err(ParseError::new("`fov` must lie between 0 and 180 degrees", s));
         }
-        if params.float("lensradius")?.is_some_and(|r| r > 0.0) {
-            self.warn("depth of field is not rendered: a pinhole camera is used", span.clone());
-        }
-        params.float("focaldistance")?;
+        // pbrt-v4's defaults: no aperture, focus a million units away.
+        let lens_radius = params.float("lensradius")?.unwrap_or(0.0);
+        let focus = params.float("focaldistance")?.unwrap_or(1e6);
+        let lens = (lens_radius > 0.0 && focus > 0.0).then_some(ThinLens {
+            radius: lens_radius,
+            focus,
+        });
         params.float("shutteropen")?;
         params.float("shutterclose")?;
         self.report_unused(&params, "the camera");
@@ -793,6 +796,7 @@ impl<'f> Reader<'f> {
             aspect_ratio: (window[1] - window[0]) / (window[3] - window[2]),
             right: Some(right),
             fov_axis: FovAxis::Shorter,
+            lens,
             span,
         });
         Ok(())

@@ -129,13 +129,28 @@ impl Sensor {
         if self.scale <= 0.0 {
             return None;
         }
-        let (sx, sy) = camera.project(p)?;
+        // Through a thin lens: from a lens point drawn from p's bits, the pixel is where the ray
+        // from it through p meets the focus plane, seen from the eye; the importance is the
+        // pinhole's from that lens point (the lens's area and its density cancel).
+        let (eye, seen) = match camera.lens {
+            None => (self.eye, p),
+            Some(lens) => {
+                let l = camera.lens_point(lens, crate::camera::hash_point(&[p.x, p.y, p.z]));
+                let w = p - l;
+                let along = w.dot(self.normal);
+                if along <= 0.0 {
+                    return None;
+                }
+                (l, l + w * (lens.focus / along))
+            }
+        };
+        let (sx, sy) = camera.project(seen)?;
         let x = sx * self.width as f32;
         let y = (1.0 - sy) * self.height as f32;
         if !(x >= 0.0 && y >= 0.0 && x < self.width as f32 && y < self.height as f32) {
             return None;
         }
-        let offset = self.eye - p;
+        let offset = eye - p;
         let distance = offset.length();
         if distance.is_nan() || distance <= 0.0 {
             return None;

@@ -217,6 +217,7 @@ impl RayCamera {
             aspect_ratio: aspect,
             right: None,
             fov_axis: FovAxis::Vertical,
+            lens: None,
             span: self.span.clone(),
         }
     }
