@@ -50,6 +50,41 @@ fn the_camera_is_not_mirrored() {
     assert!(camera.project(Vec3::new(1.0, 0.0, 0.0)).unwrap().0 > 0.5);
 }
 
+/// pbrt's thin lens: `lensradius` and `focaldistance`; in focus, a point on the focus plane
+/// lands on one pixel from every lens point, a nearer one on several.
+#[test]
+fn the_camera_reads_a_thin_lens() {
+    let text = "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float lensradius\" 0.2 \"float focaldistance\" 5\nWorldBegin\n";
+    let desc = read_text(text).unwrap().description;
+    let lens = desc.camera.as_ref().unwrap().lens.unwrap();
+    assert_eq!((lens.radius, lens.focus), (0.2, 5.0));
+    let camera = crate::camera::Camera::from_desc(desc.camera.as_ref().unwrap());
+    // Rays through one screen point from different lens points (drawn from nearby screen
+    // points' bits) meet at the focus plane, 5 along the view.
+    let hits: Vec<Vec3> = [0.3001f32, 0.30011, 0.30012]
+        .iter()
+        .map(|&sx| {
+            let ray = camera.generate_ray(sx, 0.6);
+            ray.origin + ray.dir * ((0.0 - ray.origin.z) / ray.dir.z)
+        })
+        .collect();
+    let origins: Vec<Vec3> = [0.3001f32, 0.30011, 0.30012]
+        .iter()
+        .map(|&sx| camera.generate_ray(sx, 0.6).origin)
+        .collect();
+    assert!(
+        (origins[0] - origins[1]).length() > 1e-3,
+        "different lens points: {origins:?}"
+    );
+    assert!(
+        (hits[0] - hits[1]).length() < 1e-3 && (hits[0] - hits[2]).length() < 1e-3,
+        "{hits:?}"
+    );
+    // Without the parameters, a pinhole.
+    let pinhole = read_text("LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n").unwrap();
+    assert!(pinhole.description.camera.unwrap().lens.is_none());
+}
+
 #[test]
 fn transforms_compose_as_pbrt_does() {
     let desc = scene(
