@@ -38,6 +38,8 @@ class Conversion:
         self.meshes = {}
         # Each mesh's parts by material, converted once however many instances place it.
         self.mesh_parts = {}
+        # Images' pixels by (name, channel), for maps that read them.
+        self.pixel_cache = {}
         self.shapes = []
         self.lights = []
 
@@ -355,7 +357,14 @@ class Conversion:
 
     def image_pixels(self, image, channel):
         """One channel of an image's pixels as linear values (rows from the top): 0–2, "alpha",
-        or "luminance"; an sRGB image's colour is decoded first, as Cycles reads it into a number."""
+        "luminance" or "rgb"; an sRGB image's colour is decoded first, as Cycles reads it into a
+        number. Each image and channel is read once per conversion."""
+        key = (image.name, channel)
+        if key not in self.pixel_cache:
+            self.pixel_cache[key] = self.read_pixels(image, channel)
+        return self.pixel_cache[key]
+
+    def read_pixels(self, image, channel):
         w, h = image.size
         if w == 0 or h == 0:
             return None

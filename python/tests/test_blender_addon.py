@@ -25,26 +25,10 @@ COMMON = r"""
 import json, math, sys
 import bpy
 sys.path.insert(0, ADDONS)
+sys.path.insert(0, SCENES)
 import caustica_blender
+from blender_build import add_light, camera, grey_floor
 caustica_blender.register()
-
-
-def grey_floor(size):
-    bpy.ops.mesh.primitive_plane_add(size=size)
-    floor = bpy.data.materials.new("Floor")
-    floor.use_nodes = True
-    bsdf = floor.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    bsdf.inputs["Specular"].default_value = 0.0
-    bpy.context.object.data.materials.append(floor)
-
-
-def camera(scene, location, rotation=(0.0, 0.0, 0.0)):
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    cam.location = location
-    cam.rotation_euler = rotation
-    scene.collection.objects.link(cam)
-    scene.camera = cam
 
 
 def caustica_settings(scene, integrator, passes, width, height):
@@ -67,13 +51,7 @@ caustica_settings(scene, "PATH", 4, 40, 30)
 def lamp(kind, **props):
     for o in [o for o in scene.objects if o.type == "LIGHT"]:
         bpy.data.objects.remove(o)
-    light = bpy.data.lights.new(kind, type=kind)
-    for k, v in props.items():
-        setattr(light, k, v)
-    obj = bpy.data.objects.new(kind, light)
-    obj.location = (0.0, 0.0, 3.0)
-    scene.collection.objects.link(obj)
-    return obj
+    return add_light(scene, kind, **props)
 for name, kind, props in [
     ("point", "POINT", dict(energy=1000.0, shadow_soft_size=0.0)),
     ("sun", "SUN", dict(energy=3.0, angle=0.0)),
@@ -91,7 +69,11 @@ json.dump({"engine": scene.render.engine}, open(OUT + ".json", "w"))
 def run_blender(tmp_path, script_text):
     out = str(tmp_path / "r-")
     script = tmp_path / "scene.py"
-    script.write_text(f"ADDONS = {str(ROOT / 'blender')!r}\nOUT = {out!r}\n" + COMMON + script_text)
+    script.write_text(
+        f"ADDONS = {str(ROOT / 'blender')!r}\nSCENES = {str(ROOT / 'scripts' / 'scenes')!r}\nOUT = {out!r}\n"
+        + COMMON
+        + script_text
+    )
     env = dict(os.environ)
     # Blender's own Python finds the caustica package where this test imports it from.
     env["PYTHONPATH"] = os.pathsep.join([str(Path(caustica.__file__).parents[1]), env.get("PYTHONPATH", "")])
@@ -151,12 +133,7 @@ def build(glass_node):
         p.inputs["Roughness"].default_value = 0.0
         p.inputs["Base Color"].default_value = (1.0, 1.0, 1.0, 1.0)
     bpy.context.object.data.materials.append(glass)
-    light = bpy.data.lights.new("Lamp", type="POINT")
-    light.energy = 2000.0
-    light.shadow_soft_size = 0.0
-    lamp = bpy.data.objects.new("Lamp", light)
-    lamp.location = (0.0, 0.0, 6.0)
-    scene.collection.objects.link(lamp)
+    add_light(scene, "POINT", (0.0, 0.0, 6.0), "Lamp", energy=2000.0, shadow_soft_size=0.0)
     camera(scene, (0.0, -7.0, 6.0), (math.radians(45.0), 0.0, 0.0))
     caustica_settings(scene, "VCM", 32, 64, 48)
     return scene

@@ -16,8 +16,10 @@ import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "blender"))
+sys.path.insert(0, os.path.join(ROOT, "scripts", "scenes"))
 import caustica  # noqa: E402
 import caustica_blender  # noqa: E402
+from blender_build import add_light, camera, grey_floor  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 out = os.path.abspath(argv[0] if argv else "blender-lights")
@@ -30,18 +32,8 @@ W, H = 64, 48
 def base_scene():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    bpy.ops.mesh.primitive_plane_add(size=40.0)
-    floor = bpy.data.materials.new("Floor")
-    floor.use_nodes = True
-    bsdf = floor.node_tree.nodes["Principled BSDF"]
-    bsdf.inputs["Base Color"].default_value = (0.5, 0.5, 0.5, 1.0)
-    bsdf.inputs["Specular"].default_value = 0.0
-    bsdf.inputs["Roughness"].default_value = 0.0
-    bpy.context.object.data.materials.append(floor)
-    cam = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
-    cam.location = (0.0, 0.0, 8.0)
-    scene.collection.objects.link(cam)
-    scene.camera = cam
+    grey_floor(40.0)
+    camera(scene, (0.0, 0.0, 8.0))
     world = bpy.data.worlds.new("World")
     world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
@@ -52,16 +44,6 @@ def base_scene():
     scene.render.image_settings.color_depth = "32"
     scene.view_settings.view_transform = "Standard"
     return scene
-
-
-def add_light(scene, kind, **props):
-    light = bpy.data.lights.new(kind, type=kind)
-    for k, v in props.items():
-        setattr(light, k, v)
-    obj = bpy.data.objects.new(kind, light)
-    obj.location = (0.0, 0.0, 3.0)
-    scene.collection.objects.link(obj)
-    return obj
 
 
 def setups():

@@ -18,6 +18,9 @@ import sys
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from blender_build import add_light, camera  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 out = os.path.abspath(argv[0] if argv else "blender-export")
 samples = int(argv[1]) if len(argv) > 1 else 256
@@ -82,21 +85,10 @@ boxed.node_tree.links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
 place(bpy.context.object, boxed)
 
 # A 1000 W point light above the glass ball, point-sized.
-light = bpy.data.lights.new("Lamp", type="POINT")
-light.energy = 1000.0
-light.shadow_soft_size = 0.0
-lamp = bpy.data.objects.new("Lamp", light)
-lamp.location = (0.0, 0.0, 4.0)
-scene.collection.objects.link(lamp)
+add_light(scene, "POINT", (0.0, 0.0, 4.0), "Lamp", energy=1000.0, shadow_soft_size=0.0)
 
 # Blender's default camera placement and lens; 16:9.
-cam = bpy.data.cameras.new("Camera")
-cam.lens = 50.0
-camera = bpy.data.objects.new("Camera", cam)
-camera.location = (7.36, -6.93, 4.96)
-camera.rotation_euler = (math.radians(63.6), 0.0, math.radians(46.7))
-scene.collection.objects.link(camera)
-scene.camera = camera
+camera(scene, (7.36, -6.93, 4.96), (math.radians(63.6), 0.0, math.radians(46.7))).data.lens = 50.0
 
 # No world light: the lamp alone.
 world = bpy.data.worlds.new("World")
