@@ -26,6 +26,63 @@ pub struct SceneDescription {
     /// What the file says about how to render it (image size, integrator); a front end's own
     /// options win over these.
     pub hints: RenderHints,
+    /// Participating media, which materials' [`InterfaceDesc`]s name by index.
+    pub media: Vec<MediumDesc>,
+    /// The medium that fills the scene where no interface says otherwise (haze), if any.
+    pub ambient_medium: Option<usize>,
+    /// The media lights are in, where the file says (light index, medium); other lights' are
+    /// found from the surfaces around them.
+    pub light_media: Vec<(usize, Option<usize>)>,
+    /// The medium the camera is in, where the file says (pbrt's `CameraMedium`); otherwise it
+    /// is found from the surfaces around the eye.
+    pub camera_medium: Option<usize>,
+}
+
+/// A participating medium: coefficients per unit of length (RGB, already scaled) and a
+/// Henyey–Greenstein phase function; on a grid, the density multiplies both.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MediumDesc {
+    /// Its name in the file, if any.
+    pub name: Option<String>,
+    /// σa, absorption.
+    pub sigma_a: Vec3,
+    /// σs, scattering.
+    pub sigma_s: Vec3,
+    /// Henyey–Greenstein's mean cosine.
+    pub g: f32,
+    /// A density grid, or `None`: homogeneous.
+    pub grid: Option<GridDesc>,
+    /// Where it was defined.
+    pub span: Span,
+}
+
+/// A density on a regular grid of samples (x fastest), spanning the unit cube of grid space.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridDesc {
+    /// Samples along x, y and z.
+    pub dims: [usize; 3],
+    /// The densities.
+    pub values: Vec<f32>,
+    /// From world space to the grid's unit cube.
+    pub grid_from_world: Mat4,
+}
+
+/// Which media a material's surface separates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct InterfaceDesc {
+    /// Against the outward normal.
+    pub inside: MediumSide,
+    /// On the outward normal's side.
+    pub outside: MediumSide,
+}
+
+/// One side of a medium boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MediumSide {
+    /// This medium (an index into [`SceneDescription::media`]), or `None`: vacuum.
+    Medium(Option<usize>),
+    /// Whatever surrounded a path before it went in.
+    Surrounding,
 }
 
 /// Render settings a scene file asks for (pbrt-v4's `Film`, `Integrator` and `Sampler`,
@@ -48,6 +105,9 @@ pub struct RenderHints {
     pub photons_per_pass: Option<usize>,
     /// Gather radius in scene units (pbrt's sppm `radius`).
     pub radius: Option<f32>,
+    /// A medium scatters light: only path tracing and light tracing render it, and path
+    /// tracing is the default.
+    pub scattering_media: bool,
     /// The output file the scene names (pbrt's `Film "filename"`), as written.
     pub output: Option<PathBuf>,
 }
@@ -360,6 +420,11 @@ pub struct MaterialDesc {
     /// length d inside keeps exp(−σ d) (Beer–Lambert; glTF's `KHR_materials_volume`
     /// attenuation). `None`: clear.
     pub absorption: Option<Vec3>,
+    /// The media on the two sides of the surface (`None`: it changes no path's medium).
+    pub interface: Option<InterfaceDesc>,
+    /// Only a boundary between media (pbrt's `interface`): paths pass it unchanged and it is not
+    /// drawn.
+    pub boundary: bool,
     /// pbrt's `mix`: the physical reading takes one of two materials at each point; the course
     /// fields above hold the larger part.
     pub mix: Option<Box<MixDesc>>,
@@ -764,6 +829,8 @@ impl Default for MaterialDesc {
             alpha: None,
             emitting_faces: EmittingFaces::Both,
             absorption: None,
+            interface: None,
+            boundary: false,
             mix: None,
             clearcoat: None,
             clearcoat_maps: None,

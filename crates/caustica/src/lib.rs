@@ -24,6 +24,7 @@ pub mod light;
 pub mod loader;
 pub mod material;
 pub mod math;
+pub mod medium;
 pub mod photon;
 pub mod presets;
 pub mod preview;

@@ -560,14 +560,12 @@ impl LightSet {
             Light::Area(light) => light.sample_direct(&q, (u_pick, u)),
             Light::Soft(light) => light.sample_direct(&q, u),
         };
-        if !scene.absorbs() {
+        if !scene.has_media() {
             return sample;
         }
-        // Through rough glass to a light inside it (a lamp in a frosted globe).
+        // Through fog, or through rough glass to a light inside it (a lamp in a frosted globe).
         sample.map(|mut s| {
-            if let Some(kept) = scene.absorbed_towards(hit, s.wi, s.distance, wl) {
-                s.contribution *= kept;
-            }
+            s.contribution *= scene.transmittance_towards(hit, s.wi, s.distance, wl, rng);
             s
         })
     }
@@ -692,10 +690,8 @@ pub(crate) fn visible_emission(
             .unoccluded_except(hit, wi, distance, sample.prim)
             .then(|| emission::area_radiance(light, scene, sample, wl));
     }
-    let origin = hit.ray_origin(wi);
-    let ray = Ray::new(origin, wi);
-    let isect = scene.intersect(&ray, f32::INFINITY)?;
-    if isect.prim != sample.prim || (isect.t - (sample.point - origin).length()).abs() > 1e-3 * (1.0 + distance) {
+    let (ray, isect) = scene.intersect_solid(&Ray::new(hit.ray_origin(wi), wi))?;
+    if isect.prim != sample.prim || (isect.t - (sample.point - ray.origin).length()).abs() > 1e-3 * (1.0 + distance) {
         return None;
     }
     Some(scene.emission_towards(&scene.surface(&ray, &isect), -wi, wl))

@@ -83,6 +83,10 @@ pub struct Material {
     pub emitting_faces: crate::description::EmittingFaces,
     /// Absorption per unit of length inside a solid glass ([`crate::description::MaterialDesc::absorption`]).
     pub absorption: Option<Vec3>,
+    /// The media its surface separates (`None`: paths keep theirs).
+    pub interface: Option<crate::medium::Interface>,
+    /// Only a boundary between media: paths pass it unchanged.
+    pub boundary: bool,
     /// pbrt's `mix`: one of two materials at each point ([`Mix`]).
     pub mix: Option<Mix>,
     /// A clear coat over the physical reading.

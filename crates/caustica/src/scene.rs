@@ -14,6 +14,7 @@ use crate::geometry::{Shape, ShapeKind};
 use crate::light::{Light, LightSet};
 use crate::material::{Lobes, Material, MaterialRef, MaterialSpectra, SurfaceParams};
 use crate::math::{Aabb, Ray, Vec2, Vec3};
+use crate::medium::{Interface, Media, Medium, Side, VACUUM};
 use crate::progress::Progress;
 use crate::spectrum::{Spectrum, Wavelengths};
 use crate::texture::Texture;
@@ -140,12 +141,14 @@ impl SegmentsFrom<'_> {
         }
         let ray = Ray::new(self.from, d / len);
         if self.occluders.overflowed {
-            return !scene.any_hit(&ray, len, |_| true);
+            return !scene.any_hit(&ray, len, |h| !scene.is_boundary(h));
         }
-        !prims
-            .iter()
-            .enumerate()
-            .any(|(i, &prim)| open & (1 << i) != 0 && scene.intersect_prim(prim, &ray, len).is_some())
+        !prims.iter().enumerate().any(|(i, &prim)| {
+            open & (1 << i) != 0
+                && scene
+                    .intersect_prim(prim, &ray, len)
+                    .is_some_and(|h| !scene.is_boundary(&h))
+        })
     }
 }
 
@@ -158,8 +161,6 @@ pub struct Scene {
     materials: Vec<Material>,
     /// Each material's fitted spectra, made the first time spectral transport asks.
     material_spectra: Vec<OnceLock<MaterialSpectra>>,
-    /// Whether some material absorbs inside ([`Scene::absorption_beyond`]).
-    absorbs: bool,
     /// Whether some material is a mix ([`Scene::choose`]).
     mixes: bool,
     /// Whether some material has a clear coat.
@@ -184,6 +185,18 @@ pub struct Scene {
     triangle_bvh: TriangleBvh,
     /// Whether some mesh has cut-outs (a material with coverage): only then are hits tested.
     cutouts: bool,
+    /// Participating media (absorbing glass among them); empty: no walk tracks any.
+    media: Vec<Medium>,
+    /// The medium where no interface says otherwise.
+    ambient_medium: u32,
+    /// The medium the eye is in.
+    camera_medium: u32,
+    /// The medium each light starts its light in.
+    light_media: Vec<u32>,
+    /// Whether some material is only a boundary between media (shadow rays pass it).
+    boundaries: bool,
+    /// The sphere around the scene: media fill no more than it.
+    sphere: (Vec3, f32),
 }
 
 /// What a scene is assembled from (the builder's output).
@@ -200,6 +213,11 @@ pub(crate) struct SceneParts {
     pub triangle_refs: Vec<TriangleRef>,
     pub warnings: Vec<String>,
     pub hints: crate::description::RenderHints,
+    pub media: Vec<Medium>,
+    pub ambient_medium: u32,
+    pub camera_medium: Option<u32>,
+    /// The media of lights the file places in one: (light number, medium).
+    pub light_media: Vec<(usize, u32)>,
 }
 
 /// The minimal record of a closest hit: enough to build a [`SurfaceHit`] when needed.
@@ -241,6 +259,9 @@ pub struct SurfaceHit {
     pub object: ObjectRef,
     /// The primitive hit (shapes first, then triangles).
     pub prim: u32,
+    /// The media on its two sides as the walk that reached it sees them (vacuum in scenes
+    /// without media).
+    pub media: Media,
 }
 
 impl SurfaceHit {
@@ -252,13 +273,29 @@ impl SurfaceHit {
     }
 }
 
-/// What a path keeps of its light after a length `distance` inside a glass absorbing `sigma`
-/// per unit of length, at the wavelengths `wl` (Beer–Lambert: exp(−σ d), nothing past an
-/// endless length).
-#[inline]
-pub fn transmittance(sigma: Vec3, distance: f32, wl: &Wavelengths) -> Spectrum {
-    let kept = Vec3::select(sigma.cmpgt(Vec3::ZERO), (-sigma * distance).exp(), Vec3::ONE);
-    wl.reflectance(kept)
+impl SurfaceHit {
+    /// A scattering point inside `medium`: no surface, the same medium on both sides (next-event
+    /// estimation asks for a hit).
+    pub fn in_medium(point: Vec3, medium: u32) -> SurfaceHit {
+        SurfaceHit {
+            t: 0.0,
+            point,
+            point_error: Vec3::ZERO,
+            geometric_normal: Vec3::ZERO,
+            shading_normal: Vec3::ZERO,
+            uv: Vec2::ZERO,
+            material: MaterialRef::One(0),
+            object: ObjectRef::Shape(u32::MAX),
+            prim: u32::MAX,
+            media: Media::both(medium),
+        }
+    }
+
+    /// Whether this is a scattering point in a medium rather than a surface.
+    #[inline]
+    pub fn is_in_medium(&self) -> bool {
+        self.prim == u32::MAX
+    }
 }
 
 impl Scene {
@@ -277,6 +314,10 @@ impl Scene {
             triangle_refs,
             warnings,
             hints,
+            media,
+            ambient_medium,
+            camera_medium,
+            light_media,
         } = parts;
         for (shape, &material) in shapes.iter_mut().zip(&shape_materials) {
             shape.needs_uv = materials[material as usize].is_textured();
@@ -289,7 +330,6 @@ impl Scene {
             lights: LightSet::default(),
             ambient,
             material_spectra: materials.iter().map(|_| OnceLock::new()).collect(),
-            absorbs: materials.iter().any(|m| m.absorption.is_some()),
             mixes: materials.iter().any(|m| m.mix.is_some()),
             coats: materials.iter().any(|m| m.clearcoat.is_some()),
             material_lobes: materials
@@ -313,13 +353,70 @@ impl Scene {
             shape_bvh,
             triangle_bvh,
             cutouts: false,
+            media: Vec::new(),
+            ambient_medium: VACUUM,
+            camera_medium: VACUUM,
+            light_media: Vec::new(),
+            boundaries: false,
+            sphere: (Vec3::ZERO, 0.0),
         };
         scene.cutouts = scene
             .meshes
             .iter()
             .any(|m| scene.materials[m.material as usize].alpha.is_some());
         scene.lights = LightSet::new(&scene, lights);
+        scene.set_media(media, ambient_medium, camera_medium, &light_media);
         scene
+    }
+
+    /// A point inside a light, to find the medium it shines into (`None`: a far light).
+    fn light_point(&self, light: &Light) -> Option<Vec3> {
+        match light {
+            Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
+            Light::Soft(soft) => Some(soft.center()),
+            Light::Area(area) => Some(match area.object {
+                ObjectRef::Shape(s) => self.shapes[s as usize].bounds.center(),
+                ObjectRef::Mesh(m) => self.meshes[m as usize].bounds.center(),
+            }),
+            Light::Directional { .. } | Light::Sun { .. } | Light::Environment(_) => None,
+        }
+    }
+
+    /// Puts the media in place: each absorbing glass becomes a medium that only absorbs, inside
+    /// its surface, with whatever surrounded the path outside; then the media of the eye and of
+    /// each light are found.
+    fn set_media(&mut self, mut media: Vec<Medium>, ambient: u32, camera: Option<u32>, lights: &[(usize, u32)]) {
+        for material in &mut self.materials {
+            if let (Some(sigma), None) = (material.absorption, material.interface) {
+                media.push(Medium::homogeneous(sigma, Vec3::ZERO, 0.0));
+                material.interface = Some(Interface {
+                    inside: Side::Medium(media.len() as u32 - 1),
+                    outside: Side::Surrounding,
+                });
+            }
+        }
+        self.boundaries = self.materials.iter().any(|m| m.boundary);
+        let clear = media.iter().all(Medium::is_clear) && !self.boundaries;
+        if clear {
+            // Nothing to track: every walk takes the fast way.
+            return;
+        }
+        self.media = media;
+        self.ambient_medium = ambient;
+        let bounds = self.bounds();
+        self.sphere = (bounds.center(), (0.5 * bounds.extent().length()).max(1e-3));
+        self.camera_medium = camera.unwrap_or_else(|| self.medium_at(self.camera.eye));
+        self.light_media = self
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(i, light)| match lights.iter().find(|&&(n, _)| n == i) {
+                Some(&(_, medium)) => medium,
+                None => self
+                    .light_point(light)
+                    .map_or(self.ambient_medium, |p| self.medium_at(p)),
+            })
+            .collect();
     }
 
     /// The scene with `lights` in place of its own (its emissive objects kept).
@@ -440,33 +537,169 @@ impl Scene {
         }
     }
 
-    /// What a path that crosses the surface at `hit` in direction `dir` travels through next:
-    /// the glass's absorption per unit of length when `dir` goes in (against the outward
-    /// geometric normal) and the glass absorbs, else nothing (clear glass, or out into the
-    /// air: glass nested in glass is not tracked).
+    /// Whether walks track media here (some medium, absorbing glass or boundary): without,
+    /// every walk takes the fast way and no hit carries media.
     #[inline]
-    pub fn absorption_beyond(&self, hit: &SurfaceHit, dir: Vec3) -> Option<Vec3> {
-        if dir.dot(hit.geometric_normal) >= 0.0 {
-            return None;
-        }
+    pub fn has_media(&self) -> bool {
+        !self.media.is_empty()
+    }
+
+    /// Whether some medium scatters light (fog, smoke; not a glass that only absorbs).
+    pub fn scatters(&self) -> bool {
+        self.media.iter().any(|m| !m.only_absorbs() && !m.is_clear())
+    }
+
+    /// Medium `id` (not [`VACUUM`]).
+    #[inline]
+    pub fn medium(&self, id: u32) -> &Medium {
+        &self.media[id as usize]
+    }
+
+    /// The medium where no interface says otherwise.
+    pub fn ambient_medium(&self) -> u32 {
+        self.ambient_medium
+    }
+
+    /// The medium the eye is in.
+    pub fn camera_medium(&self) -> u32 {
+        self.camera_medium
+    }
+
+    /// The medium light `index` starts in.
+    pub fn light_medium(&self, index: usize) -> u32 {
+        self.light_media.get(index).copied().unwrap_or(VACUUM)
+    }
+
+    /// The media the surface at `hit` separates (`None`: paths crossing it keep theirs).
+    #[inline]
+    pub fn interface(&self, hit: &SurfaceHit) -> Option<Interface> {
         match hit.material {
-            MaterialRef::One(id) => self.materials[id as usize].absorption,
+            MaterialRef::One(id) => self.materials[id as usize].interface,
             MaterialRef::Blend { .. } => None,
         }
     }
 
-    /// What light keeps along a segment of length `distance` from `hit` towards `dir` (unit)
-    /// where that runs inside the hit's absorbing glass (`None`: it does not).
+    /// Whether the primitive of `isect` is only a boundary between media.
     #[inline]
-    pub fn absorbed_towards(&self, hit: &SurfaceHit, dir: Vec3, distance: f32, wl: &Wavelengths) -> Option<Spectrum> {
-        self.absorption_beyond(hit, dir)
-            .map(|sigma| transmittance(sigma, distance, wl))
+    pub fn is_boundary(&self, isect: &Intersection) -> bool {
+        self.boundaries && self.materials[self.intersection_material(isect) as usize].boundary
     }
 
-    /// Whether some material absorbs inside: without, no walk asks where it is.
+    /// The material of an intersection's primitive (a mesh's own, a shape's part's).
+    fn intersection_material(&self, isect: &Intersection) -> u32 {
+        let n_shapes = self.shapes.len() as u32;
+        if isect.prim < n_shapes {
+            self.part_material(isect.prim as usize, isect.part)
+        } else {
+            self.meshes[self.triangle_refs[(isect.prim - n_shapes) as usize].mesh as usize].material
+        }
+    }
+
+    /// The segment of `ray` (unit direction) between `t0` and `t1` that media fill: no more
+    /// than the sphere around the scene.
     #[inline]
-    pub fn absorbs(&self) -> bool {
-        self.absorbs
+    pub fn medium_segment(&self, ray: &Ray, (t0, t1): (f32, f32)) -> (f32, f32) {
+        let (center, radius) = self.sphere;
+        let oc = ray.origin - center;
+        let b = oc.dot(ray.dir);
+        let c = oc.length_squared() - radius * radius;
+        let disc = b * b - c;
+        if disc <= 0.0 {
+            return (t0, t0);
+        }
+        let root = disc.sqrt();
+        (t0.max(-b - root), t1.min(-b + root))
+    }
+
+    /// The medium at `point`, found by following a ray from it to the first boundary that says
+    /// which medium lies on the point's side (the ambient medium where none does).
+    pub fn medium_at(&self, point: Vec3) -> u32 {
+        let dir = Vec3::new(0.267_261_24, 0.534_522_5, 0.801_783_7);
+        let mut ray = Ray::new(point, dir);
+        let mut outer = self.ambient_medium;
+        for _ in 0..1024 {
+            let Some(isect) = self.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
+            let hit = self.surface(&ray, &isect);
+            if let Some(interface) = self.interface(&hit) {
+                let leaving = dir.dot(hit.geometric_normal) > 0.0;
+                match (leaving, interface.inside, interface.outside) {
+                    (true, Side::Medium(m), _) | (false, _, Side::Medium(m)) => return m,
+                    _ => outer = self.ambient_medium,
+                }
+            }
+            ray = Ray::new(hit.ray_origin(dir), dir);
+        }
+        outer
+    }
+
+    /// What light keeps along the unblocked segment from `hit` towards `wi` (unit) for
+    /// `distance` (infinite: out of the scene): the transmittance of each medium it crosses,
+    /// boundaries between media passed.
+    pub fn transmittance_towards(
+        &self,
+        hit: &SurfaceHit,
+        wi: Vec3,
+        distance: f32,
+        wl: &Wavelengths,
+        rng: &mut crate::sampling::Rng,
+    ) -> Spectrum {
+        let mut medium = hit.media.towards(hit.geometric_normal, wi);
+        let origin = hit.ray_origin(wi);
+        let mut left = if distance.is_finite() {
+            (distance - (origin - hit.point).length()) * (1.0 - 1e-5)
+        } else {
+            f32::INFINITY
+        };
+        let mut ray = Ray::new(origin, wi);
+        let mut kept = wl.grey(1.0);
+        let mut outer = self.ambient_medium;
+        for _ in 0..1024 {
+            let next = if self.boundaries {
+                self.intersect(&ray, left).filter(|i| self.is_boundary(i))
+            } else {
+                None
+            };
+            let end = next.map_or(left, |i| i.t);
+            if medium != VACUUM {
+                let segment = self.medium_segment(&ray, (0.0, end));
+                kept *= self.media[medium as usize].transmittance(&ray, segment, wl, rng);
+            }
+            let Some(isect) = next else {
+                break;
+            };
+            let boundary = self.surface(&ray, &isect);
+            medium = self.medium_beyond(&boundary, wi, medium, &mut outer);
+            let origin = boundary.ray_origin(wi);
+            left -= (origin - ray.origin).length();
+            ray = Ray::new(origin, wi);
+        }
+        kept
+    }
+
+    /// The medium a path in `current` goes into across the surface at `hit` along `dir`;
+    /// `outer` remembers what surrounded it where a surface's outside is
+    /// [`Side::Surrounding`].
+    #[inline]
+    pub fn medium_beyond(&self, hit: &SurfaceHit, dir: Vec3, current: u32, outer: &mut u32) -> u32 {
+        let Some(interface) = self.interface(hit) else {
+            return current;
+        };
+        if dir.dot(hit.geometric_normal) < 0.0 {
+            if interface.outside == Side::Surrounding {
+                *outer = current;
+            }
+            match interface.inside {
+                Side::Medium(m) => m,
+                Side::Surrounding => current,
+            }
+        } else {
+            match interface.outside {
+                Side::Medium(m) => m,
+                Side::Surrounding => *outer,
+            }
+        }
     }
 
     /// The radiance a surface point emits towards `wo` at the wavelengths `wl`: zero out of a
@@ -566,7 +799,7 @@ impl Scene {
         } else {
             f32::INFINITY
         };
-        !self.any_hit(&Ray::new(origin, wi), t_max, |_| true)
+        !self.any_hit(&Ray::new(origin, wi), t_max, |h| !self.is_boundary(h))
     }
 
     /// As [`Scene::unoccluded`], but primitive `own` never blocks (the light whose point the
@@ -580,12 +813,14 @@ impl Scene {
         // would find it on nearly every call only to throw the hit away.
         let blocked = self.shape_bvh.any_hit(&ray, t_max, |prim, t_max| {
             prim != own
-                && self.shapes[prim as usize]
-                    .intersect_object_normal(&ray, t_max)
-                    .is_some()
-        }) || self
-            .triangle_bvh
-            .each_hit(&ray, t_max, |h| n_shapes + h.prim != own && !self.is_hole(&ray, &h));
+                && self
+                    .intersect_shape(prim, &ray, t_max)
+                    .is_some_and(|h| !self.is_boundary(&h))
+        }) || self.triangle_bvh.each_hit(&ray, t_max, |h| {
+            n_shapes + h.prim != own
+                && !self.is_hole(&ray, &h)
+                && !(self.boundaries && self.is_boundary(&self.triangle_intersection(h)))
+        });
         !blocked
     }
 
@@ -659,6 +894,22 @@ impl Scene {
             Some(hit.t)
         });
         best
+    }
+
+    /// The closest hit along `ray` that is not only a boundary between media, and the ray it
+    /// lies on (moved past the boundaries crossed; the same ray where there are none).
+    #[inline]
+    pub fn intersect_solid(&self, ray: &Ray) -> Option<(Ray, Intersection)> {
+        let mut ray = *ray;
+        for _ in 0..1024 {
+            let isect = self.intersect(&ray, f32::INFINITY)?;
+            if !self.is_boundary(&isect) {
+                return Some((ray, isect));
+            }
+            let boundary = self.surface(&ray, &isect);
+            ray = Ray::new(boundary.ray_origin(ray.dir), ray.dir);
+        }
+        None
     }
 
     /// Calls `visit(hit)` for each primitive the segment `(0, t_max)` meets (its nearest hit
@@ -807,6 +1058,7 @@ impl Scene {
                 )),
                 object: ObjectRef::Shape(hit.prim),
                 prim: hit.prim,
+                media: Media::VACUUM,
             };
         }
         let tri_index = (hit.prim - n_shapes) as usize;
@@ -872,6 +1124,7 @@ impl Scene {
             material,
             object: ObjectRef::Mesh(tri_ref.mesh),
             prim: hit.prim,
+            media: Media::VACUUM,
         }
     }
 
@@ -923,7 +1176,8 @@ impl Scene {
     /// moved off its surface to the side its normal points to (the side it is seen or lit from),
     /// whatever the segment's direction, so a segment along a floor stays above it.
     pub fn segment_clear(&self, a: Vec3, a_normal: Vec3, b: Vec3, b_normal: Vec3) -> bool {
-        segment_ray(a, a_normal, b, b_normal).is_none_or(|(ray, len)| !self.any_hit(&ray, len, |_| true))
+        segment_ray(a, a_normal, b, b_normal)
+            .is_none_or(|(ray, len)| !self.any_hit(&ray, len, |h| !self.is_boundary(h)))
     }
 
     /// The material id of an object (a mesh's base material).

@@ -21,9 +21,9 @@ use self::lexer::{Kind, Lexer, Token};
 use self::params::{Params, Spectrum, Values};
 use super::{ply, SceneSource, SourceFiles};
 use crate::description::{
-    Alpha, CameraDesc, ClearCoat, Coating, FovAxis, ImageMap, ImageSource, IntegratorHint, LightDesc, MaterialDesc,
-    MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc,
-    ThinLens, TrimeshDesc, SMOOTH_ALPHA,
+    Alpha, CameraDesc, ClearCoat, Coating, FovAxis, GridDesc, ImageMap, ImageSource, IntegratorHint, InterfaceDesc,
+    LightDesc, MaterialDesc, MediumDesc, MediumSide, MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial,
+    RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc, ThinLens, TrimeshDesc, SMOOTH_ALPHA,
 };
 use crate::error::{ParseError, Result, Span};
 use crate::progress::Progress;
@@ -75,6 +75,9 @@ struct GraphicsState {
     material: CurrentMaterial,
     area_light: Option<AreaLight>,
     reverse_orientation: bool,
+    /// `MediumInterface`: the media inside and outside the shapes that follow (indices into
+    /// the description's media; `None`: vacuum).
+    media: (Option<usize>, Option<usize>),
 }
 
 /// One entry of the attribute stack.
@@ -111,6 +114,8 @@ struct Reader<'f> {
     stack: Vec<Saved>,
     named_systems: HashMap<String, Mat4>,
     named_materials: HashMap<String, MaterialDesc>,
+    /// `MakeNamedMedium`'s names (`None`: a kind of medium that is not read).
+    named_media: HashMap<String, Option<usize>>,
     textures: HashMap<String, TextureValue>,
     instances: HashMap<String, Vec<ObjectDesc>>,
     defining: Option<(String, Vec<ObjectDesc>, Span)>,
@@ -130,6 +135,7 @@ impl<'f> Reader<'f> {
             material: CurrentMaterial::Desc(Box::new(MaterialDesc::lambert(Param::grey(0.5)))),
             area_light: None,
             reverse_orientation: false,
+            media: (None, None),
         };
         let mut desc = SceneDescription::default();
         desc.hints.physical = true;
@@ -143,6 +149,7 @@ impl<'f> Reader<'f> {
             stack: Vec::new(),
             named_systems: HashMap::new(),
             named_materials: HashMap::new(),
+            named_media: HashMap::new(),
             textures: HashMap::new(),
             instances: HashMap::new(),
             defining: None,
@@ -462,6 +469,10 @@ impl<'f> Reader<'f> {
                     return Err(ParseError::new("the camera's transform is singular", t.span));
                 }
                 self.named_systems.insert("camera".into(), world_from_camera);
+                // The camera is in the medium outside the interface in effect; so is anything
+                // no interface encloses.
+                self.desc.camera_medium = self.state.media.1;
+                self.desc.ambient_medium = self.state.media.1;
                 self.camera = Some((params, world_from_camera, t.span.start..kind.span.end));
             }
             "Film" => {
@@ -495,16 +506,19 @@ impl<'f> Reader<'f> {
             }
             "Integrator" => self.integrator(&t)?,
             "MakeNamedMedium" => {
-                self.string_arg(&t)?;
-                self.params()?;
-                self.warn_once("medium", "participating media are not rendered", t.span);
+                let name = self.string_arg(&t)?;
+                let params = self.params()?;
+                self.named_medium(name, &params)?;
+                self.report_unused(&params, "the medium");
             }
             "MediumInterface" => {
-                self.string_arg(&t)?;
-                if matches!(self.peek()?, Some(n) if n.kind == Kind::Str) {
-                    self.next()?;
-                }
-                self.warn_once("medium", "participating media are not rendered", t.span);
+                let inside = self.string_arg(&t)?;
+                let outside = if matches!(self.peek()?, Some(n) if n.kind == Kind::Str) {
+                    self.string_arg(&t)?
+                } else {
+                    inside.clone()
+                };
+                self.state.media = (self.medium_named(&inside), self.medium_named(&outside));
             }
             "WorldBegin" => {
                 self.in_world = true;
@@ -800,6 +814,127 @@ impl<'f> Reader<'f> {
             span,
         });
         Ok(())
+    }
+
+    // ---- media ----------------------------------------------------------------------------------
+
+    /// `MakeNamedMedium`: a homogeneous medium or a `uniformgrid` density in the current
+    /// transform's space; other kinds are named but left out (vacuum) with a warning.
+    fn named_medium(&mut self, name: Token, params: &Params) -> Result<(), ParseError> {
+        let (kind, kind_span) = params.string("type")?.unwrap_or_default();
+        let scale = params.float_or("scale", 1.0)?;
+        let g = params.float_or("g", 0.0)?;
+        if !(-1.0 < g && g < 1.0) {
+            return Err(ParseError::new(
+                format!("the medium's `g` must lie strictly between −1 and 1, not {g}"),
+                params.span_of("g").unwrap_or(name.span),
+            ));
+        }
+        if params.has("preset") {
+            self.warn(
+                "measured medium presets are not known: `sigma_a` and `sigma_s` are used".to_string(),
+                params.span_of("preset").unwrap_or(name.span.clone()),
+            );
+        }
+        for emission in ["Le", "Lescale", "temperature", "temperaturescale"] {
+            if let Some(span) = params.span_of(emission) {
+                self.warn_once("mediumle", "emitting media are not rendered: `Le` is ignored", span);
+            }
+        }
+        let grid = match kind.as_str() {
+            "homogeneous" => None,
+            "uniformgrid" => Some(self.density_grid(params, &name)?),
+            _ => {
+                self.warn(
+                    format!(
+                        "the {kind} medium is not supported: \"{}\" is left out (clear)",
+                        name.text
+                    ),
+                    kind_span,
+                );
+                self.named_media.insert(name.text, None);
+                return Ok(());
+            }
+        };
+        let sigma_a = self.constant_colour(params, "sigma_a", Vec3::ONE)? * scale;
+        let sigma_s = self.constant_colour(params, "sigma_s", Vec3::ONE)? * scale;
+        self.desc.media.push(MediumDesc {
+            name: Some(name.text.clone()),
+            sigma_a,
+            sigma_s,
+            g,
+            grid,
+            span: name.span,
+        });
+        self.named_media.insert(name.text, Some(self.desc.media.len() - 1));
+        Ok(())
+    }
+
+    /// A `uniformgrid`'s densities (`nx`×`ny`×`nz`, x fastest) over the box from `p0` to `p1` in
+    /// the current transform's space.
+    fn density_grid(&mut self, params: &Params, name: &Token) -> Result<GridDesc, ParseError> {
+        let dim = |axis: &str| -> Result<usize, ParseError> {
+            match params.int(axis)? {
+                None => Ok(1),
+                Some(n) if (1..=1 << 16).contains(&n) => Ok(n as usize),
+                Some(n) => Err(ParseError::new(
+                    format!("`{axis}` must be from 1 to 65536, not {n}"),
+                    params.span_of(axis).unwrap_or(name.span.clone()),
+                )),
+            }
+        };
+        let dims = [dim("nx")?, dim("ny")?, dim("nz")?];
+        let Some((values, span)) = params.list("density", &["float"], 1)? else {
+            return Err(ParseError::new(
+                "a uniformgrid medium needs `density` values",
+                name.span.clone(),
+            ));
+        };
+        let count = dims[0] * dims[1] * dims[2];
+        if values.len() != count {
+            return Err(ParseError::new(
+                format!("{} density values for a grid of {count}", values.len()),
+                span,
+            ));
+        }
+        if values.iter().any(|v| !v.is_finite() || *v < 0.0) {
+            return Err(ParseError::new("densities must be finite and not negative", span));
+        }
+        let p0 = params.vec3("p0", &["point3", "point"])?.unwrap_or(Vec3::ZERO);
+        let p1 = params.vec3("p1", &["point3", "point"])?.unwrap_or(Vec3::ONE);
+        let size = p1 - p0;
+        if !size.cmpgt(Vec3::ZERO).all() {
+            return Err(ParseError::new(
+                "the grid's `p1` must lie above `p0` on every axis",
+                params.span_of("p1").unwrap_or(name.span.clone()),
+            ));
+        }
+        let medium_from_world = self.state.ctm.inverse();
+        if !medium_from_world.is_finite() {
+            return Err(ParseError::new("the medium's transform is singular", name.span.clone()));
+        }
+        Ok(GridDesc {
+            dims,
+            values: values.iter().map(|&v| v as f32).collect(),
+            grid_from_world: Mat4::from_scale(size.recip()) * Mat4::from_translation(-p0) * medium_from_world,
+        })
+    }
+
+    /// The medium a `MediumInterface` names ("": vacuum; an unknown name warns and is vacuum).
+    fn medium_named(&mut self, name: &Token) -> Option<usize> {
+        if name.text.is_empty() {
+            return None;
+        }
+        match self.named_media.get(&name.text) {
+            Some(&m) => m,
+            None => {
+                self.warn(
+                    format!("no medium named \"{}\": read as clear", name.text),
+                    name.span.clone(),
+                );
+                None
+            }
+        }
     }
 
     // ---- materials and textures ----------------------------------------------------------------
@@ -1608,6 +1743,10 @@ impl<'f> Reader<'f> {
                 );
             }
             self.desc.lights.push(light);
+            // pbrt's lights shine into the medium outside the interface in effect.
+            if let Some(medium) = self.state.media.1 {
+                self.desc.light_media.push((self.desc.lights.len() - 1, Some(medium)));
+            }
         }
         Ok(())
     }
@@ -1758,12 +1897,27 @@ impl<'f> Reader<'f> {
             coverage => Some(Alpha { coverage, cutoff: None }),
         };
         self.report_unused(&params, &format!("the {} shape", kind.text));
+        let (inside, outside) = self.state.media;
+        let interface = (inside != outside).then_some(InterfaceDesc {
+            inside: MediumSide::Medium(inside),
+            outside: MediumSide::Medium(outside),
+        });
         let material = match &self.state.material {
-            CurrentMaterial::Desc(m) => (**m).clone(),
+            CurrentMaterial::Desc(m) => MaterialDesc {
+                interface,
+                ..(**m).clone()
+            },
+            // Only a boundary between media: paths pass it, and it is not drawn.
+            CurrentMaterial::Interface if interface.is_some() => MaterialDesc {
+                name: Some("interface".into()),
+                interface,
+                boundary: true,
+                ..MaterialDesc::default()
+            },
             CurrentMaterial::Interface => {
                 self.warn_once(
                     "interface",
-                    "shapes with the `interface` material bound media and are not drawn",
+                    "shapes with the `interface` material and no change of medium are not drawn",
                     span,
                 );
                 return Ok(());

@@ -9,7 +9,7 @@
 
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
-use crate::photon::light_walk::Passage;
+use crate::photon::light_walk::{MediumArrival, Passage, Step};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -41,6 +41,16 @@ pub trait CameraVisitor {
     /// At each surface reached: emission, next-event estimation, gathers. `false` ends the walk.
     fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool;
 
+    /// At each scattering point in a medium: next-event estimation, gathers. `false` ends the
+    /// walk.
+    fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool;
+
+    /// The bounce at a scattering point: by default the phase function's sample. `None` ends
+    /// the walk.
+    fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        Some(at.sample_phase(rng))
+    }
+
     /// The bounce at `at`: by default the BSDF's own sample. `None` ends the walk.
     fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
         at.bsdf
@@ -61,30 +71,52 @@ pub fn walk_camera(
 ) -> u64 {
     let mut throughput = wl.grey(1.0);
     let mut dispersed = false;
-    let mut passage = Passage::default();
+    let mut passage = Passage::new(scene, scene.camera_medium());
     let mut rays = 0;
     for length in 1..=max_surfaces {
         rays += 1;
-        let Some((hit, t)) = passage.next(scene, &ray, &mut throughput, wl) else {
-            visitor.escaped(ray.dir, throughput, length);
-            break;
-        };
         let wo = -ray.dir;
-        let bsdf = Bsdf::at(scene, &hit, wo, wl);
-        let at = CameraArrival {
-            hit: &hit,
-            bsdf: &bsdf,
-            wo,
-            t,
-            throughput,
-            dispersed,
-            length,
-        };
-        if !visitor.visit(&at, rng) {
-            break;
-        }
-        let Some(sample) = visitor.bounce(&at, rng) else {
-            break;
+        let (hit, sample) = match passage.next(scene, &ray, &mut throughput, wl, rng) {
+            Step::Escaped => {
+                visitor.escaped(ray.dir, throughput, length);
+                break;
+            }
+            Step::Medium(hit) => {
+                let at = MediumArrival {
+                    hit: &hit,
+                    phase: scene.medium(hit.media.back).phase,
+                    wo: wo.normalize(),
+                    throughput,
+                    dispersed,
+                    length,
+                };
+                if !visitor.visit_medium(&at, rng) {
+                    break;
+                }
+                let Some(sample) = visitor.bounce_medium(&at, rng) else {
+                    break;
+                };
+                (hit, sample)
+            }
+            Step::Surface(hit) => {
+                let bsdf = Bsdf::at(scene, &hit, wo, wl);
+                let at = CameraArrival {
+                    hit: &hit,
+                    bsdf: &bsdf,
+                    wo,
+                    t: hit.t,
+                    throughput,
+                    dispersed,
+                    length,
+                };
+                if !visitor.visit(&at, rng) {
+                    break;
+                }
+                let Some(sample) = visitor.bounce(&at, rng) else {
+                    break;
+                };
+                (hit, sample)
+            }
         };
         let roulette = length >= roulette_from;
         if !continue_camera(&sample, roulette, (&mut throughput, &mut dispersed), wl, rng) {
@@ -124,6 +156,7 @@ pub fn continue_camera(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::medium::VACUUM;
     use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor};
     use crate::scene::build::test_scene;
 
@@ -142,12 +175,18 @@ mod tests {
             self.arrivals.push((at.length, at.throughput.x));
             true
         }
+        fn visit_medium(&mut self, _at: &MediumArrival, _rng: &mut Rng) -> bool {
+            unreachable!("no media here")
+        }
     }
 
     impl LightVisitor for Record {
         fn visit(&mut self, at: &LightArrival) -> bool {
             self.arrivals.push((at.length, at.throughput.x));
             true
+        }
+        fn visit_medium(&mut self, _at: &MediumArrival) -> bool {
+            unreachable!("no media here")
         }
     }
 
@@ -179,7 +218,15 @@ mod tests {
         let mut light = Record::default();
         for _ in 0..walks {
             walk_camera(&scene, ray(&mut rng), &wl, (1000, 1), &mut rng, &mut camera);
-            walk_light(&scene, ray(&mut rng), wl.grey(1.0), &wl, 1000, &mut rng, &mut light);
+            walk_light(
+                &scene,
+                ray(&mut rng),
+                (wl.grey(1.0), VACUUM),
+                &wl,
+                1000,
+                &mut rng,
+                &mut light,
+            );
         }
         for (name, record) in [("camera", &camera), ("light", &light)] {
             visits += record.arrivals.len();

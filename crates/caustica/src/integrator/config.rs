@@ -266,6 +266,7 @@ impl RenderConfig {
             config.integrator = Some(match hints.integrator {
                 Some(IntegratorHint::Ppm) => IntegratorKind::Ppm,
                 Some(IntegratorHint::LightTracer) => IntegratorKind::Lt,
+                None if hints.scattering_media => IntegratorKind::Path,
                 Some(IntegratorHint::Bidirectional) | None => IntegratorKind::Vcm,
                 Some(IntegratorHint::Path) => IntegratorKind::Path,
             });
@@ -543,6 +544,13 @@ pub fn integrator_note(given: &GivenOptions, hints: &RenderHints, scene: &crate:
         return None;
     }
     let Some(named) = hints.integrator else {
+        if hints.scattering_media {
+            return Some(
+                "integrator path: the file names none, and the scene has fog or smoke, which path and lt \
+                 render (vcm, ppm and gi do not yet)"
+                    .into(),
+            );
+        }
         return Some(
             "integrator vcm: the file names none, and vcm renders the caustics of point, spot and sun lights \
              through glass and mirrors as well as all a path tracer renders (--integrator chooses another)"

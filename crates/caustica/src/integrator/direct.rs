@@ -4,6 +4,7 @@
 
 use crate::bsdf::{Bsdf, BsdfSample};
 use crate::math::{Ray, Vec3};
+use crate::photon::light_walk::MediumArrival;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -34,6 +35,23 @@ pub fn direct_light(
             1.0
         };
         l += f * sample.contribution * (cos * weight);
+    });
+    l
+}
+
+/// Direct light in-scattered at a point in a medium by one light sample, weighted against
+/// phase-function sampling when `mis` is set (the caller then also counts emitters its phase
+/// samples hit).
+pub fn direct_in_medium(scene: &Scene, at: &MediumArrival, mis: bool, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
+    let mut l = Spectrum::ZERO;
+    scene.lights().sample_direct(scene, at.hit, wl, rng, |sample| {
+        let p = at.phase.eval(at.wo, sample.wi);
+        let weight = if mis && sample.pdf > 0.0 {
+            power_heuristic(sample.pdf, p)
+        } else {
+            1.0
+        };
+        l += sample.contribution * (p * weight);
     });
     l
 }

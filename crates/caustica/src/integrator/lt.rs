@@ -17,12 +17,15 @@ use crate::bsdf::{Bsdf, Transport};
 use crate::camera::Camera;
 use crate::light::emission::EmissionPoint;
 use crate::math::{offset_origin, Ray, Vec3};
-use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor};
+use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor, MediumArrival};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 use rayon::prelude::*;
+
+/// Mixed into the seed of the streams shadow rays to the eye draw from.
+const EYE_SEED: u64 = 0x6579_6573_6861_646f;
 
 /// Settings of the light tracer.
 #[derive(Clone, Debug, PartialEq)]
@@ -204,8 +207,11 @@ impl<'a> LightTracer<'a> {
             return;
         };
         let share = 1.0 / self.settings.photons_per_pass as f32;
+        // Shadow rays to the eye draw from a stream of their own (transmittance through a grid).
+        let mut eye_rng = Rng::new(self.seed ^ EYE_SEED, (pass << 40) ^ index);
         if let Some(origin) = &emitted.origin {
-            if let Some((pixel, value)) = self.connect_light(origin, share) {
+            let medium = scene.light_medium(emitted.light);
+            if let Some((pixel, value)) = self.connect_light(origin, medium, share, wl, &mut eye_rng) {
                 let rgb = wl.to_rgb(value);
                 if rgb.is_finite() {
                     out.push((pixel as u32, rgb));
@@ -213,12 +219,17 @@ impl<'a> LightTracer<'a> {
             }
         }
         // The walk's photons carry flux, as the photon tracer's do.
-        let mut splats = Splats { tracer: self, wl, out };
+        let mut splats = Splats {
+            tracer: self,
+            wl,
+            out,
+            rng: eye_rng,
+        };
         let surfaces = self.settings.max_depth.saturating_add(1);
         walk_light(
             scene,
             emitted.ray,
-            emitted.throughput * share,
+            (emitted.throughput * share, scene.light_medium(emitted.light)),
             wl,
             surfaces,
             &mut rng,
@@ -232,7 +243,15 @@ impl<'a> LightTracer<'a> {
     /// point), and We the camera's importance ([`Sensor::sample`]). With shading normals the
     /// adjoint BSDF needs Veach's correction |wo·ns| |ωe·ng| / (|wo·ng| |ωe·ns|), so the cosine
     /// becomes |ωe·ng| |wo·ns| / |wo·ng|.
-    fn connect(&self, hit: &SurfaceHit, bsdf: &Bsdf, wo: Vec3, power: Spectrum) -> Option<(usize, Spectrum)> {
+    fn connect(
+        &self,
+        hit: &SurfaceHit,
+        bsdf: &Bsdf,
+        wo: Vec3,
+        power: Spectrum,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+    ) -> Option<(usize, Spectrum)> {
         let s = self.sensor.sample(hit.point)?;
         let f = bsdf.eval_in(wo, s.to_eye, Transport::Importance);
         if f == Spectrum::ZERO {
@@ -248,7 +267,32 @@ impl<'a> LightTracer<'a> {
             return None;
         }
         let g = cos / (s.distance * s.distance);
-        Some((s.pixel, power * f * (g * s.importance)))
+        Some((s.pixel, power * f * self.to_eye(hit, &s, wl, rng) * (g * s.importance)))
+    }
+
+    /// As [`LightTracer::connect`] from a scattering point in a medium: its phase function in
+    /// place of f · cos.
+    fn connect_medium(&self, at: &MediumArrival, wl: &Wavelengths, rng: &mut Rng) -> Option<(usize, Spectrum)> {
+        let s = self.sensor.sample(at.hit.point)?;
+        let p = at.phase.eval(at.wo, s.to_eye);
+        if p <= 0.0 || !self.scene.unoccluded(at.hit, s.to_eye, s.distance) {
+            return None;
+        }
+        let g = 1.0 / (s.distance * s.distance);
+        Some((
+            s.pixel,
+            at.throughput * self.to_eye(at.hit, &s, wl, rng) * (p * g * s.importance),
+        ))
+    }
+
+    /// What the media between `hit` and the eye keep of the light (1 without media).
+    #[inline]
+    fn to_eye(&self, hit: &SurfaceHit, s: &SensorSample, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
+        if self.scene.has_media() {
+            self.scene.transmittance_towards(hit, s.to_eye, s.distance, wl, rng)
+        } else {
+            Spectrum::ONE
+        }
     }
 }
 
@@ -257,18 +301,34 @@ struct Splats<'t, 'a> {
     tracer: &'t LightTracer<'a>,
     wl: &'t Wavelengths,
     out: &'t mut Vec<(u32, Vec3)>,
+    rng: Rng,
+}
+
+impl Splats<'_, '_> {
+    fn push(&mut self, splat: Option<(usize, Spectrum)>) {
+        if let Some((pixel, value)) = splat {
+            let rgb = self.wl.to_rgb(value);
+            if rgb.is_finite() {
+                self.out.push((pixel as u32, rgb));
+            }
+        }
+    }
 }
 
 impl LightVisitor for Splats<'_, '_> {
     fn visit(&mut self, at: &LightArrival) -> bool {
         if at.bsdf.is_smooth() {
-            if let Some((pixel, value)) = self.tracer.connect(at.hit, at.bsdf, at.wo, at.throughput) {
-                let rgb = self.wl.to_rgb(value);
-                if rgb.is_finite() {
-                    self.out.push((pixel as u32, rgb));
-                }
-            }
+            let splat = self
+                .tracer
+                .connect(at.hit, at.bsdf, at.wo, at.throughput, self.wl, &mut self.rng);
+            self.push(splat);
         }
+        true
+    }
+
+    fn visit_medium(&mut self, at: &MediumArrival) -> bool {
+        let splat = self.tracer.connect_medium(at, self.wl, &mut self.rng);
+        self.push(splat);
         true
     }
 }
@@ -276,18 +336,26 @@ impl LightVisitor for Splats<'_, '_> {
 impl LightTracer<'_> {
     /// The pixel the light's own point `origin` shows in, and what it adds there (the light seen
     /// directly): L/p(x) · |cos θ| / r² · We, times this photon's `share` of the pass.
-    fn connect_light(&self, origin: &EmissionPoint, share: f32) -> Option<(usize, Spectrum)> {
+    fn connect_light(
+        &self,
+        origin: &EmissionPoint,
+        medium: u32,
+        share: f32,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+    ) -> Option<(usize, Spectrum)> {
         let s = self.sensor.sample(origin.point)?;
         if !origin.faces.emit_towards(origin.normal, s.to_eye) {
             return None;
         }
         let ray = Ray::new(offset_origin(origin.point, origin.normal, s.to_eye), s.to_eye);
         let t_max = (s.distance - (ray.origin - origin.point).length()) * (1.0 - 1e-5);
-        if self.scene.any_hit(&ray, t_max, |_| true) {
+        if self.scene.any_hit(&ray, t_max, |h| !self.scene.is_boundary(h)) {
             return None;
         }
         let g = origin.normal.dot(s.to_eye).abs() / (s.distance * s.distance);
-        Some((s.pixel, origin.radiance * (share * g * s.importance)))
+        let kept = self.to_eye(&SurfaceHit::in_medium(ray.origin, medium), &s, wl, rng);
+        Some((s.pixel, origin.radiance * kept * (share * g * s.importance)))
     }
 }
 

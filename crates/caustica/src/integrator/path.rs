@@ -5,9 +5,10 @@
 //! after a mirror or through glass); that is what photon mapping is for.
 
 use super::camera_walk::{walk_camera, CameraArrival, CameraVisitor};
-use super::direct::{direct_light, emitted, power_heuristic};
+use super::direct::{direct_in_medium, direct_light, emitted, power_heuristic};
 use crate::bsdf::{BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
+use crate::photon::light_walk::MediumArrival;
 use crate::sampling::Rng;
 use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -104,6 +105,22 @@ impl CameraVisitor for PathRadiance<'_> {
             self.l += at.throughput * direct_light(scene, hit, at.bsdf, wo, true, self.wl, rng);
         }
         true
+    }
+
+    fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool {
+        if at.length > self.settings.max_depth {
+            return false;
+        }
+        self.l += at.throughput * direct_in_medium(self.scene, at, true, self.wl, rng);
+        true
+    }
+
+    fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        let sample = at.sample_phase(rng);
+        self.specular = false;
+        self.last_pdf = sample.pdf;
+        self.last_point = at.hit.point;
+        Some(sample)
     }
 
     fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {

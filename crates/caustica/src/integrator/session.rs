@@ -200,6 +200,12 @@ impl<'a> RenderSession<'a> {
     /// A session for `scene`; the options are checked here.
     pub fn new(scene: &'a Scene, options: RenderOptions) -> Result<RenderSession<'a>> {
         options.integrator.validate()?;
+        if scene.scatters() && !matches!(options.integrator, Integrator::Path(_) | Integrator::Lt(_)) {
+            return Err(crate::error::Error::InvalidSettings(format!(
+                "the scene has a medium that scatters light, which only --integrator path and lt render so far (not {})",
+                options.integrator.name()
+            )));
+        }
         let (width, height) = image_size(scene.camera(), options.width, options.height);
         check_image_size(width, height)?;
         let seed = options.seed;

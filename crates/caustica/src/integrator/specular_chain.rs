@@ -114,6 +114,11 @@ where
         true
     }
 
+    // Not reached: ppm and gi refuse scenes whose media scatter (`RenderSession::new`).
+    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival, _rng: &mut Rng) -> bool {
+        false
+    }
+
     fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
         let sample = at
             .bsdf

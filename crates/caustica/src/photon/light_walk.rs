@@ -11,6 +11,7 @@
 
 use crate::bsdf::{adjoint_correction, Bsdf, BsdfSample, Transport};
 use crate::math::Ray;
+use crate::medium::{Media, Phase, VACUUM};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -37,6 +38,15 @@ pub trait LightVisitor {
     /// At each surface reached: stores, splats or records the vertex. `false` ends the walk here.
     fn visit(&mut self, at: &LightArrival) -> bool;
 
+    /// At each scattering point in a medium: stores, splats or records it. `false` ends the walk.
+    fn visit_medium(&mut self, at: &MediumArrival) -> bool;
+
+    /// The bounce at a scattering point and the roulette that judges it: by default the phase
+    /// function's own sample.
+    fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<(BsdfSample, Roulette)> {
+        Some((at.sample_phase(rng), Roulette::KeepFlux))
+    }
+
     /// The bounce at `at` and the roulette that judges it: by default the BSDF's own sample, the
     /// flux kept nearly constant.
     fn bounce(&mut self, at: &LightArrival, rng: &mut Rng) -> Option<(BsdfSample, Roulette)> {
@@ -46,21 +56,69 @@ pub trait LightVisitor {
     }
 }
 
-pub use crate::scene::transmittance;
+/// A scattering point a walk has reached inside a medium, as its visitor sees it.
+pub struct MediumArrival<'a> {
+    /// The point, as a hit without a surface ([`SurfaceHit::in_medium`]): its medium on both
+    /// sides.
+    pub hit: &'a SurfaceHit,
+    /// The medium's phase function.
+    pub phase: Phase,
+    /// Unit direction back along the arriving ray.
+    pub wo: Vec3,
+    /// What the walk carries on arrival (the scattering's weight included).
+    pub throughput: Spectrum,
+    /// Only the hero wavelength is left.
+    pub dispersed: bool,
+    /// Vertices met so far, this one included.
+    pub length: u32,
+}
 
-/// What both walks carry from surface to surface: the glass they are inside, whose absorption
-/// each segment pays. A walk starts where it is (a lamp inside a glass ball, a camera in a
-/// block of glass): its first segment is inside a glass if it meets that glass from within.
-#[derive(Clone, Copy, Debug, Default)]
+impl MediumArrival<'_> {
+    /// The phase function's sample from this point, as a bounce: a smooth one whose weight is 1.
+    pub fn sample_phase(&self, rng: &mut Rng) -> BsdfSample {
+        let (wi, pdf) = self.phase.sample(self.wo, rng.uniform2());
+        BsdfSample {
+            wi,
+            weight: Spectrum::ONE,
+            pdf,
+            specular: false,
+            transmitted: false,
+            dispersive: false,
+        }
+    }
+}
+
+/// Where a walk's next segment ends.
+pub enum Step {
+    /// At a surface: its hit (with the media on its two sides) and the ray's parameter there.
+    Surface(SurfaceHit),
+    /// At a scattering point in a medium ([`SurfaceHit::in_medium`]).
+    Medium(SurfaceHit),
+    /// Out of the scene.
+    Escaped,
+}
+
+/// What both walks carry from vertex to vertex: the medium they are in (fog, or the inside of
+/// an absorbing glass), whose free flights and absorption each segment samples, and the one
+/// that surrounded them before they entered a glass.
+#[derive(Clone, Copy, Debug)]
 pub struct Passage {
-    absorbing: Option<Vec3>,
-    /// Whether the first segment has been traced (from then on, crossings decide).
-    started: bool,
+    medium: u32,
+    outer: u32,
 }
 
 impl Passage {
-    /// The next surface along `ray` (`None`: the ray leaves the scene), the throughput
-    /// attenuated by the glass on the way, at the wavelengths `wl`.
+    /// A walk starting in `medium`.
+    pub fn new(scene: &Scene, medium: u32) -> Passage {
+        Passage {
+            medium,
+            outer: scene.ambient_medium(),
+        }
+    }
+
+    /// Where the segment along `ray` ends: the next surface, a scattering point in the medium
+    /// the walk is in, or out of the scene; `throughput` pays the medium on the way, at the
+    /// wavelengths `wl`. Boundaries between media are crossed on the way, not returned.
     #[inline]
     pub fn next(
         &mut self,
@@ -68,87 +126,136 @@ impl Passage {
         ray: &Ray,
         throughput: &mut Spectrum,
         wl: &Wavelengths,
-    ) -> Option<(SurfaceHit, f32)> {
-        let isect = scene.intersect(ray, f32::INFINITY);
-        if !self.started {
-            self.started = true;
-            if scene.absorbs() {
-                return self.first(scene, ray, isect, throughput, wl);
-            }
+        rng: &mut Rng,
+    ) -> Step {
+        if !scene.has_media() {
+            return match scene.intersect(ray, f32::INFINITY) {
+                Some(isect) => Step::Surface(scene.surface(ray, &isect)),
+                None => Step::Escaped,
+            };
         }
-        if let Some(sigma) = self.absorbing {
-            let distance = isect.as_ref().map_or(f32::INFINITY, |i| i.t * ray.dir.length());
-            *throughput *= transmittance(sigma, distance, wl);
-        }
-        let isect = isect?;
-        Some((scene.surface(ray, &isect), isect.t))
+        self.next_in_media(scene, ray, throughput, wl, rng)
     }
 
-    /// The walk's first segment in a scene with absorbing glass: inside a glass if it meets
-    /// that glass from within.
-    #[cold]
-    fn first(
+    fn next_in_media(
         &mut self,
         scene: &Scene,
         ray: &Ray,
-        isect: Option<crate::scene::Intersection>,
         throughput: &mut Spectrum,
         wl: &Wavelengths,
-    ) -> Option<(SurfaceHit, f32)> {
-        let isect = isect?;
-        let hit = scene.surface(ray, &isect);
-        self.absorbing = scene.absorption_beyond(&hit, -ray.dir);
-        if let Some(sigma) = self.absorbing {
-            *throughput *= transmittance(sigma, isect.t * ray.dir.length(), wl);
+        rng: &mut Rng,
+    ) -> Step {
+        let length = ray.dir.length();
+        let dir = ray.dir / length;
+        let mut ray = Ray::new(ray.origin, dir);
+        // Distance from the first ray's origin to this one's.
+        let mut travelled = 0.0;
+        for _ in 0..1024 {
+            let isect = scene.intersect(&ray, f32::INFINITY);
+            if self.medium != VACUUM {
+                let segment = scene.medium_segment(&ray, (0.0, isect.map_or(f32::INFINITY, |i| i.t)));
+                let medium = scene.medium(self.medium);
+                if let Some(t) = medium.sample_flight(&ray, segment, wl, throughput, rng) {
+                    let mut hit = SurfaceHit::in_medium(ray.at(t), self.medium);
+                    hit.t = (travelled + t) / length;
+                    return Step::Medium(hit);
+                }
+            }
+            let Some(isect) = isect else {
+                return Step::Escaped;
+            };
+            let mut hit = scene.surface(&ray, &isect);
+            if scene.is_boundary(&isect) {
+                self.medium = scene.medium_beyond(&hit, dir, self.medium, &mut self.outer);
+                let origin = hit.ray_origin(dir);
+                travelled += (origin - ray.origin).length();
+                ray = Ray::new(origin, dir);
+                continue;
+            }
+            let beyond = scene.medium_beyond(&hit, dir, self.medium, &mut self.outer.clone());
+            hit.media = if dir.dot(hit.geometric_normal) < 0.0 {
+                Media {
+                    front: self.medium,
+                    back: beyond,
+                }
+            } else {
+                Media {
+                    front: beyond,
+                    back: self.medium,
+                }
+            };
+            hit.t = (travelled + isect.t) / length;
+            return Step::Surface(hit);
         }
-        Some((hit, isect.t))
+        Step::Escaped
     }
 
-    /// After a bounce at `hit` that goes on along `sample`: through the surface, the walk is
-    /// inside its glass or out of it.
+    /// After a bounce at the surface `hit` that goes on along `sample`: through the surface,
+    /// the walk is in the medium beyond it.
     #[inline]
     pub fn cross(&mut self, scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample) {
-        if sample.transmitted {
-            self.absorbing = scene.absorption_beyond(hit, sample.wi);
+        if sample.transmitted && scene.has_media() {
+            self.medium = scene.medium_beyond(hit, sample.wi, self.medium, &mut self.outer);
         }
     }
 }
 
-/// Follows light from `ray` carrying `throughput` at the wavelengths `wl` through at most
-/// `max_surfaces` surfaces, handing each to `visitor`. Returns the rays traced (surfaces found
+/// Follows light from `ray` carrying `throughput` from a light in `medium` at the wavelengths
+/// `wl` through at most `max_surfaces` vertices (surfaces and scattering points), handing each
+/// to `visitor`. Returns the rays traced (surfaces found
 /// and the last ray's miss).
 pub fn walk_light(
     scene: &Scene,
     mut ray: Ray,
-    mut throughput: Spectrum,
+    (mut throughput, medium): (Spectrum, u32),
     wl: &Wavelengths,
     max_surfaces: u32,
     rng: &mut Rng,
     visitor: &mut impl LightVisitor,
 ) -> u64 {
     let mut dispersed = false;
-    let mut passage = Passage::default();
+    let mut passage = Passage::new(scene, medium);
     let mut rays = 0;
     for length in 1..=max_surfaces {
         rays += 1;
-        let Some((hit, _)) = passage.next(scene, &ray, &mut throughput, wl) else {
-            break;
-        };
         let wo = -ray.dir;
-        let bsdf = Bsdf::at(scene, &hit, wo, wl);
-        let at = LightArrival {
-            hit: &hit,
-            wo,
-            bsdf: &bsdf,
-            throughput,
-            dispersed,
-            length,
-        };
-        if !visitor.visit(&at) {
-            break;
-        }
-        let Some((sample, roulette)) = visitor.bounce(&at, rng) else {
-            break;
+        let (hit, sample, roulette) = match passage.next(scene, &ray, &mut throughput, wl, rng) {
+            Step::Escaped => break,
+            Step::Medium(hit) => {
+                let at = MediumArrival {
+                    hit: &hit,
+                    phase: scene.medium(hit.media.back).phase,
+                    wo,
+                    throughput,
+                    dispersed,
+                    length,
+                };
+                if !visitor.visit_medium(&at) {
+                    break;
+                }
+                let Some((sample, roulette)) = visitor.bounce_medium(&at, rng) else {
+                    break;
+                };
+                (hit, sample, roulette)
+            }
+            Step::Surface(hit) => {
+                let bsdf = Bsdf::at(scene, &hit, wo, wl);
+                let at = LightArrival {
+                    hit: &hit,
+                    wo,
+                    bsdf: &bsdf,
+                    throughput,
+                    dispersed,
+                    length,
+                };
+                if !visitor.visit(&at) {
+                    break;
+                }
+                let Some((sample, roulette)) = visitor.bounce(&at, rng) else {
+                    break;
+                };
+                (hit, sample, roulette)
+            }
         };
         if !continue_light(&hit, wo, &sample, roulette, (&mut throughput, &mut dispersed), wl, rng) {
             break;

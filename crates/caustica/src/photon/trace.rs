@@ -67,7 +67,8 @@ pub fn trace_count(
                         out,
                     };
                     let surfaces = max_bounces.saturating_add(1);
-                    walk_light(scene, emitted.ray, flux, wl, surfaces, &mut rng, &mut photons);
+                    let medium = scene.light_medium(emitted.light);
+                    walk_light(scene, emitted.ray, (flux, medium), wl, surfaces, &mut rng, &mut photons);
                 }
             });
             photons
@@ -249,6 +250,12 @@ pub struct PhysicalPhotons<'o> {
 }
 
 impl LightVisitor for PhysicalPhotons<'_> {
+    // Photons are not stored in media yet: ppm and gi refuse scenes whose media scatter
+    // (`RenderSession::new`), and a medium that only absorbs has no scattering points.
+    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival) -> bool {
+        true
+    }
+
     fn visit(&mut self, at: &LightArrival) -> bool {
         if at.bsdf.is_smooth() {
             let left = self

@@ -15,6 +15,7 @@ use crate::image_io;
 use crate::light::{Environment, Light, SoftLight};
 use crate::material::{Channel, Material};
 use crate::math::{Aabb, Mat3, Vec3};
+use crate::medium::{DensityGrid, Medium, Side, VACUUM};
 use crate::progress::{NoProgress, Progress};
 use crate::texture::{Image, Texture};
 use rayon::prelude::*;
@@ -55,9 +56,18 @@ fn build_objects(
     let camera = desc.camera.as_ref().map(Camera::from_desc).unwrap_or_default();
     let mut warnings: Vec<String> = desc.warnings.iter().map(|(w, _)| w.clone()).collect();
     let mut lights = Vec::new();
+    // Each described light's number among the built ones (`None`: left out).
+    let mut light_numbers = Vec::with_capacity(desc.lights.len());
     for light in &desc.lights {
-        lights.extend(convert_light(light, &mut warnings)?);
+        let built = convert_light(light, &mut warnings)?;
+        light_numbers.push(built.is_some().then_some(lights.len()));
+        lights.extend(built);
     }
+    let light_media = desc
+        .light_media
+        .iter()
+        .filter_map(|&(i, m)| Some((light_numbers.get(i).copied().flatten()?, m.map_or(VACUUM, |m| m as u32))))
+        .collect();
     if desc.camera.is_none() {
         warnings.push("the scene has no camera: using the default one at the origin looking down −z".into());
     }
@@ -89,10 +99,46 @@ fn build_objects(
             triangles: builder.triangles,
             triangle_refs: builder.triangle_refs,
             warnings,
-            hints: desc.hints.clone(),
+            hints: crate::description::RenderHints {
+                scattering_media: desc.media.iter().any(|m| m.sigma_s.max_element() > 0.0),
+                ..desc.hints.clone()
+            },
+            media: desc.media.iter().map(convert_medium).collect::<Result<_, _>>()?,
+            ambient_medium: desc.ambient_medium.map_or(VACUUM, |m| m as u32),
+            camera_medium: desc.camera_medium.map(|m| m as u32),
+            light_media,
         },
         progress,
     ))
+}
+
+/// A side of a medium boundary, as the scene numbers media.
+fn medium_side(side: crate::description::MediumSide) -> Side {
+    match side {
+        crate::description::MediumSide::Medium(m) => Side::Medium(m.map_or(VACUUM, |m| m as u32)),
+        crate::description::MediumSide::Surrounding => Side::Surrounding,
+    }
+}
+
+/// A medium ready to render; a grid whose size and samples disagree is an error at its span.
+fn convert_medium(desc: &crate::description::MediumDesc) -> Result<Medium, ParseError> {
+    let mut medium = Medium::homogeneous(desc.sigma_a, desc.sigma_s, desc.g);
+    if let Some(grid) = &desc.grid {
+        let [x, y, z] = grid.dims;
+        if x.checked_mul(y).and_then(|n| n.checked_mul(z)) != Some(grid.values.len()) || grid.values.is_empty() {
+            return Err(ParseError::new(
+                format!(
+                    "a density grid of {x}×{y}×{z} samples needs {} values, not {}",
+                    x.saturating_mul(y).saturating_mul(z),
+                    grid.values.len()
+                ),
+                desc.span.clone(),
+            ));
+        }
+        let to_grid = glam::Affine3A::from_mat4(grid.grid_from_world);
+        medium.grid = Some(DensityGrid::new(grid.dims, grid.values.clone(), to_grid));
+    }
+    Ok(medium)
 }
 
 /// Units of build work for an object: its triangles, or 1 for a shape.
@@ -511,6 +557,11 @@ impl Builder {
             },
             emitting_faces: desc.emitting_faces,
             absorption: desc.absorption.filter(|a| a.cmpgt(Vec3::ZERO).any()),
+            interface: desc.interface.map(|i| crate::medium::Interface {
+                inside: medium_side(i.inside),
+                outside: medium_side(i.outside),
+            }),
+            boundary: desc.boundary,
             mix: match &desc.mix {
                 Some(m) => Some(crate::material::Mix {
                     materials: [self.material(&m.materials[0])?, self.material(&m.materials[1])?],
@@ -550,7 +601,7 @@ impl Builder {
             .chain([material.abbe.map_or(0, f32::to_bits)])
             .chain(
                 format!(
-                    "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
+                    "{:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?} {:?}",
                     material.physical,
                     material.normal_map,
                     material.metallic_roughness,
@@ -560,7 +611,9 @@ impl Builder {
                     material.mix,
                     material.clearcoat,
                     material.clearcoat_maps,
-                    material.roughness_map
+                    material.roughness_map,
+                    material.interface,
+                    material.boundary
                 )
                 .bytes()
                 .map(u32::from),

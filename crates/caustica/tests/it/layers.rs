@@ -26,7 +26,9 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("description", &["description"]),
     (
         "readers and scene",
-        &["format", "geometry", "accel", "camera", "material", "light", "scene"],
+        &[
+            "format", "geometry", "accel", "camera", "material", "medium", "light", "scene",
+        ],
     ),
     ("transport", &["bsdf", "photon"]),
     ("integrators", &["integrator"]),
@@ -38,7 +40,11 @@ const LAYERS: &[(&str, &[&str])] = &[
 /// Modules of one layer that must not use each other: the file formats know nothing of the
 /// renderable scene, and the scene nothing of file syntax.
 const SIBLINGS: &[(&str, &[&str])] = &[
-    ("format", &["geometry", "accel", "camera", "material", "light", "scene"]),
+    (
+        "format",
+        &["geometry", "accel", "camera", "material", "medium", "light", "scene"],
+    ),
+    ("medium", &["format"]),
     ("geometry", &["format"]),
     ("accel", &["format"]),
     ("camera", &["format"]),

@@ -23,6 +23,7 @@ mod formats;
 mod layers;
 mod light_tracing;
 mod lights;
+mod media;
 mod photon_budget;
 mod physical;
 mod rough_glass;

@@ -169,6 +169,7 @@ impl RayScene {
             objects,
             warnings,
             hints: Default::default(),
+            ..Default::default()
         })
     }
 }

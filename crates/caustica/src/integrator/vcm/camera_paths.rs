@@ -49,6 +49,11 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
         self.l += throughput * seen;
     }
 
+    // Not reached: vcm refuses scenes whose media scatter (`RenderSession::new`).
+    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival, _rng: &mut Rng) -> bool {
+        false
+    }
+
     fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
         let (vcm, f, wl) = (self.vcm, &self.pass.factors, self.wl);
         let (hit, bsdf, wo, length) = (at.hit, at.bsdf, at.wo, at.length);
@@ -103,7 +108,7 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
             if vcm.settings.connections && own + 1 < paths.ends.len() {
                 let (start, end) = (paths.ends[own] as usize, paths.ends[own + 1] as usize);
                 for z in &paths.vertices[start..end] {
-                    self.l += vcm.connect(&v, z, f, wl, merges_here);
+                    self.l += vcm.connect(&v, z, f, wl, merges_here, rng);
                 }
             }
             if merges_here && f.merge > 0.0 {
@@ -350,6 +355,7 @@ impl<'a> Vcm<'a> {
         f: &Factors,
         wl: &Wavelengths,
         camera_merges: bool,
+        rng: &mut Rng,
     ) -> Spectrum {
         if v.length + z.length + 1 > self.max_length {
             return Spectrum::ZERO;
@@ -388,10 +394,11 @@ impl<'a> Vcm<'a> {
         }
         let g = cos_camera * cos_light / d2;
         // Two vertices inside one rough glass: the connection pays its absorption.
-        let inside = self
-            .scene
-            .absorbed_towards(v.hit, dir, d2.sqrt(), wl)
-            .unwrap_or(Spectrum::ONE);
+        let inside = if self.scene.has_media() {
+            self.scene.transmittance_towards(v.hit, dir, d2.sqrt(), wl, rng)
+        } else {
+            Spectrum::ONE
+        };
         v.throughput
             * camera_f
             * light_f

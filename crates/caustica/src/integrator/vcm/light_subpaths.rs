@@ -31,7 +31,7 @@ impl<'a> Vcm<'a> {
         let rays = walk_light(
             scene,
             emission.ray,
-            emission.throughput,
+            (emission.throughput, scene.light_medium(emission.light)),
             wl,
             surfaces,
             &mut rng,
@@ -148,6 +148,11 @@ struct Subpath<'v, 'a> {
 }
 
 impl LightVisitor for Subpath<'_, '_> {
+    // Not reached: vcm refuses scenes whose media scatter (`RenderSession::new`).
+    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival) -> bool {
+        false
+    }
+
     fn visit(&mut self, at: &LightArrival) -> bool {
         let (vcm, f, emission) = (self.vcm, self.f, self.emission);
         let (hit, wo, bsdf, length) = (*at.hit, at.wo, at.bsdf, at.length);

@@ -1,0 +1,260 @@
+//! Participating media against closed forms, in every physical integrator that renders them,
+//! from pbrt-v4 files (`MakeNamedMedium`, `MediumInterface`, the `interface` material).
+
+use crate::common::render_with;
+use caustica::film::Film;
+use caustica::format::{read_text, ReadOptions};
+use caustica::integrator::RenderConfig;
+use caustica::math::Vec3;
+use caustica::progress::NoProgress;
+use caustica::scene::build::{build, BuildSettings};
+use caustica::scene::Scene;
+
+/// A scene from pbrt-v4 text.
+fn pbrt(text: &str) -> Scene {
+    let source = read_text(
+        std::path::Path::new("media.pbrt"),
+        text.to_string(),
+        std::path::Path::new("."),
+        &ReadOptions::default(),
+        &NoProgress,
+    )
+    .unwrap_or_else(|e| panic!("{e:?}"));
+    build(&source.description, &BuildSettings::default()).unwrap()
+}
+
+/// `scene` by `integrator` at `size`², with `passes` passes of `photons` light paths and
+/// `--depth` `depth`.
+fn render(scene: &Scene, integrator: &str, size: usize, passes: u64, photons: usize, depth: Option<u32>) -> Film {
+    let config = RenderConfig {
+        integrator: Some(integrator.parse().unwrap()),
+        width: size,
+        height: Some(size),
+        passes: Some(passes.to_string()),
+        photons,
+        light_paths: Some(photons as u64),
+        depth,
+        seed: 7,
+        ..RenderConfig::default()
+    };
+    render_with(scene, &config)
+}
+
+fn mean(film: &Film) -> Vec3 {
+    film.region_mean((0, film.height), (0, film.width))
+}
+
+/// A lamp of radiance 1 seen through a slab of thickness 0.5 filled with a medium that only
+/// absorbs, bounded by `interface` shapes: every integrator sees exp(−σa d), channel by channel.
+#[test]
+fn a_lamp_through_an_absorbing_slab_keeps_exp_minus_sigma_d() {
+    let sigma = Vec3::new(1.0, 0.4, 0.1);
+    let scene = pbrt(&format!(
+        r#"LookAt 0 0 5  0 0 0  0 1 0
+        Camera "perspective" "float fov" 6
+        WorldBegin
+        MakeNamedMedium "ink" "string type" "homogeneous" "rgb sigma_a" [{} {} {}] "rgb sigma_s" [0 0 0]
+        AttributeBegin
+          AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
+          Shape "bilinearmesh" "point3 P" [-4 -4 -1  4 -4 -1  -4 4 -1  4 4 -1]
+        AttributeEnd
+        AttributeBegin
+          MediumInterface "ink" ""
+          Material "interface"
+          Translate 0 0 0.25
+          Scale 2 2 0.25
+          Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1]
+            "integer indices" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  2 3 7 2 7 6  1 2 6 1 6 5  0 4 7 0 7 3]
+        AttributeEnd"#,
+        sigma.x, sigma.y, sigma.z
+    ));
+    let expected = (-sigma * 0.5).exp();
+    for (integrator, passes, photons) in [("path", 4, 0), ("lt", 4, 200_000)] {
+        let got = mean(&render(&scene, integrator, 8, passes, photons, None));
+        eprintln!("{integrator}: {got} against {expected}");
+        assert!(
+            (got - expected).abs().max_element() < 0.02,
+            "{integrator}: {got}, want {expected}"
+        );
+    }
+}
+
+/// Single scattering of a point light of intensity I in a homogeneous isotropic medium that
+/// fills the scene (inside a black sphere far away), seen along each camera ray: the integral
+/// over the ray of σs · I / (4π d²) · exp(−σt (t + d)), with d the distance from the light,
+/// computed here by the midpoint rule.
+#[test]
+fn single_scattering_of_a_point_light_matches_its_integral() {
+    let (sigma_a, sigma_s, intensity) = (0.2f32, 0.3f32, 10.0f32);
+    let sigma_t = sigma_a + sigma_s;
+    let light = Vec3::new(0.0, 1.0, -2.0);
+    let scene = pbrt(&format!(
+        r#"LookAt 0 0 0  0 0 -1  0 1 0
+        MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [{sigma_a} {sigma_a} {sigma_a}] "rgb sigma_s" [{sigma_s} {sigma_s} {sigma_s}]
+        MediumInterface "" "fog"
+        Camera "perspective" "float fov" 20
+        WorldBegin
+        LightSource "point" "rgb I" [{intensity} {intensity} {intensity}] "point3 from" [{} {} {}]
+        Material "diffuse" "rgb reflectance" [0 0 0]
+        Shape "sphere" "float radius" 100"#,
+        light.x, light.y, light.z
+    ));
+    const SIZE: usize = 8;
+    let camera = scene.camera().fitted(SIZE, SIZE);
+    // The expected mean over the image: each pixel's ray integrated at 4×4 points.
+    let mut expected = 0.0f64;
+    for py in 0..SIZE * 4 {
+        for px in 0..SIZE * 4 {
+            let (sx, sy) = (
+                (px as f32 + 0.5) / (SIZE * 4) as f32,
+                (py as f32 + 0.5) / (SIZE * 4) as f32,
+            );
+            let dir = camera.generate_ray(sx, sy).dir.normalize();
+            let (mut sum, dt) = (0.0f64, 0.002f64);
+            for i in 0..40_000 {
+                let t = (i as f64 + 0.5) * dt;
+                let d2 = (dir * t as f32 - light).length_squared() as f64;
+                let d = d2.sqrt();
+                sum += sigma_s as f64 * intensity as f64 / (4.0 * std::f64::consts::PI * d2)
+                    * (-(sigma_t as f64) * (t + d)).exp()
+                    * dt;
+            }
+            expected += sum;
+        }
+    }
+    expected /= (SIZE * SIZE * 16) as f64;
+    for (integrator, passes, photons) in [("path", 256, 0), ("lt", 16, 100_000)] {
+        let got = mean(&render(&scene, integrator, SIZE, passes, photons, Some(0)));
+        eprintln!("{integrator}: {got} against {expected}");
+        for c in 0..3 {
+            let rel = (got[c] as f64 - expected).abs() / expected;
+            assert!(rel < 0.02, "{integrator}: {got}, want {expected}");
+        }
+    }
+}
+
+/// A ball of a medium that scatters everything (albedo 1, forward scattering) under a uniform
+/// sky of radiance 1 and nothing else: a white furnace, in which every pixel is 1 (the path
+/// tracer, which sees the sky as well). The light tracer cannot see the sky straight through the
+/// ball: it sees the scattered rest, 1 − exp(−σt ℓ) for a chord of length ℓ.
+#[test]
+fn an_albedo_one_medium_in_a_white_furnace_is_the_furnace() {
+    let furnace = |sigma: &str| {
+        pbrt(&format!(
+            r#"LookAt 0 0 4  0 0 0  0 1 0
+            Camera "perspective" "float fov" 30
+            WorldBegin
+            LightSource "infinite" "rgb L" [1 1 1]
+            MakeNamedMedium "cloud" "string type" "homogeneous" "rgb sigma_a" [0 0 0] "rgb sigma_s" [{sigma}] "float g" 0.5
+            MediumInterface "cloud" ""
+            Material "interface"
+            Shape "sphere" "float radius" 1"#
+        ))
+    };
+    let got = mean(&render(&furnace("3 2 1"), "path", 8, 256, 0, None));
+    eprintln!("path: {got}");
+    assert!((got - Vec3::ONE).abs().max_element() < 0.02, "path: {got}, want 1");
+
+    const SIZE: usize = 8;
+    let scene = furnace("2 2 2");
+    let camera = scene.camera().fitted(SIZE, SIZE);
+    let film = render(&scene, "lt", SIZE, 8, 200_000, None);
+    // The 4×4 pixels in the middle (rows and columns 2 to 5, inclusive).
+    let (rows, cols) = ((2, 5), (2, 5));
+    let mut expected = 0.0f32;
+    for py in rows.0 * 4..(rows.1 + 1) * 4 {
+        for px in cols.0 * 4..(cols.1 + 1) * 4 {
+            let (sx, sy) = (
+                (px as f32 + 0.5) / (SIZE * 4) as f32,
+                (py as f32 + 0.5) / (SIZE * 4) as f32,
+            );
+            let ray = camera.generate_ray(sx, sy);
+            let dir = ray.dir.normalize();
+            // The chord through the unit sphere at the origin.
+            let b = ray.origin.dot(dir);
+            let disc = b * b - (ray.origin.length_squared() - 1.0);
+            let chord = 2.0 * disc.max(0.0).sqrt();
+            expected += 1.0 - (-2.0 * chord).exp();
+        }
+    }
+    expected /= 256.0;
+    let got = film.region_mean(rows, cols);
+    eprintln!("lt: {got} against {expected}");
+    assert!(
+        (got - Vec3::splat(expected)).abs().max_element() < 0.02 * expected,
+        "lt: {got}, want {expected}"
+    );
+}
+
+/// A medium of zero density changes nothing, bit for bit: a glass ball filled with it and a
+/// camera in it give the image of the scene without media.
+#[test]
+fn a_medium_of_zero_density_changes_nothing() {
+    let scene = |media: bool| {
+        let (define, interface) = if media {
+            (
+                r#"MakeNamedMedium "none" "string type" "homogeneous" "rgb sigma_a" [1 1 1] "rgb sigma_s" [1 1 1] "float scale" 0
+                MakeNamedMedium "empty" "string type" "uniformgrid" "integer nx" 2 "integer ny" 1 "integer nz" 1 "float density" [0 0]
+                MediumInterface "" "none""#,
+                r#"MediumInterface "empty" "none""#,
+            )
+        } else {
+            ("", "")
+        };
+        pbrt(&format!(
+            r#"LookAt 0 1 4  0 0 0  0 1 0
+            {define}
+            Camera "perspective" "float fov" 40
+            WorldBegin
+            LightSource "point" "rgb I" [5 5 5] "point3 from" [1 3 1]
+            Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+            Shape "bilinearmesh" "point3 P" [-3 -1 -3  3 -1 -3  -3 -1 3  3 -1 3]
+            AttributeBegin
+              {interface}
+              Material "dielectric" "float eta" 1.5
+              Shape "sphere" "float radius" 0.8
+            AttributeEnd"#
+        ))
+    };
+    let (with, without) = (scene(true), scene(false));
+    for integrator in ["path", "lt", "ppm", "vcm"] {
+        let a = render(&with, integrator, 12, 2, 5_000, None);
+        let b = render(&without, integrator, 12, 2, 5_000, None);
+        assert_eq!(a.pixels, b.pixels, "{integrator}");
+    }
+}
+
+/// A ball of coloured fog (σs differs by channel) with a diffuse ball and a small lamp
+/// inside, over a floor outside it: the path tracer and the light tracer agree on the image's
+/// mean, multiple scattering, shadows in the fog and light leaving it included.
+#[test]
+fn path_and_light_tracing_agree_in_fog() {
+    let scene = pbrt(
+        r#"LookAt 0 0.5 5  0 0 0  0 1 0
+        Camera "perspective" "float fov" 40
+        WorldBegin
+        MakeNamedMedium "fog" "string type" "homogeneous" "rgb sigma_a" [0.05 0.05 0.05] "rgb sigma_s" [0.4 0.3 0.2] "float g" 0.3
+        AttributeBegin
+          AreaLightSource "diffuse" "rgb L" [40 40 40] "bool twosided" true
+          Translate 0 1.2 0
+          Shape "bilinearmesh" "point3 P" [-0.2 0 -0.2  0.2 0 -0.2  -0.2 0 0.2  0.2 0 0.2]
+        AttributeEnd
+        AttributeBegin
+          MediumInterface "fog" ""
+          Material "interface"
+          Shape "sphere" "float radius" 1.5
+        AttributeEnd
+        Material "diffuse" "rgb reflectance" [0.6 0.6 0.6]
+        Shape "bilinearmesh" "point3 P" [-4 -1.6 -4  4 -1.6 -4  -4 -1.6 4  4 -1.6 4]
+        AttributeBegin
+          Material "diffuse" "rgb reflectance" [0.5 0.5 0.5]
+          Translate 0 0.3 0
+          Shape "sphere" "float radius" 0.5
+        AttributeEnd"#,
+    );
+    let path = render(&scene, "path", 16, 2048, 0, None);
+    let lt = render(&scene, "lt", 16, 16, 200_000, None);
+    let (a, b) = (mean(&path), mean(&lt));
+    eprintln!("path {a} lt {b}");
+    assert!(((a - b) / b).abs().max_element() < 0.03, "path {a} lt {b}");
+}
