@@ -4,8 +4,9 @@
 
 use caustica::description::{
     Alpha, CameraDesc, ClearCoat, ClearCoatMaps, Coating, EmittingFaces, FovAxis, ImageMap, ImageSource,
-    IntegratorHint, LightDesc, MaterialDesc, MixDesc, NormalMap, ObjectDesc, Param, PhysicalMaterial, RenderHints,
-    RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc, ThinLens, TrimeshDesc, SMOOTH_ALPHA,
+    IntegratorHint, InterfaceDesc, LightDesc, MaterialDesc, MediumDesc, MediumSide, MixDesc, NormalMap, ObjectDesc,
+    Param, PhysicalMaterial, RenderHints, RoughnessMap, RoughnessRemap, SceneDescription, ShapeDesc, SoftShapeDesc,
+    ThinLens, TrimeshDesc, SMOOTH_ALPHA,
 };
 use caustica::math::{Affine2, Mat3, Mat4, Vec2, Vec3, Vec4};
 use caustica::texture::{Encoding, Wrap};
@@ -400,7 +401,20 @@ pub fn description(dict: &Bound<'_, PyAny>) -> PyResult<SceneDescription> {
         desc.camera = Some(camera);
         (desc.hints.width, desc.hints.height) = size;
     }
-    let materials = by_name(&mut top, "materials", material)?;
+    // Media by name, before the materials that put them inside their objects.
+    let media = by_name(&mut top, "media", medium)?;
+    let mut names: Vec<&String> = media.keys().collect();
+    names.sort();
+    let numbers: HashMap<String, usize> = names.iter().enumerate().map(|(i, n)| ((*n).clone(), i)).collect();
+    desc.media = names.iter().map(|n| media[*n].clone()).collect();
+    if let Some(name) = top.string("medium")? {
+        let number = *numbers
+            .get(&name)
+            .ok_or_else(|| At("medium".into()).error(format!("no medium named \"{name}\" in `media`")))?;
+        desc.ambient_medium = Some(number);
+        desc.camera_medium = Some(number);
+    }
+    let materials = by_name(&mut top, "materials", |v, at| material(v, at, &numbers))?;
     // Meshes by name, for shapes that place them (instances of one mesh share its arrays).
     let meshes = by_name(&mut top, "meshes", |value, at| {
         let mut t = Table::new(value, at.clone())?;
@@ -595,7 +609,38 @@ fn camera(value: &Bound<'_, PyAny>, at: At) -> PyResult<(CameraDesc, Size)> {
 }
 
 /// A material: its `type`'s physical reading, with the course fields that go with it.
-fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
+/// A participating medium: `{"absorption": σa, "scattering": σs, "g": mean cosine}`, the
+/// coefficients per unit of length (three numbers each, default 0), g from −1 to 1 (default 0).
+fn medium(value: &Bound<'_, PyAny>, at: At) -> PyResult<MediumDesc> {
+    let mut t = Table::new(value, at.clone())?;
+    let sigma_a = t.colour("absorption", Vec3::ZERO)?;
+    let sigma_s = t.colour("scattering", Vec3::ZERO)?;
+    for (key, v) in [("absorption", sigma_a), ("scattering", sigma_s)] {
+        if !(v.cmpge(Vec3::ZERO).all() && v.is_finite()) {
+            return Err(at
+                .key(key)
+                .error(format!("per unit of length, each value zero or more, not {v}")));
+        }
+    }
+    let g = t.float("g", 0.0)?;
+    if !(g > -1.0 && g < 1.0) {
+        return Err(at
+            .key("g")
+            .error(format!("a mean cosine strictly between −1 and 1, not {g}")));
+    }
+    t.done()?;
+    Ok(MediumDesc {
+        name: None,
+        sigma_a,
+        sigma_s,
+        g,
+        grid: None,
+        span: 0..0,
+    })
+}
+
+/// A material; `media` numbers the scene's media by name, for its `inside` and `outside`.
+fn material(value: &Bound<'_, PyAny>, at: At, media: &HashMap<String, usize>) -> PyResult<MaterialDesc> {
     let mut t = Table::new(value, at.clone())?;
     let kind = t.string("type")?.ok_or_else(|| at.key("type").error("required"))?;
     // The GGX α: `alpha` itself, or `roughness` (α = roughness², Blender's and glTF's reading),
@@ -636,6 +681,11 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
     };
     let mut m = match kind.as_str() {
         "diffuse" => MaterialDesc::lambert(t.param("reflectance", Vec3::splat(0.5))?),
+        // Only where one medium meets another: not drawn, passed unbent.
+        "boundary" => MaterialDesc {
+            boundary: true,
+            ..MaterialDesc::default()
+        },
         "glass" => {
             let (eta, alpha) = (ior(&mut t)?, alpha(&mut t)?);
             let tint = t.param("tint", Vec3::ONE)?;
@@ -718,8 +768,8 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
             if list.len() != 2 {
                 return Err(at.key("materials").error(format!("two materials, not {}", list.len())));
             }
-            let first = material(&list.get_item(0)?, at.key("materials").index(0))?;
-            let second = material(&list.get_item(1)?, at.key("materials").index(1))?;
+            let first = material(&list.get_item(0)?, at.key("materials").index(0), media)?;
+            let second = material(&list.get_item(1)?, at.key("materials").index(1), media)?;
             // The course model reads the larger part (the first where a texture decides).
             let mut m = match amount {
                 Param::Constant(a) if a.x >= 0.5 => second.clone(),
@@ -744,10 +794,30 @@ fn material(value: &Bound<'_, PyAny>, at: At) -> PyResult<MaterialDesc> {
         }
         other => {
             return Err(at.key("type").error(format!(
-                "\"diffuse\", \"glass\", \"thin_glass\", \"conductor\", \"coated\" or \"mix\", not \"{other}\""
+                "\"diffuse\", \"glass\", \"thin_glass\", \"conductor\", \"coated\", \"mix\" or \"boundary\", not \"{other}\""
             )))
         }
     };
+    // The media inside and outside the object (names in `media`); outside defaults to whatever
+    // surrounds it.
+    let side = |t: &mut Table, key: &str| -> PyResult<Option<MediumSide>> {
+        match t.string(key)? {
+            None => Ok(None),
+            Some(name) => match media.get(&name) {
+                Some(&n) => Ok(Some(MediumSide::Medium(Some(n)))),
+                None => Err(at.key(key).error(format!("no medium named \"{name}\" in `media`"))),
+            },
+        }
+    };
+    let (inside, outside) = (side(&mut t, "inside")?, side(&mut t, "outside")?);
+    if inside.is_some() || outside.is_some() {
+        m.interface = Some(InterfaceDesc {
+            inside: inside.unwrap_or(MediumSide::Medium(None)),
+            outside: outside.unwrap_or(MediumSide::Surrounding),
+        });
+    } else if m.boundary {
+        return Err(at.error("a boundary has a medium `inside` (or `outside`)"));
+    }
     if roughness_map.is_some() {
         if m.mix.is_some() {
             return Err(at.key("roughness").error("a mix's roughness is its parts'"));

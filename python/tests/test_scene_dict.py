@@ -512,3 +512,34 @@ def test_light_tracing_and_vcm_see_through_the_lens_as_camera_paths_do():
     d["camera"]["aperture"] = 0.0
     pinhole = blocks(caustica.render(caustica.Scene.from_dict(d), integrator="path", passes=128, seed=1, depth=1))
     assert np.abs(pinhole[lit] / bp[lit] - 1).max() > 0.1
+
+
+def test_media_fill_objects_and_the_scene():
+    # A ball of fog that scatters everything, bounded by a `boundary`, under a white sky: the
+    # furnace, every pixel 1 (also with the fog as the scene's `medium`, the ball then only the
+    # scene's extent). Unknown names and a boundary without a medium are errors.
+    fog = {"scattering": [2, 1.5, 1], "g": 0.5}
+    d = {
+        "camera": {"eye": [0, 0, 4], "look_at": [0, 0, 0], "fov": 30, "width": 8, "height": 8},
+        "media": {"fog": fog},
+        "materials": {"edge": {"type": "boundary", "inside": "fog"}},
+        "shapes": [{"type": "sphere", "center": [0, 0, 0], "radius": 1, "material": "edge"}],
+        "lights": SKY,
+    }
+    for integrator, passes in (("path", 256), ("vcm", 64)):
+        image = caustica.render(caustica.Scene.from_dict(d), integrator=integrator, passes=passes, seed=2)
+        np.testing.assert_allclose(image.mean(axis=(0, 1)), 1.0, rtol=0.02, err_msg=integrator)
+    d["medium"] = "fog"
+    d["materials"]["edge"] = {"type": "diffuse", "reflectance": 1, "coverage": 0}
+    image = caustica.render(caustica.Scene.from_dict(d), integrator="vcm", passes=64, seed=2)
+    np.testing.assert_allclose(image.mean(axis=(0, 1)), 1.0, rtol=0.02)
+    d["materials"]["edge"] = {"type": "boundary", "inside": "smoke"}
+    with pytest.raises(ValueError, match=r'materials\.edge\.inside: no medium named "smoke"'):
+        caustica.Scene.from_dict(d)
+    d["materials"]["edge"] = {"type": "boundary"}
+    with pytest.raises(ValueError, match=r"materials\.edge: a boundary has a medium"):
+        caustica.Scene.from_dict(d)
+    d["materials"]["edge"] = {"type": "boundary", "inside": "fog"}
+    d["media"]["fog"] = {"scattering": 1, "g": 1}
+    with pytest.raises(ValueError, match=r"media\.fog\.g: a mean cosine strictly between"):
+        caustica.Scene.from_dict(d)

@@ -27,7 +27,6 @@ def scene(area):
     light = (
         f"""AttributeBegin
   AreaLightSource "diffuse" "rgb L" [{LAMP_RADIANCE} {LAMP_RADIANCE} {LAMP_RADIANCE}]
-  ReverseOrientation
   {quad([(-LAMP_HALF, 1.99, -LAMP_HALF), (LAMP_HALF, 1.99, -LAMP_HALF), (-LAMP_HALF, 1.99, LAMP_HALF), (LAMP_HALF, 1.99, LAMP_HALF)])}
 AttributeEnd"""
         if area

@@ -35,10 +35,14 @@ mod rough_dielectric;
 use crate::description::{ClearCoat, Coating};
 use crate::material::{Lobes, MaterialRef, MaterialSpectra, PhysicalMaterial, SurfaceParams};
 use crate::math::{reflect, Frame, Vec3, Vec4};
+use crate::medium::{henyey_greenstein, Phase};
 use crate::sampling::sample_cosine_hemisphere;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{cauchy_index, SigmoidPolynomial, Spectrum, Wavelengths};
 use std::f32::consts::PI;
+
+/// The roughness that marks a [`Bsdf::phase`].
+const PHASE: f32 = f32::INFINITY;
 
 /// Whether a path carries radiance (from the camera) or importance (from a light): refraction
 /// scales radiance by 1/η² but not flux.
@@ -195,6 +199,54 @@ impl Bsdf {
         match scene.constant_lobes(hit) {
             Some(lobes) => Bsdf::new(lobes, ns, ng, wo, wl, spectra, abbe),
             None => Bsdf::new(&Lobes::new(&scene.phong(hit)), ns, ng, wo, wl, spectra, abbe),
+        }
+    }
+
+    /// A medium's phase function of mean cosine `g` at a scattering point, seen from `wo`, as
+    /// lobes: smooth, its density its value (f·cos with a cosine of 1, [`Bsdf::cos`]). It is
+    /// kept as a rough glass whose roughness is [`PHASE`] and whose index is g, so surfaces pay
+    /// nothing for it: only the rough glass's own branches look.
+    pub fn phase(g: f32, wo: Vec3, wl: &Wavelengths) -> Bsdf {
+        Bsdf {
+            frame: Frame::from_normal(wo),
+            ng: Vec3::ZERO,
+            outside: true,
+            diffuse: Spectrum::ZERO,
+            glossy: Spectrum::ZERO,
+            exponent: 0.0,
+            mirror: Spectrum::ZERO,
+            transmission: wl.grey(1.0),
+            index: g,
+            dispersive: false,
+            pick: [0.0, 0.0, 0.0, 1.0, 0.0, 0.0],
+            coat: 0.0,
+            coat_weight: 0.0,
+            microfacet: None,
+            diffuse_transmission: Spectrum::ZERO,
+            thin: false,
+            rough: PHASE,
+            index_d: g,
+            abbe: 0.0,
+            clear: NO_COAT,
+            p_coat: 0.0,
+            reflection_bound: 1.0,
+            wl: *wl,
+        }
+    }
+
+    /// Whether these lobes are a medium's phase function ([`Bsdf::phase`]).
+    #[inline]
+    pub fn is_phase(&self) -> bool {
+        self.rough == PHASE
+    }
+
+    /// The cosine that multiplies f towards `dir`: |n · dir| at a surface, 1 in a medium.
+    #[inline]
+    pub fn cos(&self, dir: Vec3) -> f32 {
+        if self.is_phase() {
+            1.0
+        } else {
+            self.frame.z.dot(dir).abs()
         }
     }
 
@@ -789,6 +841,9 @@ impl Bsdf {
     /// A rough dielectric's f: each wavelength refracts by its own index where the glass is
     /// dispersive, so every wavelength follows any direction (no hero termination).
     fn rough_eval(&self, wo: Vec3, wi: Vec3, mode: Transport) -> Spectrum {
+        if self.is_phase() {
+            return self.wl.grey(henyey_greenstein(wo.dot(wi), self.index));
+        }
         if !self.sides_agree(wi) {
             return Spectrum::ZERO;
         }
@@ -810,6 +865,9 @@ impl Bsdf {
     /// The density of drawing `wi` from `wo` (`reverse`: of drawing `wo` had the walk arrived
     /// from `wi`, seen from `wi`'s side, where the relative index is inverted).
     fn rough_pdf(&self, wo: Vec3, wi: Vec3, reverse: bool) -> f32 {
+        if self.is_phase() {
+            return henyey_greenstein(wo.dot(wi), self.index);
+        }
         if !self.sides_agree(wi) {
             return 0.0;
         }
@@ -825,6 +883,17 @@ impl Bsdf {
     /// Reflection or refraction off a visible microfacet of a rough dielectric (`x` in [0, 1)
     /// makes Fresnel's choice).
     fn sample_rough(&self, wo: Vec3, x: f32, u: glam::Vec2, mode: Transport) -> Option<BsdfSample> {
+        if self.is_phase() {
+            let (wi, pdf) = Phase { g: self.index }.sample(wo, u);
+            return Some(BsdfSample {
+                wi,
+                weight: self.wl.grey(1.0),
+                pdf,
+                specular: false,
+                transmitted: false,
+                dispersive: false,
+            });
+        }
         let li = self.rough_interface(self.index).sample(self.frame.to_local(wo), x, u)?;
         let wi = self.frame.to_world(li);
         let pdf = self.rough_pdf(wo, wi, false);

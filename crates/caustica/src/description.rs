@@ -105,8 +105,8 @@ pub struct RenderHints {
     pub photons_per_pass: Option<usize>,
     /// Gather radius in scene units (pbrt's sppm `radius`).
     pub radius: Option<f32>,
-    /// A medium scatters light: only path tracing and light tracing render it, and path
-    /// tracing is the default.
+    /// A medium scatters light: the physical model renders the scene (the course model knows
+    /// no media), and gi refuses it.
     pub scattering_media: bool,
     /// The output file the scene names (pbrt's `Film "filename"`), as written.
     pub output: Option<PathBuf>,

@@ -136,6 +136,11 @@ impl DensityGrid {
         }
     }
 
+    /// Samples along x, y and z.
+    pub fn dims(&self) -> [usize; 3] {
+        self.dims
+    }
+
     /// The density at the world point `p`.
     pub fn density(&self, p: Vec3) -> f32 {
         let g = self.to_grid.transform_point3(p);
@@ -228,6 +233,15 @@ impl Medium {
     fn coefficients(&self, wl: &Wavelengths) -> (Spectrum, Spectrum) {
         let s = wl.unbounded(self.sigma_s);
         (s, s + wl.unbounded(self.sigma_a))
+    }
+
+    /// σs at the point `p`, at the wavelengths `wl` (the grid's density included).
+    pub fn sigma_s_at(&self, p: Vec3, wl: &Wavelengths) -> Spectrum {
+        let s = wl.unbounded(self.sigma_s);
+        match &self.grid {
+            None => s,
+            Some(grid) => s * grid.density(p),
+        }
     }
 
     /// Samples where a walk along `ray` (unit direction) between `t0` and `t1` first scatters:

@@ -549,6 +549,11 @@ impl Scene {
         self.media.iter().any(|m| !m.only_absorbs() && !m.is_clear())
     }
 
+    /// Every medium (empty in a scene that tracks none).
+    pub fn media(&self) -> &[Medium] {
+        &self.media
+    }
+
     /// Medium `id` (not [`VACUUM`]).
     #[inline]
     pub fn medium(&self, id: u32) -> &Medium {

@@ -116,6 +116,18 @@ fn text(scene: &str, s: &SceneSummary) -> String {
     }
     line(format!("bounds     {:?} .. {:?}", s.bounds.min, s.bounds.max));
     line(format!("materials  {}   textures {}", s.materials.len(), s.textures));
+    if !s.media.is_empty() {
+        line(format!("media      {}", s.media.len()));
+        for (i, m) in s.media.iter().enumerate() {
+            let grid = m
+                .grid
+                .map_or(String::new(), |[x, y, z]| format!("  density grid {x}×{y}×{z}"));
+            line(format!(
+                "  {i:>3}  absorption {:?}  scattering {:?}  g {}{grid}",
+                m.absorption, m.scattering, m.g
+            ));
+        }
+    }
     for (i, m) in s.materials.iter().enumerate() {
         line(format!(
             "  {i:>3}  kd {}  ks {}  kr {}  kt {}  ke {}  ka {}  ns {}  index {}",

@@ -32,6 +32,22 @@ pub struct CameraArrival<'a> {
     pub length: u32,
 }
 
+impl<'a> CameraArrival<'a> {
+    /// A scattering point as an arrival whose lobes are `bsdf` (its phase function, for users
+    /// that treat it as any smooth vertex).
+    pub fn in_medium(at: &MediumArrival<'a>, bsdf: &'a Bsdf) -> CameraArrival<'a> {
+        CameraArrival {
+            hit: at.hit,
+            bsdf,
+            wo: at.wo,
+            t: at.hit.t,
+            throughput: at.throughput,
+            dispersed: at.dispersed,
+            length: at.length,
+        }
+    }
+}
+
 /// What a camera walk's user does at each vertex, where the path leaves the scene, and how it
 /// bounces.
 pub trait CameraVisitor {

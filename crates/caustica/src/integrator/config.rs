@@ -261,12 +261,12 @@ impl RenderConfig {
             config.width = w;
         }
         config.height = hints.height;
-        if hints.physical {
+        // The course model knows no media: a scene with one is rendered physically.
+        if hints.physical || hints.scattering_media {
             config.model = Some(Model::Physical);
             config.integrator = Some(match hints.integrator {
                 Some(IntegratorHint::Ppm) => IntegratorKind::Ppm,
                 Some(IntegratorHint::LightTracer) => IntegratorKind::Lt,
-                None if hints.scattering_media => IntegratorKind::Path,
                 Some(IntegratorHint::Bidirectional) | None => IntegratorKind::Vcm,
                 Some(IntegratorHint::Path) => IntegratorKind::Path,
             });
@@ -540,17 +540,10 @@ pub fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
 /// or glass are lit by point, spot or sun lights, that a path tracer cannot show their caustics.
 /// `None` where the user chose, or the file is not in physical units.
 pub fn integrator_note(given: &GivenOptions, hints: &RenderHints, scene: &crate::scene::Scene) -> Option<String> {
-    if given.model_or_integrator || !hints.physical {
+    if given.model_or_integrator || !(hints.physical || hints.scattering_media) {
         return None;
     }
     let Some(named) = hints.integrator else {
-        if hints.scattering_media {
-            return Some(
-                "integrator path: the file names none, and the scene has fog or smoke, which path and lt \
-                 render (vcm, ppm and gi do not yet)"
-                    .into(),
-            );
-        }
         return Some(
             "integrator vcm: the file names none, and vcm renders the caustics of point, spot and sun lights \
              through glass and mirrors as well as all a path tracer renders (--integrator chooses another)"

@@ -28,7 +28,7 @@ pub fn direct_light(
         if f == Spectrum::ZERO {
             return;
         }
-        let cos = bsdf.normal().dot(sample.wi).abs();
+        let cos = bsdf.cos(sample.wi);
         let weight = if mis && sample.pdf > 0.0 {
             power_heuristic(sample.pdf, bsdf.pdf(wo, sample.wi))
         } else {
@@ -59,6 +59,9 @@ pub fn direct_in_medium(scene: &Scene, at: &MediumArrival, mis: bool, wl: &Wavel
 /// Emitted radiance of a surface towards `wo`, at the wavelengths `wl`.
 #[inline]
 pub fn emitted(scene: &Scene, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Spectrum {
+    if hit.is_in_medium() {
+        return Spectrum::ZERO;
+    }
     scene.emission_towards(hit, wo, wl)
 }
 
@@ -73,18 +76,30 @@ pub fn bsdf_can_reach_light(scene: &Scene) -> bool {
 /// The light that the smooth-lobe sample `sample` from the surface point `hit` reaches directly —
 /// an emitter's surface or the sky — weighted against next-event estimation: the BSDF half of
 /// direct lighting by MIS (the caller multiplies by `sample.weight`).
-pub fn direct_by_bsdf(scene: &Scene, hit: &SurfaceHit, sample: &BsdfSample, wl: &Wavelengths) -> Spectrum {
+pub fn direct_by_bsdf(
+    scene: &Scene,
+    hit: &SurfaceHit,
+    sample: &BsdfSample,
+    wl: &Wavelengths,
+    rng: &mut Rng,
+) -> Spectrum {
     let lights = scene.lights();
     let ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
-    match scene.intersect(&ray, f32::INFINITY) {
-        None => lights.escaped_weighted(sample.wi, Some(sample.pdf), wl),
-        Some(isect) => {
-            let reached = scene.surface(&ray, &isect);
+    let (seen, distance) = match scene.intersect_solid(&ray) {
+        None => (lights.escaped_weighted(sample.wi, Some(sample.pdf), wl), f32::INFINITY),
+        Some((ray_there, isect)) => {
+            let reached = scene.surface(&ray_there, &isect);
             let le = emitted(scene, &reached, -sample.wi, wl);
             if le == Spectrum::ZERO {
                 return Spectrum::ZERO;
             }
-            le * power_heuristic(sample.pdf, lights.pdf_direct(hit.point, &reached))
+            let weight = power_heuristic(sample.pdf, lights.pdf_direct(hit.point, &reached));
+            (le * weight, (reached.point - hit.point).length())
         }
+    };
+    if scene.has_media() && seen != Spectrum::ZERO {
+        // The media on the way take their share, as next-event estimation's shadow rays pay.
+        return seen * scene.transmittance_towards(hit, sample.wi, distance, wl, rng);
     }
+    seen
 }

@@ -16,7 +16,7 @@ use super::tiles::sample_pass;
 use super::Progressive;
 use crate::math::{Ray, Vec3};
 use crate::photon::map::PhotonMap;
-use crate::photon::trace::trace_count;
+use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left, Photon};
 use crate::progress::Control;
 use crate::sampling::Rng;
@@ -133,7 +133,12 @@ impl<'a> Ppm<'a> {
     /// The photons of pass `pass` that the estimate uses (all but direct ones), at the pass's
     /// wavelengths `wl`.
     pub fn photon_map(&self, pass: u64, wl: &Wavelengths, control: Control) -> PhotonMap {
-        let mut photons = trace_count(
+        self.photon_maps(pass, wl, control).0
+    }
+
+    /// The photons of pass `pass` that the estimate uses, on surfaces and in media.
+    fn photon_maps(&self, pass: u64, wl: &Wavelengths, control: Control) -> (PhotonMap, PhotonMap) {
+        let (mut photons, mut volume) = trace_count_in_media(
             self.scene,
             self.settings.photons_per_pass,
             (self.seed ^ PHOTON_SEED, pass),
@@ -142,14 +147,22 @@ impl<'a> Ppm<'a> {
             control,
         );
         photons.retain(|p| !is_direct(p));
-        PhotonMap::new(photons)
+        volume.retain(|p| !is_direct(p));
+        (PhotonMap::new(photons), PhotonMap::new(volume))
     }
 
     /// Radiance along a camera ray with the photons of one pass: smooth lobes are counted in
     /// full at the first smooth surface that is not sharply glossy (next-event estimation and
     /// photons); specular lobes and sharp highlights continue the path, a highlight counting
     /// direct light and the photons that reached it by mirrors and glass alone.
-    fn radiance(&self, map: &PhotonMap, ray: Ray, radius_factor: f32, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
+    fn radiance(
+        &self,
+        (map, volume): (&PhotonMap, &PhotonMap),
+        ray: Ray,
+        radius_factor: f32,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+    ) -> Spectrum {
         camera_chain(
             self.scene,
             ray,
@@ -160,13 +173,18 @@ impl<'a> Ppm<'a> {
             |hit, bsdf, wo, path_length, dispersed, left, caustic_only, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
                 let min_left = needed_bounces_left(self.settings.max_depth, left);
+                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
+                if bsdf.is_phase() {
+                    // In a medium: the volume photons within a ball of the same radius.
+                    let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
+                    return direct + volume.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
+                }
                 let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
-                direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
-                    + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
+                direct + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
             },
-            |hit, sample, _, _, _, _| {
+            |hit, sample, _, _, _, rng| {
                 if self.mis {
-                    sample.weight * direct_by_bsdf(self.scene, hit, sample, wl)
+                    sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
                 } else {
                     Spectrum::ZERO
                 }
@@ -178,14 +196,14 @@ impl<'a> Ppm<'a> {
 impl Progressive for Ppm<'_> {
     fn render_pass(&self, pass: u64, control: Control) -> Option<Vec<Vec3>> {
         let wl = pass_wavelengths(self.spectral, self.seed, pass);
-        let map = self.photon_map(pass, &wl, control);
+        let (map, volume) = self.photon_maps(pass, &wl, control);
         if control.cancelled() {
             return None;
         }
         let factor = radius_factor(pass, self.settings.alpha);
         let camera = &self.camera;
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
-            wl.to_rgb(self.radiance(&map, camera.generate_ray(sx, sy), factor, &wl, rng))
+            wl.to_rgb(self.radiance((&map, &volume), camera.generate_ray(sx, sy), factor, &wl, rng))
         })
     }
 }

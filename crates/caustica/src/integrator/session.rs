@@ -200,9 +200,9 @@ impl<'a> RenderSession<'a> {
     /// A session for `scene`; the options are checked here.
     pub fn new(scene: &'a Scene, options: RenderOptions) -> Result<RenderSession<'a>> {
         options.integrator.validate()?;
-        if scene.scatters() && !matches!(options.integrator, Integrator::Path(_) | Integrator::Lt(_)) {
+        if scene.scatters() && matches!(options.integrator, Integrator::Whitted(_) | Integrator::Gi(_)) {
             return Err(crate::error::Error::InvalidSettings(format!(
-                "the scene has a medium that scatters light, which only --integrator path and lt render so far (not {})",
+                "the scene has a medium that scatters light, which --integrator vcm, path, lt and ppm render (not {})",
                 options.integrator.name()
             )));
         }

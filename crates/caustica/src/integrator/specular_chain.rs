@@ -4,6 +4,7 @@
 use super::camera_walk::{walk_camera, CameraArrival, CameraVisitor};
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
+use crate::photon::light_walk::MediumArrival;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -114,9 +115,16 @@ where
         true
     }
 
-    // Not reached: ppm and gi refuse scenes whose media scatter (`RenderSession::new`).
-    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival, _rng: &mut Rng) -> bool {
-        false
+    // A scattering point is a smooth vertex whose lobes are the phase function: the chain
+    // gathers there and ends.
+    fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool {
+        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
+        self.visit(&CameraArrival::in_medium(at, &bsdf), rng)
+    }
+
+    fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
+        self.bounce(&CameraArrival::in_medium(at, &bsdf), rng)
     }
 
     fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {

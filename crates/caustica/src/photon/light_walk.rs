@@ -73,7 +73,23 @@ pub struct MediumArrival<'a> {
     pub length: u32,
 }
 
-impl MediumArrival<'_> {
+impl<'a> MediumArrival<'a> {
+    /// This point as a surface arrival whose lobes are `bsdf` (its phase function, for users
+    /// that treat it as any smooth vertex).
+    pub fn as_light_arrival<'b>(&self, bsdf: &'b Bsdf) -> LightArrival<'b>
+    where
+        'a: 'b,
+    {
+        LightArrival {
+            hit: self.hit,
+            wo: self.wo,
+            bsdf,
+            throughput: self.throughput,
+            dispersed: self.dispersed,
+            length: self.length,
+        }
+    }
+
     /// The phase function's sample from this point, as a bounce: a smooth one whose weight is 1.
     pub fn sample_phase(&self, rng: &mut Rng) -> BsdfSample {
         let (wi, pdf) = self.phase.sample(self.wo, rng.uniform2());

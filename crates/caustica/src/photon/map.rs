@@ -449,6 +449,33 @@ impl PhotonMap {
         sum / (PI * r * r)
     }
 
+    /// Radiance a point in a medium scatters towards `wo` from the volume photons within `r`
+    /// (those with at least `min_left` bounces left): Σ p(wo, ωp) Φp / (4/3 π r³) over σs, the
+    /// medium's scattering coefficient there (photons are stored where they scatter, at a
+    /// density σs times the fluence).
+    pub fn in_scattered_within(
+        &self,
+        point: Vec3,
+        phase: &Bsdf,
+        wo: Vec3,
+        (r, min_left): (f32, u8),
+        dispersed: bool,
+        sigma_s: Spectrum,
+    ) -> Spectrum {
+        if self.photons.is_empty() || r.is_nan() || r <= 0.0 {
+            return Spectrum::ZERO;
+        }
+        let mut sum = Spectrum::ZERO;
+        self.tree.for_each_within(&self.photons, point, r * r, |slot, _| {
+            let photon = &self.photons[slot as usize];
+            if photon.bounces_left() >= min_left {
+                sum += phase.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
+            }
+        });
+        let density = sum / (4.0 / 3.0 * PI * r * r * r);
+        Spectrum::select(sigma_s.cmpgt(Spectrum::ZERO), density / sigma_s, Spectrum::ZERO)
+    }
+
     /// Reflected radiance at `point` towards `wo` from the `k` nearest photons within
     /// `max_radius`, the radius being the distance to the k-th.
     pub fn radiance_nearest(

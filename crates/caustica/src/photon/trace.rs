@@ -19,7 +19,7 @@
 //! (physical). Both are deterministic whatever the thread count: photon `i` draws from its own
 //! random stream and batches are concatenated in order.
 
-use super::light_walk::{walk_light, LightArrival, LightVisitor, Roulette};
+use super::light_walk::{walk_light, LightArrival, LightVisitor, MediumArrival, Roulette};
 use super::{Photon, DIFFUSE, DISPERSED, MAX_BOUNCES_LEFT, REFLECTED, REFRACTED};
 use crate::bsdf::{BsdfSample, Transport};
 use crate::light::{distance_attenuation, Light};
@@ -40,41 +40,57 @@ pub(crate) const BATCH: u64 = 4096;
 pub fn trace_count(
     scene: &Scene,
     count: u64,
-    (seed, stream): (u64, u64),
+    stream: (u64, u64),
     max_bounces: u32,
     wl: &Wavelengths,
     control: Control,
 ) -> Vec<Photon> {
+    trace_count_in_media(scene, count, stream, max_bounces, wl, control).0
+}
+
+/// [`trace_count`], also returning the photons stored where they scattered in a medium (its
+/// second list, empty without media that scatter).
+pub fn trace_count_in_media(
+    scene: &Scene,
+    count: u64,
+    (seed, stream): (u64, u64),
+    max_bounces: u32,
+    wl: &Wavelengths,
+    control: Control,
+) -> (Vec<Photon>, Vec<Photon>) {
     let lights = scene.lights();
     if lights.is_empty() || count == 0 {
-        return Vec::new();
+        return (Vec::new(), Vec::new());
     }
     let scale = 1.0 / count as f32;
-    let parts: Vec<Vec<Photon>> = (0..count.div_ceil(BATCH))
+    let parts: Vec<(Vec<Photon>, Vec<Photon>)> = (0..count.div_ceil(BATCH))
         .into_par_iter()
         .map(|b| {
+            let (mut out, mut volume) = (Vec::new(), Vec::new());
             if control.cancelled() {
-                return Vec::new();
+                return (out, volume);
             }
             let first = b * BATCH;
-            let (photons, _) = trace_batch(first..(first + BATCH).min(count), |i, out| {
+            for i in first..(first + BATCH).min(count) {
                 let mut rng = Rng::new(seed, (stream << 40) ^ i);
                 if let Some(emitted) = lights.emit(scene, wl, &mut rng) {
                     let flux = emitted.throughput * scale;
                     let mut photons = PhysicalPhotons {
                         max_bounces,
                         flags: 0,
-                        out,
+                        out: &mut out,
+                        volume: Some(&mut volume),
                     };
                     let surfaces = max_bounces.saturating_add(1);
                     let medium = scene.light_medium(emitted.light);
                     walk_light(scene, emitted.ray, (flux, medium), wl, surfaces, &mut rng, &mut photons);
                 }
-            });
-            photons
+            }
+            (out, volume)
         })
         .collect();
-    parts.concat()
+    let (surface, volume): (Vec<_>, Vec<_>) = parts.into_iter().unzip();
+    (surface.concat(), volume.concat())
 }
 
 /// Runs `photon(i, out)` for each photon index of a batch; returns what they stored and, for
@@ -247,13 +263,34 @@ pub struct PhysicalPhotons<'o> {
     pub flags: u8,
     /// Where the photons go.
     pub out: &'o mut Vec<Photon>,
+    /// Where photons that scatter in a medium go (`None`: they are not kept).
+    pub volume: Option<&'o mut Vec<Photon>>,
 }
 
 impl LightVisitor for PhysicalPhotons<'_> {
-    // Photons are not stored in media yet: ppm and gi refuse scenes whose media scatter
-    // (`RenderSession::new`), and a medium that only absorbs has no scattering points.
-    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival) -> bool {
+    // A photon that scatters in a medium is kept there too, its normal the direction it
+    // arrived from (a volume photon has none).
+    fn visit_medium(&mut self, at: &MediumArrival) -> bool {
+        if let Some(volume) = self.volume.as_mut() {
+            let left = self
+                .max_bounces
+                .saturating_sub(at.length - 1)
+                .min(MAX_BOUNCES_LEFT as u32) as u8;
+            volume.push(Photon::with_spectrum(
+                at.hit.point,
+                at.throughput,
+                -at.wo,
+                at.wo,
+                self.flags | left << 4,
+            ));
+        }
         true
+    }
+
+    fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<(BsdfSample, Roulette)> {
+        // Scattering in a medium is a diffuse bounce: what follows is no caustic.
+        self.flags |= DIFFUSE;
+        Some((at.sample_phase(rng), Roulette::KeepFlux))
     }
 
     fn visit(&mut self, at: &LightArrival) -> bool {

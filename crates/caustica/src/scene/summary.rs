@@ -31,6 +31,8 @@ pub struct SceneSummary {
     pub materials: Vec<MaterialSummary>,
     /// Number of textures.
     pub textures: usize,
+    /// Participating media (absorbing glass among them), by number.
+    pub media: Vec<MediumSummary>,
     /// World bounds (infinite, `null` in JSON, for an empty scene).
     pub bounds: BoundsSummary,
     /// Remarks made while reading and building.
@@ -192,6 +194,20 @@ pub enum ChannelSummary {
         /// Texture id.
         texture: u32,
     },
+}
+
+/// A participating medium's coefficients per unit of length, its phase function's mean cosine,
+/// and a density grid's size.
+#[derive(Clone, Debug, Serialize)]
+pub struct MediumSummary {
+    /// σa.
+    pub absorption: [f32; 3],
+    /// σs.
+    pub scattering: [f32; 3],
+    /// Henyey–Greenstein's g.
+    pub g: f32,
+    /// Samples along x, y, z of its density grid (`None`: homogeneous).
+    pub grid: Option<[usize; 3]>,
 }
 
 /// A material's eight course parameters.
@@ -416,6 +432,16 @@ impl Scene {
             objects,
             materials,
             textures: self.textures().len(),
+            media: self
+                .media()
+                .iter()
+                .map(|m| MediumSummary {
+                    absorption: m.sigma_a.to_array(),
+                    scattering: m.sigma_s.to_array(),
+                    g: m.phase.g,
+                    grid: m.grid.as_ref().map(|g| g.dims()),
+                })
+                .collect(),
             bounds: BoundsSummary::of(&self.bounds()),
             warnings: self.warnings().to_vec(),
         }

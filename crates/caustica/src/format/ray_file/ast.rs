@@ -68,6 +68,10 @@ pub struct RayScene {
     pub warnings: Vec<(String, Span)>,
     /// Meshes named by `file` (a caustica extension), read when the scene is lowered.
     pub mesh_files: Vec<MeshFile>,
+    /// Media inside objects and the scene's own (`medium { … }`), caustica extensions.
+    pub media: Vec<crate::description::MediumDesc>,
+    /// The medium filling the scene (`medium { … }` at the top level).
+    pub ambient_medium: Option<usize>,
 }
 
 /// A `polymesh { file = "…"; }`: an OBJ or PLY file in place of the mesh's lists.
@@ -169,6 +173,9 @@ impl RayScene {
             objects,
             warnings,
             hints: Default::default(),
+            media: self.media,
+            ambient_medium: self.ambient_medium,
+            camera_medium: self.ambient_medium,
             ..Default::default()
         })
     }

@@ -60,6 +60,8 @@ pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>, dialect: Di
             objects: Vec::new(),
             warnings: Vec::new(),
             mesh_files: Vec::new(),
+            media: Vec::new(),
+            ambient_medium: None,
         },
     };
     loop {

@@ -158,6 +158,7 @@ pub(crate) const TOP_LEVEL: &[&str] = &[
     "warn_model_light",
     "skybox",
     "ambient_light",
+    "medium",
     "material",
     "sphere",
     "box",

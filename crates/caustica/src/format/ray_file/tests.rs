@@ -806,3 +806,64 @@ fn default_view_and_look_at() {
     let cam = Camera::from_desc(&d.lower());
     assert!((cam.generate_ray(0.5, 0.5).dir - Vec3::X).length() < 1e-6);
 }
+
+// ---------------------------------------------------------------- media
+
+/// A material's `scattering`, `absorption` and `phase` make a medium inside its object, with
+/// whatever surrounds it outside; `boundary` leaves only the boundary; absorption alone stays a
+/// coloured glass; a top-level `medium` fills the scene and holds the camera.
+#[test]
+fn media_are_read_into_materials_and_the_scene() {
+    let scene = read(
+        "medium { scattering = (0.1, 0.2, 0.3); absorption = (0.01, 0.01, 0.01); phase = 0.4; }
+         sphere { material = { scattering = (2, 2, 2); phase = -0.3; boundary = true; } }
+         box { material = { transmissive = (1, 1, 1); index = 1.33; absorption = (0.5, 0.1, 0); scattering = (0.3, 0.3, 0.3); } }
+         square { material = { transmissive = (1, 1, 1); absorption = (1, 0, 0); } }",
+    );
+    assert_eq!(scene.media.len(), 3);
+    assert_eq!(scene.ambient_medium, Some(0));
+    let fog = &scene.media[0];
+    assert_eq!(
+        (fog.sigma_s, fog.sigma_a, fog.g),
+        (Vec3::new(0.1, 0.2, 0.3), Vec3::splat(0.01), 0.4)
+    );
+    let [ball, water, glass] = [0, 1, 2].map(|i| &scene.objects[i].material);
+    assert!(ball.boundary && ball.absorption.is_none());
+    assert_eq!(scene.media[1].g, -0.3);
+    let inside = |m: &MaterialDesc| m.interface.map(|i| (i.inside, i.outside));
+    use crate::description::MediumSide;
+    assert_eq!(
+        inside(ball),
+        Some((MediumSide::Medium(Some(1)), MediumSide::Surrounding))
+    );
+    assert_eq!(
+        inside(water),
+        Some((MediumSide::Medium(Some(2)), MediumSide::Surrounding))
+    );
+    assert_eq!(scene.media[2].sigma_a, Vec3::new(0.5, 0.1, 0.0));
+    assert!(!water.boundary && water.absorption.is_none());
+    assert_eq!((glass.interface, glass.absorption), (None, Some(Vec3::X)));
+}
+
+#[test]
+fn media_errors() {
+    for (body, covered, says) in [
+        ("sphere { material = { phase = 1.5; } }", "1.5", "strictly between"),
+        (
+            "sphere { material = { scattering = (1, -1, 0); } }",
+            "(1, -1, 0)",
+            "zero or more",
+        ),
+        ("sphere { material = { boundary = yes; } }", "yes", "`true` or `false`"),
+        (
+            "medium { scattering = (1, 1, 1); } medium { absorption = (1, 1, 1); }",
+            "medium { absorption = (1, 1, 1); }",
+            "second `medium`",
+        ),
+        ("medium { colour = (1, 1, 1); }", "colour", "medium field"),
+    ] {
+        let (error, text) = fail(body);
+        assert_eq!(text, covered, "{body}");
+        assert!(error.message.contains(says), "{body}: {}", error.message);
+    }
+}

@@ -17,6 +17,7 @@ use super::skybox::{SkyboxFields, SKYBOX_FIELDS};
 use super::suggest;
 use super::transform_stack::{self, TransformStack};
 use super::trimesh::{self, MeshInput};
+use crate::description::{InterfaceDesc, MediumDesc, MediumSide};
 use crate::ParseError;
 use glam::{Vec2, Vec3, Vec4};
 use std::path::Path;
@@ -56,8 +57,12 @@ const MATERIAL_FIELDS: &[&str] = &[
     "index",
     "abbe",
     "absorption",
+    "scattering",
+    "phase",
+    "boundary",
     "name",
 ];
+const MEDIUM_FIELDS: &[&str] = &["absorption", "scattering", "phase"];
 const CAMERA_FIELDS: &[&str] = &[
     "position",
     "viewdir",
@@ -108,6 +113,8 @@ pub(crate) fn parse(text: &str, scene_dir: &Path, reach: &Reach<'_>) -> Result<R
             objects: Vec::new(),
             warnings: Vec::new(),
             mesh_files: Vec::new(),
+            media: Vec::new(),
+            ambient_medium: None,
         },
     };
     parser.file()?;
@@ -127,6 +134,27 @@ enum Frame {
         start: usize,
         splits: Vec<usize>,
     },
+}
+
+/// A medium's fields as read (a material's or the scene's `medium`).
+#[derive(Default)]
+struct MediumFields {
+    absorption: Option<Vec3>,
+    scattering: Option<Vec3>,
+    phase: Option<f32>,
+}
+
+impl MediumFields {
+    fn medium(&self, span: Span) -> MediumDesc {
+        MediumDesc {
+            name: None,
+            sigma_a: self.absorption.unwrap_or(Vec3::ZERO),
+            sigma_s: self.scattering.unwrap_or(Vec3::ZERO),
+            g: self.phase.unwrap_or(0.0),
+            grid: None,
+            span,
+        }
+    }
 }
 
 struct Parser<'a> {
@@ -179,6 +207,7 @@ impl<'a> Parser<'a> {
                     }
                     "environment_light" => self.environment_light()?,
                     "ambient_light" => self.ambient_light()?,
+                    "medium" => self.ambient_medium()?,
                     "material" => {
                         let base = self.default_material.clone();
                         self.default_material = self.material_stmt(&base)?;
@@ -907,6 +936,77 @@ impl<'a> Parser<'a> {
         Ok(())
     }
 
+    /// `medium { absorption = …; scattering = …; phase = g; }` at the top level (a caustica
+    /// extension): a medium that fills the scene where no object's says otherwise.
+    fn ambient_medium(&mut self) -> Result<(), ParseError> {
+        let start = self.cur.next().span.start;
+        self.cur.expect(Tok::LBrace, "after `medium`")?;
+        let mut fields = MediumFields::default();
+        while !self.cur.eat(Tok::RBrace) {
+            if !self.medium_field(&mut fields)? {
+                return Err(self.bad_word(
+                    "a medium field (`absorption`, `scattering`, `phase`) or `}`",
+                    MEDIUM_FIELDS,
+                ));
+            }
+        }
+        if self.scene.ambient_medium.is_some() {
+            return Err(ParseError::new(
+                "the scene has a second `medium`",
+                start..self.cur.prev_end(),
+            ));
+        }
+        let medium = fields.medium(start..self.cur.prev_end());
+        self.scene.media.push(medium);
+        self.scene.ambient_medium = Some(self.scene.media.len() - 1);
+        Ok(())
+    }
+
+    /// One field of a medium (the key is next): `false` when the word is not one.
+    fn medium_field(&mut self, fields: &mut MediumFields) -> Result<bool, ParseError> {
+        let token = self.cur.peek().clone();
+        let key = if token.tok == Tok::Word {
+            self.cur.text_of(&token)
+        } else {
+            ""
+        };
+        match key {
+            "absorption" | "scattering" => {
+                let key = key.to_string();
+                self.key_equals()?;
+                let (value, span) = self.tuple::<3>(&format!("(per unit of length) for `{key}`"))?;
+                let value = Vec3::from(value);
+                if !(value.cmpge(Vec3::ZERO).all() && value.is_finite()) {
+                    return Err(ParseError::new(
+                        format!("`{key}` is per unit of length, each value zero or more, not {value}"),
+                        span,
+                    ));
+                }
+                if key == "absorption" {
+                    fields.absorption = Some(value);
+                } else {
+                    fields.scattering = Some(value);
+                }
+            }
+            "phase" => {
+                self.key_equals()?;
+                let (g, span) = self
+                    .cur
+                    .number("(the mean cosine g of the scattering, from −1 to 1) for `phase`")?;
+                if !(g > -1.0 && g < 1.0) {
+                    return Err(ParseError::new(
+                        format!("`phase` is the mean cosine g, strictly between −1 and 1, not {g}"),
+                        span,
+                    ));
+                }
+                fields.phase = Some(g);
+            }
+            _ => return Ok(false),
+        }
+        self.cur.eat(Tok::Semicolon);
+        Ok(true)
+    }
+
     /// `material = body ;?` (the `material` word is next); the body starts from `base`.
     fn material_stmt(&mut self, base: &MaterialDesc) -> Result<MaterialDesc, ParseError> {
         self.key_equals()?;
@@ -932,6 +1032,9 @@ impl<'a> Parser<'a> {
         let mut material = base.clone();
         material.name = None;
         let mut name: Option<(String, Span)> = None;
+        // The medium inside the object, where the body gives one.
+        let mut medium = MediumFields::default();
+        let mut medium_span: Option<Span> = None;
         loop {
             let token = self.cur.peek().clone();
             if self.cur.eat(Tok::RBrace) {
@@ -972,19 +1075,15 @@ impl<'a> Parser<'a> {
                     self.cur.eat(Tok::Semicolon);
                     material.abbe = Some(value);
                 }
-                "absorption" => {
+                "absorption" | "scattering" | "phase" => {
+                    let start = token.span.start;
+                    self.medium_field(&mut medium)?;
+                    medium_span.get_or_insert(start..self.cur.prev_end());
+                }
+                "boundary" => {
                     self.key_equals()?;
-                    let (value, span) =
-                        self.tuple::<3>("(the absorption per unit of length inside the glass) for `absorption`")?;
-                    let value = Vec3::from(value);
-                    if !(value.cmpge(Vec3::ZERO).all() && value.is_finite()) {
-                        return Err(ParseError::new(
-                            format!("`absorption` is per unit of length, each value zero or more, not {value}"),
-                            span,
-                        ));
-                    }
+                    material.boundary = self.boolean("for `boundary`")?;
                     self.cur.eat(Tok::Semicolon);
-                    material.absorption = Some(value);
                 }
                 _ if COLOUR_FIELDS.contains(&key) || key == "shininess" || key == "index" => {
                     self.key_equals()?;
@@ -1000,9 +1099,22 @@ impl<'a> Parser<'a> {
                 }
                 _ if self.skip_extension_field("material")? => {}
                 _ => {
-                    let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `abbe`, `absorption`, `name`";
+                    let list = "`diffuse`, `specular`, `reflective`, `transmissive`, `emissive`, `ambient`, `shininess`, `index`, `abbe`, `absorption`, `scattering`, `phase`, `boundary`, `name`";
                     return Err(self.bad_word(&format!("a material field ({list}) or `}}`"), MATERIAL_FIELDS));
                 }
+            }
+        }
+        if let Some(span) = medium_span {
+            if medium.scattering.is_none() && medium.phase.is_none() {
+                // Only absorption: a coloured glass, as before media.
+                material.absorption = medium.absorption;
+            } else {
+                self.scene.media.push(medium.medium(span));
+                material.absorption = None;
+                material.interface = Some(InterfaceDesc {
+                    inside: MediumSide::Medium(Some(self.scene.media.len() - 1)),
+                    outside: MediumSide::Surrounding,
+                });
             }
         }
         if let Some((value, span)) = name {

@@ -3,6 +3,7 @@
 //! ([`super::merging`]), every strategy weighted by [`mis`].
 
 use super::*;
+use crate::photon::light_walk::MediumArrival;
 
 /// One camera subpath on its walk: its MIS sums, the variants merging at the first vertex
 /// needs, and the radiance gathered.
@@ -49,9 +50,17 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
         self.l += throughput * seen;
     }
 
-    // Not reached: vcm refuses scenes whose media scatter (`RenderSession::new`).
-    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival, _rng: &mut Rng) -> bool {
-        false
+    // A scattering point is a smooth vertex whose lobes are the phase function: it gathers
+    // next-event estimation and connections as a surface does, but never merges (merging's
+    // kernel is a disc on a surface).
+    fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool {
+        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
+        self.visit(&CameraArrival::in_medium(at, &bsdf), rng)
+    }
+
+    fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<BsdfSample> {
+        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
+        self.bounce(&CameraArrival::in_medium(at, &bsdf), rng)
     }
 
     fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
@@ -60,9 +69,13 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
         let d2 = (hit.point - self.previous).length_squared();
         let previous = self.previous;
         self.previous = hit.point;
-        let cos_in = bsdf.normal().dot(wo).abs();
+        let cos_in = bsdf.cos(wo);
         self.partial.arrive(d2, cos_in);
-        let le = vcm.scene.emission_towards(hit, wo, wl);
+        let le = if hit.is_in_medium() {
+            Spectrum::ZERO
+        } else {
+            vcm.scene.emission_towards(hit, wo, wl)
+        };
         if le != Spectrum::ZERO {
             self.without_last_merge.arrive(d2, cos_in);
             let weight = vcm.emitter_weight(hit, &self.without_last_merge, previous, wo, d2, length);
@@ -92,7 +105,7 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
             self.first_focused = vcm.focus.contains(hit.point);
         }
         if bsdf.is_smooth() {
-            let merges_here = !self.smooth_before;
+            let merges_here = !self.smooth_before && !hit.is_in_medium();
             let v = CameraVertex {
                 hit,
                 bsdf,
@@ -123,8 +136,8 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
     fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
         let (f, bsdf, wo, length) = (&self.pass.factors, at.bsdf, at.wo, at.length);
         let sample = bsdf.sample(wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?;
-        let merges_here = bsdf.is_smooth() && !self.smooth_before;
-        let cos_out = bsdf.normal().dot(sample.wi).abs();
+        let merges_here = bsdf.is_smooth() && !self.smooth_before && !at.hit.is_in_medium();
+        let cos_out = bsdf.cos(sample.wi);
         self.smooth_before |= !sample.specular;
         if sample.specular {
             self.partial.scatter_specular(cos_out);
@@ -144,6 +157,8 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
             self.without_last_merge.scatter(f, sample.pdf, reverse, cos_out, false);
             if length == 1 {
                 self.without_first_merge = self.without_last_merge;
+            }
+            if length == 1 && !at.hit.is_in_medium() {
                 // An emitter hit next is direct light at the first vertex: no light tracing
                 // there either (its term is the sum's first at the eye's first vertex).
                 self.without_last_merge = Partial {
@@ -302,7 +317,7 @@ impl<'a> Vcm<'a> {
                     if value == Spectrum::ZERO {
                         continue;
                     }
-                    let cos_here = v.bsdf.normal().dot(s.wi).abs();
+                    let cos_here = v.bsdf.cos(s.wi);
                     let pdfs = DirectPdfs {
                         bsdf: v.bsdf.pdf(v.wo, s.wi),
                         bsdf_reverse: self.light_pdf(v.bsdf, v.hit.point, v.wo, v.bsdf.pdf_reverse(v.wo, s.wi)),
@@ -314,8 +329,9 @@ impl<'a> Vcm<'a> {
                         delta: s.delta,
                     };
                     // Light reaches this vertex first: merging is no strategy here, and light
-                    // tracing none either if it is the eye's first (the sum's first term there).
-                    let camera = if v.length == 1 {
+                    // tracing none either if it is the eye's first on a surface (the sum's first
+                    // term there).
+                    let camera = if v.length == 1 && !v.hit.is_in_medium() {
                         Partial { vcm: 0.0, ..v.partial }
                     } else {
                         v.partial
@@ -331,7 +347,7 @@ impl<'a> Vcm<'a> {
                 } else {
                     1.0
                 };
-                l += v.throughput * value * s.contribution * (v.bsdf.normal().dot(s.wi).abs() * weight);
+                l += v.throughput * value * s.contribution * (v.bsdf.cos(s.wi) * weight);
             }
         };
         if lights.samples_every_light() {
@@ -370,13 +386,13 @@ impl<'a> Vcm<'a> {
         if camera_f == Spectrum::ZERO {
             return Spectrum::ZERO;
         }
-        let light_bsdf = Bsdf::at(self.scene, &z.hit, z.wo, wl);
+        let light_bsdf = self.vertex_bsdf(&z.hit, z.wo, wl);
         let light_f = light_bsdf.eval_in(z.wo, -dir, Transport::Importance);
         if light_f == Spectrum::ZERO {
             return Spectrum::ZERO;
         }
-        let cos_camera = v.bsdf.normal().dot(dir).abs();
-        let cos_light = light_bsdf.normal().dot(dir).abs();
+        let cos_camera = v.bsdf.cos(dir);
+        let cos_light = light_bsdf.cos(dir);
         let pdfs = ConnectionPdfs {
             camera_to_light: v.bsdf.pdf(v.wo, dir) * cos_light / d2,
             camera_reverse: self.light_pdf(v.bsdf, v.hit.point, v.wo, v.bsdf.pdf_reverse(v.wo, dir)),
@@ -393,7 +409,7 @@ impl<'a> Vcm<'a> {
             return Spectrum::ZERO;
         }
         let g = cos_camera * cos_light / d2;
-        // Two vertices inside one rough glass: the connection pays its absorption.
+        // The media between the two (fog, or the inside of one rough glass) take their share.
         let inside = if self.scene.has_media() {
             self.scene.transmittance_towards(v.hit, dir, d2.sqrt(), wl, rng)
         } else {
@@ -405,6 +421,18 @@ impl<'a> Vcm<'a> {
             * z.throughput
             * inside
             * (g * weight * both_dispersed(v.dispersed, z.dispersed))
+    }
+}
+
+impl Vcm<'_> {
+    /// The lobes of a stored vertex seen from `wo`: a surface's BSDF, or the phase function of
+    /// the medium a scattering point is in.
+    pub(super) fn vertex_bsdf(&self, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Bsdf {
+        if hit.is_in_medium() {
+            Bsdf::phase(self.scene.medium(hit.media.back).phase.g, wo, wl)
+        } else {
+            Bsdf::at(self.scene, hit, wo, wl)
+        }
     }
 }
 

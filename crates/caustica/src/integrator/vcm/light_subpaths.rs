@@ -3,6 +3,10 @@
 //! off Lambertian surfaces aimed at the mirrors and glass.
 
 use super::*;
+use crate::photon::light_walk::MediumArrival;
+
+/// Mixed into the seed of the streams joins to the eye draw from.
+const EYE_SEED: u64 = 0x6579_6573_7663_6d21;
 
 impl<'a> Vcm<'a> {
     /// Traces light subpath `index` of pass `pass`: stores its smooth vertices and joins each
@@ -26,6 +30,7 @@ impl<'a> Vcm<'a> {
             previous: emission.ray.origin,
             start: emission.throughput.max_element(),
             all_specular: true,
+            eye_rng: Rng::new(self.seed ^ EYE_SEED, (pass << 40) ^ index),
         };
         let surfaces = self.max_length.saturating_sub(1);
         let rays = walk_light(
@@ -41,9 +46,17 @@ impl<'a> Vcm<'a> {
     }
 
     /// Light tracing: the light vertex seen by the eye, splatted onto its pixel.
-    fn trace_to_eye(&self, v: &LightVertex, bsdf: &Bsdf, f: &Factors, wl: &Wavelengths, splats: &mut Vec<(u32, Vec3)>) {
-        // Direct light is the camera strategies' (see the module's notes).
-        if v.length == 1 || v.length + 1 > self.max_length {
+    fn trace_to_eye(
+        &self,
+        v: &LightVertex,
+        bsdf: &Bsdf,
+        (f, wl): (&Factors, &Wavelengths),
+        rng: &mut Rng,
+        splats: &mut Vec<(u32, Vec3)>,
+    ) {
+        // Direct light on surfaces is the camera strategies' (see the module's notes); in a
+        // medium, where a camera ray rarely stops inside a thin beam, light tracing shares it.
+        if (v.length == 1 && !v.hit.is_in_medium()) || v.length + 1 > self.max_length {
             return;
         }
         let Some(s) = self.sensor.sample(v.hit.point) else {
@@ -55,21 +68,31 @@ impl<'a> Vcm<'a> {
         }
         let (ns, ng) = (v.hit.shading_normal, v.hit.geometric_normal);
         let wo_ng = v.wo.dot(ng).abs();
-        if wo_ng <= 0.0 || !self.scene.unoccluded(&v.hit, s.to_eye, s.distance) {
+        let medium = bsdf.is_phase();
+        if (wo_ng <= 0.0 && !medium) || !self.scene.unoccluded(&v.hit, s.to_eye, s.distance) {
             return;
         }
         let inv_d2 = 1.0 / (s.distance * s.distance);
-        // The adjoint BSDF's shading-normal correction, as in light tracing.
-        let cos = s.to_eye.dot(ng).abs() * v.wo.dot(ns).abs() / wo_ng;
-        let camera_pdf = s.importance * bsdf.normal().dot(s.to_eye).abs() * inv_d2;
+        // The adjoint BSDF's shading-normal correction, as in light tracing (none in a medium).
+        let cos = if medium {
+            1.0
+        } else {
+            s.to_eye.dot(ng).abs() * v.wo.dot(ns).abs() / wo_ng
+        };
+        let camera_pdf = s.importance * bsdf.cos(s.to_eye) * inv_d2;
         let weight = mis::light_tracing(
             f,
             &v.partial,
             camera_pdf,
             bsdf.pdf_reverse(v.wo, s.to_eye),
-            v.length > 1 && !(v.direct_caustic && self.focus.contains(v.hit.point)),
+            v.length > 1 && !medium && !(v.direct_caustic && self.focus.contains(v.hit.point)),
         );
-        let splat = v.throughput * value * (cos * inv_d2 * s.importance * weight / f.light_paths);
+        let kept = if self.scene.has_media() {
+            self.scene.transmittance_towards(&v.hit, s.to_eye, s.distance, wl, rng)
+        } else {
+            Spectrum::ONE
+        };
+        let splat = v.throughput * value * kept * (cos * inv_d2 * s.importance * weight / f.light_paths);
         let rgb = wl.to_rgb(splat);
         if rgb.is_finite() {
             splats.push((s.pixel as u32, rgb));
@@ -145,12 +168,21 @@ struct Subpath<'v, 'a> {
     start: f32,
     /// Only mirrors and glass so far.
     all_specular: bool,
+    /// What joins to the eye draw from (the transmittance of a density grid).
+    eye_rng: Rng,
 }
 
 impl LightVisitor for Subpath<'_, '_> {
-    // Not reached: vcm refuses scenes whose media scatter (`RenderSession::new`).
-    fn visit_medium(&mut self, _at: &crate::photon::light_walk::MediumArrival) -> bool {
-        false
+    // A scattering point is a smooth vertex whose lobes are the phase function: stored for
+    // connections and joined to the eye, but not merged (see the camera side).
+    fn visit_medium(&mut self, at: &MediumArrival) -> bool {
+        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
+        self.visit(&at.as_light_arrival(&bsdf))
+    }
+
+    fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<(BsdfSample, Roulette)> {
+        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
+        self.bounce(&at.as_light_arrival(&bsdf), rng)
     }
 
     fn visit(&mut self, at: &LightArrival) -> bool {
@@ -170,7 +202,7 @@ impl LightVisitor for Subpath<'_, '_> {
         };
         self.previous = hit.point;
         let partial = &mut self.partial;
-        partial.arrive(d2, bsdf.normal().dot(wo).abs());
+        partial.arrive(d2, bsdf.cos(wo));
         if !vcm.settings.connections && length > 1 {
             // The sum's first term stands for a connection that makes this vertex.
             partial.vcm = 0.0;
@@ -189,10 +221,11 @@ impl LightVisitor for Subpath<'_, '_> {
             if self.to_eye {
                 // Direct light is not traced to the eye (see trace_to_eye).
                 self.out.rays += u64::from(length > 1);
-                vcm.trace_to_eye(&vertex, bsdf, f, self.wl, &mut self.out.splats);
+                vcm.trace_to_eye(&vertex, bsdf, (f, self.wl), &mut self.eye_rng, &mut self.out.splats);
             }
-            // Light reaching a vertex first is never merged (see the module's notes).
-            if length > 1 {
+            // Light reaching a vertex first is never merged (see the module's notes), nor light
+            // in a medium.
+            if length > 1 && !hit.is_in_medium() {
                 self.out.merge_points.push(hit.point);
                 self.out.merge_vertices.push(MergeVertex {
                     wo,
@@ -217,7 +250,7 @@ impl LightVisitor for Subpath<'_, '_> {
         let (bsdf, wo) = (at.bsdf, at.wo);
         let aim = self.vcm.bounce_aim.as_ref().filter(|_| bsdf.is_lambertian());
         let (sample, towards_target) = light_bounce(bsdf, at.hit.point, wo, aim, rng)?;
-        let cos_out = bsdf.normal().dot(sample.wi).abs();
+        let cos_out = bsdf.cos(sample.wi);
         if sample.specular {
             self.partial.scatter_specular(cos_out);
         } else {
