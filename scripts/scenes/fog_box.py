@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Writes scenes/fog_box.pbrt: a Cornell box filled with thin fog, a glass ball hanging in it and
 a spot light above shining down through the ball, which focuses its light into a bright beam in
-the fog and a caustic on the floor. Light tracing (`lt`) renders the beam; a path tracer cannot
-reach a spot light through glass. `--area` puts a small square lamp in place of the spot (the
+the fog and a caustic on the floor. vcm and light tracing (`lt`) render the beam; a path tracer
+cannot reach a spot light through glass. `--area` puts a small square lamp in place of the spot (the
 scene an independent volumetric path tracer can render too).
 
     scripts/scenes/fog_box.py [--area] [OUT]
@@ -35,7 +35,7 @@ AttributeEnd"""
     )
     return f"""# pbrt-v4, written by scripts/scenes/fog_box.py: a Cornell box of thin fog, a glass ball and
 # {'a small square lamp' if area else 'a spot light'} above it; the ball focuses the light into a beam in the fog.
-#   caustica render scenes/fog_box{'_area' if area else ''}.pbrt --integrator {'path' if area else 'lt'}
+#   caustica render scenes/fog_box{'_area' if area else ''}.pbrt   (bdpt: caustica renders it with vcm)
 LookAt {' '.join(map(str, EYE))}   {' '.join(map(str, TARGET))}   0 1 0
 MakeNamedMedium "fog" "string type" "homogeneous"
     "rgb sigma_a" [{SIGMA_A} {SIGMA_A} {SIGMA_A}] "rgb sigma_s" [{SIGMA_S} {SIGMA_S} {SIGMA_S}] "float g" [{G}]
@@ -43,7 +43,7 @@ MediumInterface "" "fog"
 Camera "perspective" "float fov" [{FOV}]
 Film "rgb" "integer xresolution" [{WIDTH}] "integer yresolution" [{HEIGHT}]
     "string filename" "fog_box{'_area' if area else ''}.png"
-Integrator "{'volpath' if area else 'lightpath'}" "integer maxdepth" [20]
+Integrator "bdpt" "integer maxdepth" [20]
 WorldBegin
 {light}
 # The box: white floor, ceiling and back, red left and green right walls, open at the front.

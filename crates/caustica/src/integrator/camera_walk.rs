@@ -32,6 +32,29 @@ pub struct CameraArrival<'a> {
     pub length: u32,
 }
 
+/// What a visitor that treats a scattering point as any smooth vertex does there: `visit` it as
+/// a surface whose lobes are the phase function.
+pub fn visit_as_surface<V: CameraVisitor>(
+    visitor: &mut V,
+    at: &MediumArrival,
+    wl: &Wavelengths,
+    rng: &mut Rng,
+) -> bool {
+    let bsdf = Bsdf::phase(at.phase.g, at.wo, wl);
+    visitor.visit(&CameraArrival::in_medium(at, &bsdf), rng)
+}
+
+/// [`visit_as_surface`]'s bounce: the visitor's own, through the phase function's lobes.
+pub fn bounce_as_surface<V: CameraVisitor>(
+    visitor: &mut V,
+    at: &MediumArrival,
+    wl: &Wavelengths,
+    rng: &mut Rng,
+) -> Option<BsdfSample> {
+    let bsdf = Bsdf::phase(at.phase.g, at.wo, wl);
+    visitor.bounce(&CameraArrival::in_medium(at, &bsdf), rng)
+}
+
 impl<'a> CameraArrival<'a> {
     /// A scattering point as an arrival whose lobes are `bsdf` (its phase function, for users
     /// that treat it as any smooth vertex).

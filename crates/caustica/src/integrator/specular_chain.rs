@@ -1,7 +1,7 @@
 //! The camera paths of the photon-mapping integrators: a camera ray followed through mirrors,
 //! glass and (for `ppm`) sharp highlights to the smooth surfaces where photons are gathered.
 
-use super::camera_walk::{walk_camera, CameraArrival, CameraVisitor};
+use super::camera_walk::{bounce_as_surface, visit_as_surface, walk_camera, CameraArrival, CameraVisitor};
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
 use crate::photon::light_walk::MediumArrival;
@@ -118,13 +118,13 @@ where
     // A scattering point is a smooth vertex whose lobes are the phase function: the chain
     // gathers there and ends.
     fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool {
-        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
-        self.visit(&CameraArrival::in_medium(at, &bsdf), rng)
+        let wl = self.wl;
+        visit_as_surface(self, at, wl, rng)
     }
 
     fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<BsdfSample> {
-        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
-        self.bounce(&CameraArrival::in_medium(at, &bsdf), rng)
+        let wl = self.wl;
+        bounce_as_surface(self, at, wl, rng)
     }
 
     fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {

@@ -42,7 +42,7 @@ pub mod mis;
 mod pilots;
 mod settings;
 
-use super::camera_walk::{walk_camera, CameraArrival, CameraVisitor};
+use super::camera_walk::{bounce_as_surface, visit_as_surface, walk_camera, CameraArrival, CameraVisitor};
 use super::lt::Sensor;
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{radius_factor, InitialRadius};

@@ -40,6 +40,25 @@ fn render(scene: &Scene, integrator: &str, size: usize, passes: u64, photons: us
     render_with(scene, &config)
 }
 
+/// A lamp of radiance 1 at z = −1 behind a slab 4 × 4 × 0.5 (z from 0 to 0.5) that holds
+/// `medium`, bounded by `interface` faces.
+fn lamp_behind_slab(medium: &str) -> String {
+    format!(
+        r#"AttributeBegin
+          AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
+          Shape "bilinearmesh" "point3 P" [-4 -4 -1  4 -4 -1  -4 4 -1  4 4 -1]
+        AttributeEnd
+        AttributeBegin
+          MediumInterface "{medium}" ""
+          Material "interface"
+          Translate 0 0 0.25
+          Scale 2 2 0.25
+          Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1]
+            "integer indices" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  2 3 7 2 7 6  1 2 6 1 6 5  0 4 7 0 7 3]
+        AttributeEnd"#
+    )
+}
+
 fn mean(film: &Film) -> Vec3 {
     film.region_mean((0, film.height), (0, film.width))
 }
@@ -54,19 +73,11 @@ fn a_lamp_through_an_absorbing_slab_keeps_exp_minus_sigma_d() {
         Camera "perspective" "float fov" 6
         WorldBegin
         MakeNamedMedium "ink" "string type" "homogeneous" "rgb sigma_a" [{} {} {}] "rgb sigma_s" [0 0 0]
-        AttributeBegin
-          AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
-          Shape "bilinearmesh" "point3 P" [-4 -4 -1  4 -4 -1  -4 4 -1  4 4 -1]
-        AttributeEnd
-        AttributeBegin
-          MediumInterface "ink" ""
-          Material "interface"
-          Translate 0 0 0.25
-          Scale 2 2 0.25
-          Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1]
-            "integer indices" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  2 3 7 2 7 6  1 2 6 1 6 5  0 4 7 0 7 3]
-        AttributeEnd"#,
-        sigma.x, sigma.y, sigma.z
+        {}"#,
+        sigma.x,
+        sigma.y,
+        sigma.z,
+        lamp_behind_slab("ink")
     ));
     let expected = (-sigma * 0.5).exp();
     for (integrator, passes, photons) in [
@@ -104,22 +115,12 @@ fn a_lamp_through_a_density_grid_keeps_exp_minus_its_optical_depth() {
         MakeNamedMedium "smoke" "string type" "uniformgrid" "rgb sigma_a" [{} {} {}] "rgb sigma_s" [0 0 0]
             "integer nx" 2 "integer ny" 2 "integer nz" 4 "float density" [{}]
             "point3 p0" [-2 -2 0] "point3 p1" [2 2 0.5]
-        AttributeBegin
-          AreaLightSource "diffuse" "rgb L" [1 1 1] "bool twosided" true
-          Shape "bilinearmesh" "point3 P" [-4 -4 -1  4 -4 -1  -4 4 -1  4 4 -1]
-        AttributeEnd
-        AttributeBegin
-          MediumInterface "smoke" ""
-          Material "interface"
-          Translate 0 0 0.25
-          Scale 2 2 0.25
-          Shape "trianglemesh" "point3 P" [-1 -1 -1  1 -1 -1  1 1 -1  -1 1 -1  -1 -1 1  1 -1 1  1 1 1  -1 1 1]
-            "integer indices" [0 2 1 0 3 2  4 5 6 4 6 7  0 1 5 0 5 4  2 3 7 2 7 6  1 2 6 1 6 5  0 4 7 0 7 3]
-        AttributeEnd"#,
+        {}"#,
         sigma.x,
         sigma.y,
         sigma.z,
-        values.join(" ")
+        values.join(" "),
+        lamp_behind_slab("smoke")
     ));
     // The density at u in [0, 1] across the slab.
     let density = |u: f32| {

@@ -54,13 +54,13 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
     // next-event estimation and connections as a surface does, but never merges (merging's
     // kernel is a disc on a surface).
     fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool {
-        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
-        self.visit(&CameraArrival::in_medium(at, &bsdf), rng)
+        let wl = self.wl;
+        visit_as_surface(self, at, wl, rng)
     }
 
     fn bounce_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> Option<BsdfSample> {
-        let bsdf = Bsdf::phase(at.phase.g, at.wo, self.wl);
-        self.bounce(&CameraArrival::in_medium(at, &bsdf), rng)
+        let wl = self.wl;
+        bounce_as_surface(self, at, wl, rng)
     }
 
     fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
