@@ -1,6 +1,9 @@
 #!/usr/bin/env python3
 """Writes scenes/pool.ray: a swimming pool under the sun and a blue sky, whose wavy water
 surface (a smooth-normal mesh) focuses sunlight into a caustic net on the tiled floor.
+`--murky` writes scenes/pool_murky.ray instead: the same pool of slightly murky water (a medium
+that scatters, forward) seen by a camera under water, where the waves' focused sunlight shows
+as shafts through the water.
 
 The waves are a sum of sines chosen so that their curvature focuses near the floor: a wave
 of amplitude a and wavelength L has peak curvature a(2π/L)², and a water lens of curvature k
@@ -38,6 +41,8 @@ def box(x0, y0, z0, x1, y1, z1, material):
 
 
 def main():
+    murky = "--murky" in sys.argv[1:]
+    args = [a for a in sys.argv[1:] if a != "--murky"]
     light_tile = "{ diffuse = (0.75, 0.85, 0.9); ambient = (0.75, 0.85, 0.9); }"
     dark_tile = "{ diffuse = (0.3, 0.55, 0.72); ambient = (0.3, 0.55, 0.72); }"
     grout = "{ diffuse = (0.55, 0.6, 0.62); ambient = (0.55, 0.6, 0.62); }"
@@ -50,10 +55,10 @@ def main():
         "// Written by scripts/scenes/pool.py; edit that instead.",
         "",
         "camera {",
-        "\tposition = (0, -9.5, 6.5);",
-        "\tviewdir = (0, 0.8, -0.62);",
+        "\tposition = (0, -3.7, -1.3);" if murky else "\tposition = (0, -9.5, 6.5);",
+        "\tviewdir = (0, 1, 0.12);" if murky else "\tviewdir = (0, 0.8, -0.62);",
         "\tupdir = (0, 0, 1);",
-        "\tfov = 50;",
+        "\tfov = 75;" if murky else "\tfov = 50;",
         "}",
         "",
         "sun_light { direction = (0.25, 0.35, -1); color = (1.0, 0.97, 0.9); angle = 0.53; }",
@@ -99,16 +104,20 @@ def main():
             a = j * n + i
             faces.append(f"({a},{a + 1},{a + n + 1})")
             faces.append(f"({a},{a + n + 1},{a + n})")
+    # Murky water: it scatters a little, mostly forward, and absorbs red most.
+    medium = " scattering = (0.05, 0.06, 0.06); absorption = (0.12, 0.04, 0.03); phase = 0.7;" if murky else ""
     lines += [
-        "// the water: index 1.33, slightly blue",
+        "// the water: index 1.33, slightly blue" + (", murky: it scatters sunlight into shafts" if murky else ""),
         "polymesh {",
-        "\tmaterial = { transmissive = (0.88, 0.95, 0.98); index = 1.33; specular = (0.3, 0.3, 0.3); shininess = 128; };",
+        "\tmaterial = { transmissive = (0.88, 0.95, 0.98); index = 1.33; specular = (0.3, 0.3, 0.3); shininess = 128;"
+        + medium + " };",
         "\tgennormals;",
         "\tpoints = (" + ",".join(points) + ");",
         "\tfaces = (" + ",".join(faces) + ");",
         "}",
     ]
-    out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "scenes" / "pool.ray"
+    name = "pool_murky.ray" if murky else "pool.ray"
+    out = Path(args[0]) if args else Path(__file__).resolve().parents[2] / "scenes" / name
     out.write_text("\n".join(lines) + "\n")
 
 

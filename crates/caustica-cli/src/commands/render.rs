@@ -29,14 +29,19 @@ use summary::{physical_notes, preview_json, summary_line};
 /// Runs the command; returns the exit code.
 pub fn run(args: RenderArgs, cancel: &'static AtomicBool) -> Result<u8> {
     let start = Instant::now();
-    // Options are checked before the scene is read (physical formats assumed physical, and
-    // `.ray` files too, which a medium makes physical), then again with the scene's own
-    // settings.
+    // Options are checked before the scene is read (physical formats assumed physical, and a
+    // `.ray` file given passes too, which a medium in it makes physical), then again with the
+    // scene's own settings.
     let format = super::load_settings(&args.scene_args)?;
-    let physical_format = args
-        .scene
-        .as_deref()
-        .is_some_and(|p| matches!(format.read.format_of(p), Format::Pbrt | Format::Gltf | Format::Ray));
+    let passes_given = {
+        let p = &args.progressive;
+        p.passes.is_some() || p.time.is_some() || p.partial.is_some()
+    };
+    let physical_format = args.scene.as_deref().is_some_and(|p| match format.read.format_of(p) {
+        Format::Pbrt | Format::Gltf => true,
+        Format::Ray => passes_given,
+        _ => false,
+    });
     let early = RenderHints {
         physical: physical_format,
         ..RenderHints::default()
