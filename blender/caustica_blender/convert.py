@@ -42,6 +42,8 @@ class Conversion:
         self.pixel_cache = {}
         self.shapes = []
         self.lights = []
+        # Participating media by name: materials' and the world's Volume shaders.
+        self.media = {}
 
     def warn(self, message):
         if message not in self.warnings:
@@ -62,6 +64,11 @@ class Conversion:
             "shapes": self.shapes,
             "lights": self.lights + self.world(),
         }
+        world_medium = self.world_volume()
+        if world_medium is not None:
+            description["medium"] = world_medium
+        if self.media:
+            description["media"] = self.media
         return description
 
     # ---- the camera -------------------------------------------------------------------------
@@ -195,13 +202,74 @@ class Conversion:
         )
         link = output.inputs["Surface"].links[0] if output and output.inputs["Surface"].is_linked else None
         node = link.from_node if link else None
+        volume = self.volume(output, f"material {name}") if output is not None else None
+        if volume is not None:
+            self.media[name] = volume
+        if node is None and volume is not None:
+            # Only a volume: Cycles' surface is then invisible, the medium's boundary.
+            self.materials[name] = {"type": "boundary", "inside": name}
+            return name
         shader = self.shader(node, name)
         if node is not None:
             normal_map = self.normal_map(node, name)
             if normal_map is not None:
                 shader["normal_map"] = normal_map
+        if volume is not None:
+            shader["inside"] = name
         self.materials[name] = shader
         return name
+
+    # ---- volumes ----------------------------------------------------------------------------
+
+    def volume(self, output, what):
+        """The medium an output node's Volume socket holds, as Cycles reads it: Volume Scatter
+        (σs = colour × density, g = anisotropy), Volume Absorption (σa = (1 − colour) × density)
+        and an Add shader of them; None when nothing is linked (or, with a warning, what is not
+        read)."""
+        socket = output.inputs.get("Volume")
+        if socket is None or not socket.is_linked:
+            return None
+        medium = {"absorption": [0.0] * 3, "scattering": [0.0] * 3, "g": 0.0}
+        if not self.add_volume(socket.links[0].from_node, medium, what):
+            return None
+        return medium
+
+    def add_volume(self, node, medium, what):
+        """Adds the volume shader `node` to `medium`; False (with a warning) if it is not read."""
+        def constant(name):
+            socket = node.inputs[name]
+            if socket.is_linked:
+                self.warn(f"{what}: the volume's {name} from a node link is read by the input's own value")
+            value = socket.default_value
+            return np.array(value[:3], dtype=np.float64) if hasattr(value, "__len__") else float(value)
+
+        if node.type == "ADD_SHADER":
+            return all(
+                s.is_linked and self.add_volume(s.links[0].from_node, medium, what) for s in node.inputs[:2]
+            )
+        if node.type == "VOLUME_SCATTER":
+            sigma = np.clip(constant("Color"), 0.0, None) * max(constant("Density"), 0.0)
+            medium["scattering"] = list(np.array(medium["scattering"]) + sigma)
+            medium["g"] = float(np.clip(constant("Anisotropy"), -0.99, 0.99))
+            return True
+        if node.type == "VOLUME_ABSORPTION":
+            sigma = np.clip(1.0 - constant("Color"), 0.0, None) * max(constant("Density"), 0.0)
+            medium["absorption"] = list(np.array(medium["absorption"]) + sigma)
+            return True
+        self.warn(f"{what}: the {node.name} volume node is not read: no medium")
+        return False
+
+    def world_volume(self):
+        """The world's Volume shader as the medium that fills the scene (its name), or None."""
+        world = self.scene.world
+        if world is None or not world.use_nodes or world.node_tree is None:
+            return None
+        output = next((n for n in world.node_tree.nodes if n.type == "OUTPUT_WORLD" and n.is_active_output), None)
+        volume = self.volume(output, "world") if output is not None else None
+        if volume is None:
+            return None
+        self.media["(world)"] = volume
+        return "(world)"
 
     def image_file(self, image):
         """A file holding `image`: its own, or a copy of its packed bytes."""
