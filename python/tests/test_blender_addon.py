@@ -27,7 +27,7 @@ import bpy
 sys.path.insert(0, ADDONS)
 sys.path.insert(0, SCENES)
 import caustica_blender
-from blender_build import add_light, camera, grey_floor
+from blender_build import add_light, camera, grey_floor, white_world
 caustica_blender.register()
 
 
@@ -285,10 +285,7 @@ MATERIALS = r"""
 def plane_scene(setup):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
-    world = bpy.data.worlds.new("World")
-    world.use_nodes = True
-    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-    scene.world = world
+    white_world(scene)
     bpy.ops.mesh.primitive_plane_add(size=40.0)
     m = bpy.data.materials.new("M")
     m.use_nodes = True
@@ -525,10 +522,7 @@ def test_principled_alpha_coat_textures_add_shader_and_shared_meshes_read_as_ble
 VOLUMES = r"""
 bpy.ops.wm.read_factory_settings(use_empty=True)
 scene = bpy.context.scene
-world = bpy.data.worlds.new("World")
-world.use_nodes = True
-world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
-scene.world = world
+white_world(scene)
 grey_floor(20.0)
 bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.0, 0.0, 1.1))
 fog = bpy.data.materials.new("Fog")

@@ -16,6 +16,14 @@ def grey_floor(size, grey=0.5):
     return bpy.context.object
 
 
+def white_world(scene):
+    """A world of uniform radiance 1 (a white furnace's sky)."""
+    world = bpy.data.worlds.new("World")
+    world.use_nodes = True
+    world.node_tree.nodes["Background"].inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)
+    scene.world = world
+
+
 def add_light(scene, kind, location=(0.0, 0.0, 3.0), name=None, **props):
     """A light of Blender's type `kind` (POINT, SPOT, SUN, AREA) with `props` set, at
     `location`."""

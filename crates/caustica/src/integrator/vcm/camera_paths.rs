@@ -71,11 +71,7 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
         self.previous = hit.point;
         let cos_in = bsdf.cos(wo);
         self.partial.arrive(d2, cos_in);
-        let le = if hit.is_in_medium() {
-            Spectrum::ZERO
-        } else {
-            vcm.scene.emission_towards(hit, wo, wl)
-        };
+        let le = crate::integrator::direct::emitted(vcm.scene, hit, wo, wl);
         if le != Spectrum::ZERO {
             self.without_last_merge.arrive(d2, cos_in);
             let weight = vcm.emitter_weight(hit, &self.without_last_merge, previous, wo, d2, length);
