@@ -42,6 +42,7 @@ class RenderOptions(TypedDict, total=False):
     alpha: float
     no_camera_specular: bool
     vertex_connections: bool
+    no_beams: bool
     spectral: bool | None
     no_spectral: bool
     cone_quirks: bool

@@ -12,7 +12,7 @@ left-handed (world −x on the image's right here) and Mitsuba's `look_at` right
 Mitsuba's image is mirrored left to right before it is compared.
 
     scripts/race/fog_box.py [--spp 16384] [--time 16] [--integrators vcm,path,lt,ppm] [--reuse]
-    scripts/race/fog_box.py --reuse --race [--budgets 4,16] [--seeds 4]
+    scripts/race/fog_box.py --reuse --race [--budgets 4,16] [--seeds 4] [--second-spp 8192]
 
 Writes target/fog_box/{mitsuba,<integrator>}.exr and prints a table. `--race` instead renders
 every integrator and Mitsuba's volpath (passes of 4 spp until the budget) on one core at each
@@ -49,12 +49,12 @@ def region_means(img):
     return {n: float(img[r0:r1, c0:c1, :3].mean()) for n, ((r0, r1), (c0, c1)) in REGIONS.items()}
 
 
-def mitsuba(spp, threads, out):
+def mitsuba(spp, threads, out, seed=0):
     import mitsuba as mi, drjit as dr
     scene = load_mitsuba_scene(spp)
     dr.set_thread_count(threads)
     t0 = time.time()
-    img = mi.render(scene, spp=spp)
+    img = mi.render(scene, spp=spp, seed=seed)
     arr = np.ascontiguousarray(np.array(img)[:, ::-1])
     secs = time.time() - t0
     mi.Bitmap(arr).write(out)
@@ -146,22 +146,37 @@ def read_exr(path):
     return np.array(mi.Bitmap(path).convert(mi.Bitmap.PixelFormat.RGB, mi.Struct.Type.Float32))
 
 
-def errors(img, ref):
-    """Relative RMS error of the image without the lamp (pixels the reference sees above 2: the
-    lamp, its edges and its image in the ball, whose coverage noise at radiance 60 would
-    outweigh everything else), and of the beam; and the beam mean's error."""
+def errors(img, ref, ref_var=None):
+    """Relative RMS error of the image without the lamp (pixels the reference sees above 2 and
+    those within two pixels of them: the lamp, its edges and its image in the ball, whose
+    coverage noise at radiance 60 would outweigh everything else), and of the beam; the beam mean's error; and with `ref_var` (the
+    reference's own variance per pixel) the beam's error against the truth: its squared error
+    less what the reference's noise adds to it (an unbiased estimate, as the two are
+    independent)."""
     (r0, r1), (c0, c1) = REGIONS['beam']
-    keep = ref.max(axis=2) <= 2.0
+    lamp = ref.max(axis=2) > 2.0
+    near = np.zeros_like(lamp)
+    for dy in range(-2, 3):
+        for dx in range(-2, 3):
+            near |= np.roll(np.roll(lamp, dy, axis=0), dx, axis=1)
+    keep = ~near
     whole = math.sqrt(float(((img - ref) ** 2)[keep].mean())) / float(ref[keep].mean())
     b, rb = img[r0:r1, c0:c1], ref[r0:r1, c0:c1]
-    beam = math.sqrt(float(((b - rb) ** 2).mean())) / float(rb.mean())
-    return whole, beam, abs(float(b.mean()) / float(rb.mean()) - 1)
+    mse = float(((b - rb) ** 2).mean())
+    beam = math.sqrt(mse) / float(rb.mean())
+    truth = float('nan')
+    if ref_var is not None:
+        # Negative when the estimate falls below zero (noise in the noise): shown with its sign.
+        left = mse - float(ref_var[r0:r1, c0:c1].mean())
+        truth = math.copysign(math.sqrt(abs(left)), left) / float(rb.mean())
+    return whole, beam, abs(float(b.mean()) / float(rb.mean()) - 1), truth
 
 
-def race(ref, scene, out, budgets, seeds, integrators, score_only):
+def race(ref, scene, out, budgets, seeds, integrators, score_only, ref_var=None):
     """Renders (or with `score_only` reads) each renderer's image at each budget and seed."""
-    print('| renderer | budget | image rel. RMSE (no lamp) | beam rel. RMSE | beam mean error | passes |')
-    print('|---|---:|---:|---:|---:|---:|')
+    print('| renderer | budget | image rel. RMSE (no lamp) | beam rel. RMSE | beam mean error | '
+          'beam rel. RMSE, reference noise removed | passes |')
+    print('|---|---:|---:|---:|---:|---:|---:|')
     for budget in budgets:
         for who in ['mi-volpath'] + [f'cs-{i}' for i in integrators]:
             errs, work = [], []
@@ -178,10 +193,10 @@ def race(ref, scene, out, budgets, seeds, integrators, score_only):
                     summary = caustica(who[3:], scene, budget, path, seed)
                     work.append(str(summary['passes']))
                 img = read_exr(path)
-                errs.append(errors(img[:, :, :3], ref[:, :, :3]))
+                errs.append(errors(img[:, :, :3], ref[:, :, :3], ref_var))
             e = np.mean(np.array(errs), axis=0)
-            print(f'| {who} | {budget:g} s | {e[0]:.4f} | {e[1]:.4f} | {100 * e[2]:.2f}% | {", ".join(work)} |',
-                  flush=True)
+            print(f'| {who} | {budget:g} s | {e[0]:.4f} | {e[1]:.4f} | {100 * e[2]:.2f}% | {e[3]:.4f} | '
+                  f'{", ".join(work)} |', flush=True)
 
 
 def main():
@@ -195,6 +210,9 @@ def main():
     ap.add_argument('--seeds', type=int, default=4)
     ap.add_argument('--score-only', action='store_true', help="score the race's images an earlier run wrote")
     ap.add_argument('--reuse', action='store_true', help="read the reference an earlier run wrote")
+    ap.add_argument('--second-spp', type=int, default=0,
+                    help="also render (or with --reuse read) an independent second reference of this many spp: "
+                         "the two give the first one's noise, which --race then takes out of the beam's error")
     ap.add_argument('--out', default=os.path.join(REPO, 'target', 'fog_box'))
     a = ap.parse_args()
     os.makedirs(a.out, exist_ok=True)
@@ -207,9 +225,19 @@ def main():
     else:
         ref, secs, variant = mitsuba(a.spp, a.threads, ref_path)
         budget = f'{a.spp} spp, {secs:.0f} s on {a.threads} threads ({variant})'
+    ref_var = None
+    if a.second_spp:
+        second_path = os.path.join(a.out, f'mitsuba_second_{a.second_spp}.exr')
+        if a.reuse and os.path.exists(second_path):
+            second = read_exr(second_path)
+        else:
+            second, secs, _ = mitsuba(a.second_spp, a.threads, second_path, seed=1)
+            print(f'second reference: {a.second_spp} spp in {secs:.0f} s')
+        # E[(A − B)²] = Var A + Var B, and Var B = Var A · spp_A / spp_B.
+        ref_var = (ref[:, :, :3] - second[:, :, :3]) ** 2 / (1 + a.spp / a.second_spp)
     if a.race:
         race(ref, scene, a.out, [float(b) for b in a.budgets.split(',')], a.seeds,
-             list(filter(None, a.integrators.split(','))), a.score_only)
+             list(filter(None, a.integrators.split(','))), a.score_only, ref_var)
         return
     rows = [('mitsuba volpath', budget, region_means(ref))]
     for integ in filter(None, a.integrators.split(',')):

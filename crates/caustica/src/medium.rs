@@ -241,6 +241,11 @@ impl Medium {
         (s, s + wl.unbounded(self.sigma_a))
     }
 
+    /// The largest σt of any channel (a homogeneous medium's; a grid's at density one).
+    pub fn majorant(&self) -> f32 {
+        (self.sigma_a + self.sigma_s).max_element()
+    }
+
     /// σs at the point `p`, at the wavelengths `wl` (the grid's density included).
     pub fn sigma_s_at(&self, p: Vec3, wl: &Wavelengths) -> Spectrum {
         let s = wl.unbounded(self.sigma_s);
@@ -308,20 +313,56 @@ impl Medium {
             let (_, sigma_t) = self.coefficients(wl);
             return kept(sigma_t, t1 - t0);
         };
+        let mut tr = wl.grey(1.0);
+        self.ratio_tracking(grid, ray, (t0, t1), wl, rng, |_, kept| tr = kept);
+        tr
+    }
+
+    /// What light keeps along `ray` from `t0` to every point up to `t1`, at once: an unbiased
+    /// estimate of each, a step function (exp(−σt d) itself when homogeneous). `steps` is
+    /// emptied and gets `(t, kept from t0 to any point past t)` at each step, in order; before
+    /// the first step everything is kept.
+    pub fn transmittance_steps(
+        &self,
+        ray: &Ray,
+        (t0, t1): (f32, f32),
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        steps: &mut Vec<(f32, Spectrum)>,
+    ) {
+        steps.clear();
+        if let Some(grid) = &self.grid {
+            if t0 < t1 && !self.is_clear() {
+                self.ratio_tracking(grid, ray, (t0, t1), wl, rng, |t, kept| steps.push((t, kept)));
+            }
+        }
+    }
+
+    /// Ratio tracking along `ray` from `t0` to `t1` through `grid`: `step(t, kept)` at each
+    /// tentative collision with the estimate of what is kept from `t0` on past it.
+    fn ratio_tracking(
+        &self,
+        grid: &DensityGrid,
+        ray: &Ray,
+        (t0, t1): (f32, f32),
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        mut step: impl FnMut(f32, Spectrum),
+    ) {
         let Some((a, b)) = grid.clip(ray, (t0, t1)) else {
-            return wl.grey(1.0);
+            return;
         };
         let (_, sigma_t) = self.coefficients(wl);
         let majorant = grid.max * sigma_t.max_element();
         if majorant.is_nan() || majorant <= 0.0 {
-            return wl.grey(1.0);
+            return;
         }
         let mut tr = wl.grey(1.0);
         let mut t = a;
         loop {
             t -= (1.0 - rng.uniform()).ln() / majorant;
             if t >= b {
-                return tr;
+                return;
             }
             let density = grid.density(ray.at(t));
             tr *= (Spectrum::splat(1.0) - sigma_t * (density / majorant)).max(Spectrum::ZERO);
@@ -329,10 +370,12 @@ impl Medium {
             let m = tr.max_element();
             if m < 0.1 {
                 if rng.uniform() >= m / 0.1 {
-                    return Spectrum::ZERO;
+                    step(t, Spectrum::ZERO);
+                    return;
                 }
                 tr /= m / 0.1;
             }
+            step(t, tr);
         }
     }
 }

@@ -201,4 +201,8 @@ pub struct ProgressiveOptions {
     /// race they cost more than they gain.
     #[arg(long)]
     pub vertex_connections: bool,
+    /// vcm: no beam queries in media (camera rays gathering the light vertices along their
+    /// way); light in fog then comes from light tracing and next-event estimation alone.
+    #[arg(long)]
+    pub no_beams: bool,
 }

@@ -90,6 +90,19 @@ pub trait CameraVisitor {
         Some(at.sample_phase(rng))
     }
 
+    /// Before each segment of a walk through a scene with media: the ray from the last vertex
+    /// (the eye at first), the passage as the segment starts, the throughput and whether only
+    /// the hero wavelength is left, and the number of the vertex the segment leads to. By
+    /// default nothing (vcm gathers light along it: a beam query).
+    fn segment(&mut self, _ray: &Ray, _passage: &Passage, _carried: (Spectrum, bool), _length: u32, _rng: &mut Rng) {}
+
+    /// Whether the next segment passes `medium` without scattering, the throughput paying its
+    /// transmittance (the visitor gathers the light scattered there some other way). By default
+    /// never.
+    fn passes(&self, _medium: u32) -> bool {
+        false
+    }
+
     /// The bounce at `at`: by default the BSDF's own sample. `None` ends the walk.
     fn bounce(&mut self, at: &CameraArrival, rng: &mut Rng) -> Option<BsdfSample> {
         at.bsdf
@@ -115,7 +128,13 @@ pub fn walk_camera(
     for length in 1..=max_surfaces {
         rays += 1;
         let wo = -ray.dir;
-        let (hit, sample) = match passage.next(scene, &ray, &mut throughput, wl, rng) {
+        let step = if scene.has_media() {
+            visitor.segment(&ray, &passage, (throughput, dispersed), length, rng);
+            passage.next_passing(scene, &ray, (&mut throughput, wl), rng, |m| visitor.passes(m))
+        } else {
+            passage.next(scene, &ray, &mut throughput, wl, rng)
+        };
+        let (hit, sample) = match step {
             Step::Escaped => {
                 visitor.escaped(ray.dir, throughput, length);
                 break;

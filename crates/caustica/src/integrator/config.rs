@@ -143,6 +143,8 @@ pub struct RenderConfig {
     pub no_camera_specular: bool,
     /// `--vertex-connections` (vcm).
     pub vertex_connections: bool,
+    /// `--no-beams` (vcm).
+    pub no_beams: bool,
     /// `--spectral` / `--no-spectral` (physical model): light at sampled wavelengths or in RGB;
     /// by default spectral exactly when the scene has a dispersive glass.
     pub spectral: Option<bool>,
@@ -178,6 +180,7 @@ impl Default for RenderConfig {
             alpha: 2.0 / 3.0,
             no_camera_specular: false,
             vertex_connections: false,
+            no_beams: false,
             spectral: None,
             max_memory: 4096,
             partial: None,
@@ -400,6 +403,7 @@ impl RenderConfig {
                 initial_radius: initial_radius(VcmSettings::default().initial_radius),
                 max_depth: depth,
                 connections: self.vertex_connections,
+                beams: !self.no_beams,
                 aim: !self.no_aim,
                 spectral: self.spectral,
                 balanced_footprint: match (self.radius, self.footprint) {

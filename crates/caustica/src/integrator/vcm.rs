@@ -33,6 +33,7 @@
 //! Determinism: light subpaths are traced in fixed batches and added in index order.
 
 pub mod balance;
+mod beams;
 mod camera_paths;
 pub mod focus;
 pub mod grid;
@@ -52,6 +53,7 @@ use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::light::aim::{caustic_targets, Aim};
 use crate::light::emission::{Emission, Emitters};
 use crate::math::{Ray, Vec3};
+use crate::photon::kd_tree::{KdPoint, KdTree};
 use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor, Roulette};
 use crate::progress::Control;
 use crate::sampling::{power_heuristic, Rng};
@@ -99,6 +101,28 @@ struct MergeVertex {
     direct_caustic: bool,
 }
 
+/// A light vertex in a medium that camera rays gather along their way ([`beams`]).
+#[derive(Clone, Copy, Debug)]
+struct VolumeVertex {
+    point: Vec3,
+    wo: Vec3,
+    throughput: Spectrum,
+    /// Light reaching it first: the subpath's first MIS sum (next-event estimation against
+    /// it, distance densities left out) and its distance from the light ([`beams::direct_share`]);
+    /// 0 after a bounce.
+    direct: (f32, f32),
+    medium: u32,
+    length: u32,
+    dispersed: bool,
+}
+
+impl KdPoint for VolumeVertex {
+    #[inline]
+    fn position(&self) -> Vec3 {
+        self.point
+    }
+}
+
 /// The light subpaths of one pass (or of one batch of it).
 #[derive(Default)]
 struct LightPaths {
@@ -109,6 +133,8 @@ struct LightPaths {
     /// Every vertex that may be merged (light reached it after a bounce), and where it is.
     merge_points: Vec<Vec3>,
     merge_vertices: Vec<MergeVertex>,
+    /// Every light vertex in a medium that may be merged, in the kd-tree's order once arranged.
+    volume_vertices: Vec<VolumeVertex>,
     /// What light tracing adds to each pixel, in batch order.
     splats: Vec<(u32, Vec3)>,
     /// Rays the subpaths cast (for the balance pilot's costs).
@@ -122,6 +148,7 @@ impl LightPaths {
         self.ends.clear();
         self.merge_points.clear();
         self.merge_vertices.clear();
+        self.volume_vertices.clear();
         self.splats.clear();
         self.rays = 0;
     }
@@ -133,6 +160,7 @@ impl LightPaths {
         self.vertices.extend_from_slice(&batch.vertices);
         self.merge_points.extend_from_slice(&batch.merge_points);
         self.merge_vertices.extend_from_slice(&batch.merge_vertices);
+        self.volume_vertices.extend_from_slice(&batch.volume_vertices);
         self.splats.extend_from_slice(&batch.splats);
         self.rays += batch.rays;
     }
@@ -154,6 +182,8 @@ struct PassData {
     grid: HashGrid,
     /// The mergeable light vertices in the grid's order.
     merge_vertices: Vec<MergeVertex>,
+    /// Over `paths.volume_vertices`, for the camera rays' beam queries.
+    volume_tree: KdTree,
     factors: Factors,
     radius: f32,
 }
@@ -172,7 +202,7 @@ impl PassData {
     /// `paths` arranged for merging within `radius` (`grid` and `merge_vertices` lend their
     /// memory).
     fn arrange(
-        paths: LightPaths,
+        mut paths: LightPaths,
         mut grid: HashGrid,
         mut merge_vertices: Vec<MergeVertex>,
         factors: Factors,
@@ -181,10 +211,12 @@ impl PassData {
         grid.rebuild(&paths.merge_points, radius);
         merge_vertices.clear();
         merge_vertices.extend(grid.order().iter().map(|&i| paths.merge_vertices[i as usize]));
+        let volume_tree = KdTree::build(&mut paths.volume_vertices);
         PassData {
             paths,
             grid,
             merge_vertices,
+            volume_tree,
             factors,
             radius,
         }
@@ -200,6 +232,9 @@ struct CameraVertex<'h> {
     partial: Partial,
     length: u32,
     dispersed: bool,
+    /// A next-event sample taken where a beam query's segment was cut by a free flight
+    /// ([`beams`]): the medium's largest σt and the distance from the segment's start.
+    along: Option<(f32, f32)>,
 }
 
 /// The renderer over a whole image.

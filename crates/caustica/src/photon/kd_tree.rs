@@ -437,6 +437,87 @@ impl KdTree {
         };
         search(self, q.p, &mut q);
     }
+
+    /// Calls `f(slot, t, dist2)` for every item within distance `radius` of the segment
+    /// `origin + t dir`, `t0 <= t <= t1` (`dir` a unit vector), measured square to it: `t` is
+    /// where the item lies along the segment, `dist2` its squared distance from it (a beam
+    /// query, as the beam radiance estimate asks). Items project beyond either end are left
+    /// out, so that consecutive segments of one ray find each item once. In tree order.
+    ///
+    /// `items` must be the slice `build` reordered.
+    pub fn for_each_near_segment<T: KdPoint>(
+        &self,
+        items: &[T],
+        (origin, dir): (Vec3, Vec3),
+        (t0, t1): (f32, f32),
+        radius: f32,
+        mut f: impl FnMut(u32, f32, f32),
+    ) {
+        assert_eq!(items.len(), self.len(), "items are not the tree's slice");
+        // (NaN bounds or radius find nothing.)
+        let ordered = t0 <= t1 && radius >= 0.0;
+        if self.len == 0 || !ordered || origin.is_nan() || dir.is_nan() {
+            return;
+        }
+        let r2 = radius * radius;
+        let (o, d) = (origin.to_array(), dir.to_array());
+        let inv = d.map(|x| 1.0 / x);
+        // The segment meets the box grown by the radius: a slab test.
+        let meets = |b: &PointBounds| {
+            let (mut near, mut far) = (t0, t1);
+            for a in 0..3 {
+                let (lo, hi) = (b.lo[a] - radius, b.hi[a] + radius);
+                if d[a] == 0.0 {
+                    if o[a] < lo || o[a] > hi {
+                        return false;
+                    }
+                    continue;
+                }
+                let (ta, tb) = ((lo - o[a]) * inv[a], (hi - o[a]) * inv[a]);
+                near = near.max(ta.min(tb));
+                far = far.min(ta.max(tb));
+            }
+            near <= far
+        };
+        let mut stack = [Subtree::default(); SEARCH_STACK];
+        let mut sp = 0;
+        let mut cur = Subtree {
+            size: self.nodes.len() as u32,
+            len: self.len,
+            ..Subtree::default()
+        };
+        loop {
+            let bounds = if cur.size == 0 {
+                &self.leaves[cur.leaf as usize]
+            } else {
+                &self.inner[cur.node as usize]
+            };
+            if meets(bounds) {
+                if cur.size == 0 {
+                    let range = cur.lo as usize..(cur.lo + cur.len) as usize;
+                    for (slot, item) in range.clone().zip(&items[range]) {
+                        let v = item.position() - origin;
+                        let t = v.dot(dir);
+                        let d2 = (v.length_squared() - t * t).max(0.0);
+                        if t >= t0 && t <= t1 && d2 < r2 {
+                            f(slot as u32, t, d2);
+                        }
+                    }
+                } else {
+                    let (left, right) = children(cur);
+                    stack[sp] = right;
+                    sp += 1;
+                    cur = left;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            cur = stack[sp];
+        }
+    }
 }
 
 /// State of one k-NN query. `bound` is strict: a candidate must have `dist2 < bound`.

@@ -150,16 +150,18 @@ impl Passage {
                 None => Step::Escaped,
             };
         }
-        self.next_in_media(scene, ray, throughput, wl, rng)
+        self.next_passing(scene, ray, (throughput, wl), rng, |_| false)
     }
 
-    fn next_in_media(
+    /// [`Passage::next`], passing the media for which `passes` holds without scattering in
+    /// them: `throughput` pays their transmittance.
+    pub fn next_passing(
         &mut self,
         scene: &Scene,
         ray: &Ray,
-        throughput: &mut Spectrum,
-        wl: &Wavelengths,
+        (throughput, wl): (&mut Spectrum, &Wavelengths),
         rng: &mut Rng,
+        passes: impl Fn(u32) -> bool,
     ) -> Step {
         let length = ray.dir.length();
         let dir = ray.dir / length;
@@ -171,7 +173,9 @@ impl Passage {
             if self.medium != VACUUM {
                 let segment = scene.medium_segment(&ray, (0.0, isect.map_or(f32::INFINITY, |i| i.t)));
                 let medium = scene.medium(self.medium);
-                if let Some(t) = medium.sample_flight(&ray, segment, wl, throughput, rng) {
+                if passes(self.medium) {
+                    *throughput *= medium.transmittance(&ray, segment, wl, rng);
+                } else if let Some(t) = medium.sample_flight(&ray, segment, wl, throughput, rng) {
                     let mut hit = SurfaceHit::in_medium(ray.at(t), self.medium);
                     hit.t = (travelled + t) / length;
                     return Step::Medium(hit);
@@ -204,6 +208,45 @@ impl Passage {
             return Step::Surface(hit);
         }
         Step::Escaped
+    }
+
+    /// The media along `ray` (unit direction) as the walk would pass them without scattering,
+    /// up to the first surface that is not a boundary: `f(medium, t0, t1)` for each stretch of
+    /// a medium, in order, as distances from the ray's origin (one stretch where a boundary
+    /// has the same medium on both sides).
+    pub fn pieces(&self, scene: &Scene, ray: &Ray, mut f: impl FnMut(u32, f32, f32)) {
+        let (mut medium, mut outer) = (self.medium, self.outer);
+        let mut piece = *ray;
+        let mut travelled = 0.0;
+        let mut pending: Option<(u32, f32, f32)> = None;
+        for _ in 0..1024 {
+            let isect = scene.intersect(&piece, f32::INFINITY);
+            if medium != VACUUM {
+                let (a, b) = scene.medium_segment(&piece, (0.0, isect.map_or(f32::INFINITY, |i| i.t)));
+                if a < b {
+                    let (a, b) = (travelled + a, travelled + b);
+                    pending = match pending {
+                        Some((m, start, end)) if m == medium && a - end <= 1e-3 * end.max(1.0) => Some((m, start, b)),
+                        Some((m, start, end)) => {
+                            f(m, start, end);
+                            Some((medium, a, b))
+                        }
+                        None => Some((medium, a, b)),
+                    };
+                }
+            }
+            let Some(isect) = isect.filter(|i| scene.is_boundary(i)) else {
+                break;
+            };
+            let hit = scene.surface(&piece, &isect);
+            medium = scene.medium_beyond(&hit, ray.dir, medium, &mut outer);
+            let origin = hit.ray_origin(ray.dir);
+            travelled += (origin - piece.origin).length();
+            piece = Ray::new(origin, ray.dir);
+        }
+        if let Some((m, start, end)) = pending {
+            f(m, start, end);
+        }
     }
 
     /// After a bounce at the surface `hit` that goes on along `sample`: through the surface,

@@ -41,6 +41,7 @@ pub fn config(args: &RenderArgs, hints: &RenderHints) -> Result<RenderConfig> {
         alpha: p.alpha,
         no_camera_specular: p.no_camera_specular,
         vertex_connections: p.vertex_connections,
+        no_beams: p.no_beams,
         spectral: match (p.spectral, p.no_spectral) {
             (true, _) => Some(true),
             (_, true) => Some(false),

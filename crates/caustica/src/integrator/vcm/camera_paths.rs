@@ -3,7 +3,7 @@
 //! ([`super::merging`]), every strategy weighted by [`mis`].
 
 use super::*;
-use crate::photon::light_walk::MediumArrival;
+use crate::photon::light_walk::{MediumArrival, Passage};
 
 /// One camera subpath on its walk: its MIS sums, the variants merging at the first vertex
 /// needs, and the radiance gathered.
@@ -50,9 +50,26 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
         self.l += throughput * seen;
     }
 
+    // Until the path first scatters off a smooth lobe, it passes the media where beam queries
+    // gather the light (it never stops there), and each segment gathers along its way
+    // ([`super::beams`]).
+    fn passes(&self, medium: u32) -> bool {
+        self.gathers_beams() && self.vcm.merges_in_medium(medium)
+    }
+
+    fn segment(&mut self, ray: &Ray, passage: &Passage, carried: (Spectrum, bool), length: u32, rng: &mut Rng) {
+        if !self.gathers_beams() {
+            return;
+        }
+        let (vcm, pass, partial, wl) = (self.vcm, self.pass, self.partial, self.wl);
+        let seen = vcm.gather_beam(ray, passage, carried, &partial, length, pass, wl, rng, self.work);
+        self.work.merged += seen;
+        self.l += seen;
+    }
+
     // A scattering point is a smooth vertex whose lobes are the phase function: it gathers
-    // next-event estimation and connections as a surface does, but never merges (merging's
-    // kernel is a disc on a surface).
+    // next-event estimation and connections as a surface does, but never merges (where it
+    // would be the path's first smooth vertex, the path passes on: a beam query merges there).
     fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool {
         let wl = self.wl;
         visit_as_surface(self, at, wl, rng)
@@ -110,6 +127,7 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
                 partial: self.partial,
                 length,
                 dispersed: at.dispersed,
+                along: None,
             };
             self.l += vcm.direct(&v, f, wl, rng, self.work);
             let paths = &self.pass.paths;
@@ -167,6 +185,13 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
             self.last_pdf = Some(sample.pdf);
         }
         Some(sample)
+    }
+}
+
+impl CameraSubpath<'_, '_> {
+    /// Whether the path's segments gather light by beam queries: before its first smooth vertex.
+    fn gathers_beams(&self) -> bool {
+        !self.smooth_before && self.pass.factors.merge > 0.0
     }
 }
 
@@ -303,7 +328,11 @@ impl<'a> Vcm<'a> {
         let mut one = |number: usize, pick: f32, rng: &mut Rng| {
             work.rays += 1;
             if self.emitters.emits(number) {
-                let samples = self.direct_samples(number, v.length);
+                let samples = if v.along.is_some() {
+                    1
+                } else {
+                    self.direct_samples(number, v.length)
+                };
                 for _ in 0..samples {
                     let choice = lights.direct_probability(number);
                     let Some(s) = lights.sample_light(number, choice, self.scene, v.hit, wl, rng) else {
@@ -332,13 +361,21 @@ impl<'a> Vcm<'a> {
                     } else {
                         v.partial
                     };
-                    let weight = mis::direct(f, &camera, &pdfs, false);
+                    let weight = match v.along {
+                        Some((sigma, t)) => {
+                            let first = pdfs.direct * pdfs.cos_light / (pdfs.emission * pdfs.cos_here);
+                            let d = if s.distance.is_finite() { s.distance } else { 0.0 };
+                            mis::direct_along(f, &v.partial, beams::direct_share((first, d), sigma, t))
+                        }
+                        None => mis::direct(f, &camera, &pdfs, false),
+                    };
                     l += v.throughput * value * s.contribution * (cos_here * weight / samples as f32);
                 }
             } else if let Some(s) = lights.sample_light(number, pick, self.scene, v.hit, wl, rng) {
                 // Far lights and lights with a size: the camera's strategies only.
                 let value = v.bsdf.eval(v.wo, s.wi);
-                let weight = if s.pdf > 0.0 {
+                // (A point a free flight picked on a beam's segment is not scattered from.)
+                let weight = if s.pdf > 0.0 && v.along.is_none() {
                     power_heuristic(s.pdf, v.bsdf.pdf(v.wo, s.wi))
                 } else {
                     1.0

@@ -46,9 +46,11 @@ impl<'a> Vcm<'a> {
     }
 
     /// Light tracing: the light vertex seen by the eye, splatted onto its pixel.
+    /// `direct`: for light reaching a scattering point first, what [`beams::direct_share`] reads.
     fn trace_to_eye(
         &self,
         v: &LightVertex,
+        direct: (f32, f32),
         bsdf: &Bsdf,
         (f, wl): (&Factors, &Wavelengths),
         rng: &mut Rng,
@@ -80,13 +82,19 @@ impl<'a> Vcm<'a> {
             s.to_eye.dot(ng).abs() * v.wo.dot(ns).abs() / wo_ng
         };
         let camera_pdf = s.importance * bsdf.cos(s.to_eye) * inv_d2;
-        let weight = mis::light_tracing(
-            f,
-            &v.partial,
-            camera_pdf,
-            bsdf.pdf_reverse(v.wo, s.to_eye),
-            v.length > 1 && !medium && !(v.direct_caustic && self.focus.contains(v.hit.point)),
-        );
+        let weight = if medium && self.merges_in_medium(v.hit.media.back) {
+            let sigma = self.scene.medium(v.hit.media.back).majorant();
+            let direct = beams::direct_share(direct, sigma, s.distance);
+            mis::light_tracing_beside_beams(f, camera_pdf, direct)
+        } else {
+            mis::light_tracing(
+                f,
+                &v.partial,
+                camera_pdf,
+                bsdf.pdf_reverse(v.wo, s.to_eye),
+                v.length > 1 && !medium && !(v.direct_caustic && self.focus.contains(v.hit.point)),
+            )
+        };
         let kept = if self.scene.has_media() {
             self.scene.transmittance_towards(&v.hit, s.to_eye, s.distance, wl, rng)
         } else {
@@ -200,6 +208,8 @@ impl LightVisitor for Subpath<'_, '_> {
         } else {
             (hit.point - self.previous).length_squared()
         };
+        // A far light's distance is none: its light starts at the scene's edge.
+        let from_light = if emission.far { 0.0 } else { d2.sqrt() };
         self.previous = hit.point;
         let partial = &mut self.partial;
         partial.arrive(d2, bsdf.cos(wo));
@@ -208,6 +218,11 @@ impl LightVisitor for Subpath<'_, '_> {
             partial.vcm = 0.0;
         }
         let direct_caustic = length > 1 && self.all_specular;
+        let direct = if length == 1 && hit.is_in_medium() {
+            (partial.vcm, from_light)
+        } else {
+            (0.0, 0.0)
+        };
         if bsdf.is_smooth() {
             let vertex = LightVertex {
                 hit,
@@ -221,11 +236,30 @@ impl LightVisitor for Subpath<'_, '_> {
             if self.to_eye {
                 // Direct light is not traced to the eye (see trace_to_eye).
                 self.out.rays += u64::from(length > 1);
-                vcm.trace_to_eye(&vertex, bsdf, (f, self.wl), &mut self.eye_rng, &mut self.out.splats);
+                vcm.trace_to_eye(
+                    &vertex,
+                    direct,
+                    bsdf,
+                    (f, self.wl),
+                    &mut self.eye_rng,
+                    &mut self.out.splats,
+                );
             }
-            // Light reaching a vertex first is never merged (see the module's notes), nor light
-            // in a medium.
-            if length > 1 && !hit.is_in_medium() {
+            // Light reaching a surface first is never merged (see the module's notes); in a
+            // medium camera rays gather all of it along their way ([`super::beams`]).
+            if hit.is_in_medium() {
+                if vcm.merges_in_medium(hit.media.back) {
+                    self.out.volume_vertices.push(VolumeVertex {
+                        point: hit.point,
+                        wo,
+                        throughput: at.throughput,
+                        direct,
+                        medium: hit.media.back,
+                        length,
+                        dispersed: at.dispersed,
+                    });
+                }
+            } else if length > 1 {
                 self.out.merge_points.push(hit.point);
                 self.out.merge_vertices.push(MergeVertex {
                     wo,

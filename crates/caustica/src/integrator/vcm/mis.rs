@@ -196,6 +196,33 @@ pub fn merge(factors: &Factors, camera: &Partial, light: &Partial, camera_pdf: f
     1.0 / (w_light + 1.0 + w_camera)
 }
 
+/// Weight of a beam query's gather of a light vertex in a medium where the camera path (its
+/// sums `camera`, arrived there with a cosine of one) has not scattered off a smooth lobe
+/// before (see [`super::beams`]): its rivals are light tracing and, for light reaching the
+/// point first, next-event estimation where a free flight cuts the segment, as camera paths
+/// never stop there;
+/// `direct`: next-event estimation along the segment against the light subpath (see
+/// [`super::beams::direct_share`]).
+pub fn beam(factors: &Factors, camera: &Partial, direct: f32) -> f32 {
+    1.0 / (1.0 + (camera.vcm + mis(direct)) * factors.connect)
+}
+
+/// Weight of next-event estimation at a point a free flight chose on such a segment, whose
+/// light subpath would make the point `direct` times less likely (the sums' first term at the
+/// light's side, with both distance densities): its rivals are the beam query and light
+/// tracing.
+pub fn direct_along(factors: &Factors, camera: &Partial, direct: f32) -> f32 {
+    1.0 / (1.0 + (factors.merge + camera.vcm) / mis(direct))
+}
+
+/// Weight of light tracing a light vertex in such a medium, whose camera would make the point
+/// with density `camera_pdf` per unit volume (distances' densities left out) per pixel sample:
+/// its rivals are the beam query and, for light reaching it first, next-event estimation
+/// (`direct`, as for [`beam`]).
+pub fn light_tracing_beside_beams(factors: &Factors, camera_pdf: f32, direct: f32) -> f32 {
+    1.0 / (1.0 + mis(camera_pdf / factors.light_paths) * (factors.merge + mis(direct)))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -340,6 +367,72 @@ mod tests {
                     "case {case}, {name}: {w} against {expected}"
                 );
             }
+        }
+    }
+
+    /// In a medium where camera paths pass until their first smooth vertex, a path eye → y (a
+    /// scattering point, t from the eye) → light (d from y) is made by light tracing, the beam
+    /// query and next-event estimation at a point a free flight picked: the three weights, each
+    /// from its own side's sums, are the balance heuristic's and sum to one; with light that
+    /// bounced before y, the first two alone.
+    #[test]
+    fn beam_strategies_sum_to_one() {
+        let mut rng = Rng::new(23, 0);
+        for case in 0..200 {
+            let mut r = |lo: f32, hi: f32| lo + (hi - lo) * rng.uniform();
+            let (camera_w, t, d, sigma) = (r(0.5, 50.0), r(0.05, 4.0), r(0.05, 4.0), r(0.01, 3.0));
+            let (pos_pdf, dir_pdf, nee_pdf, cos_light) = (r(0.5, 5.0), r(0.05, 1.0), r(0.5, 5.0), r(0.05, 1.0));
+            let f = Factors::new(r(0.001, 0.05), r(100.0, 10_000.0));
+            let eta = f.merge as f64;
+            // Each strategy's density (per unit volume at y, the common camera direction left out).
+            let (t, d) = (t as f64, d as f64);
+            let flight = |x: f64| sigma as f64 * (-(sigma as f64) * x).exp();
+            // The light's point by area, its direction by solid angle; next-event estimation's
+            // point by area.
+            let light_y = (pos_pdf * dir_pdf) as f64 / (d * d) * flight(d);
+            let camera_y = camera_w as f64 / (t * t);
+            let traced = light_y * f.light_paths as f64;
+            let gathered = light_y * camera_y * eta;
+            let nee = camera_y * flight(t) * nee_pdf as f64;
+            let total = traced + gathered + nee;
+
+            let mut camera = Partial::camera(&f, camera_w);
+            camera.arrive((t * t) as f32, 1.0);
+            let mut light = Partial::light(&f, pos_pdf * dir_pdf, nee_pdf, cos_light, false);
+            light.arrive((d * d) as f32, 1.0);
+            let first = (light.vcm, d as f32);
+            let share = super::super::beams::direct_share(first, sigma, t as f32);
+            let w_traced = light_tracing_beside_beams(&f, camera_w / (t * t) as f32, share);
+            let w_beam = beam(&f, &camera, share);
+            // Next-event estimation's own side: its solid-angle density and the light's cosine.
+            let direct_w = nee_pdf * (d * d) as f32 / cos_light;
+            let from_eye = (direct_w * cos_light / (pos_pdf * dir_pdf), d as f32);
+            let w_nee = direct_along(
+                &f,
+                &camera,
+                super::super::beams::direct_share(from_eye, sigma, t as f32),
+            );
+            for (name, w, p) in [
+                ("traced", w_traced, traced),
+                ("beam", w_beam, gathered),
+                ("nee", w_nee, nee),
+            ] {
+                let expected = p / total;
+                assert!(
+                    (w as f64 - expected).abs() < 1e-3 * expected.max(1e-3),
+                    "case {case}, {name}: {w} against {expected}"
+                );
+            }
+            // Light that bounced before y: light tracing and the beam query only.
+            let (w_traced, w_beam) = (
+                light_tracing_beside_beams(&f, camera_w / (t * t) as f32, 0.0),
+                beam(&f, &camera, 0.0),
+            );
+            assert!(((w_traced + w_beam) as f64 - 1.0).abs() < 1e-4, "case {case}");
+            assert!(
+                (w_beam as f64 - gathered / (gathered + traced)).abs() < 1e-3,
+                "case {case}"
+            );
         }
     }
 }

@@ -33,6 +33,9 @@ pub struct VcmSettings {
     /// no caustic's focus directly); `None` keeps `initial_radius` there too. `--radius` and
     /// `--footprint` set `None`.
     pub balanced_footprint: Option<f32>,
+    /// Merge in homogeneous media: camera rays gather the light vertices along their way
+    /// ([`beams`]; `--no-beams`: light tracing and next-event estimation only).
+    pub beams: bool,
 }
 
 impl Default for VcmSettings {
@@ -47,6 +50,7 @@ impl Default for VcmSettings {
             spectral: None,
             focus_samples: FOCUS_CAMERA_SAMPLES,
             balanced_footprint: Some(BALANCED_FOOTPRINT),
+            beams: true,
         }
     }
 }

@@ -460,3 +460,42 @@ fn reaching_matches_brute_force_and_near_leaves_serve_nearby_points() {
         }
     }
 }
+
+/// A beam query finds exactly the items a brute-force scan finds square to the segment within
+/// the radius, whatever the segment's direction (along an axis too) and length.
+#[test]
+fn near_segment_matches_brute_force() {
+    let mut rng = Rng(5);
+    for (name, gen) in GENERATORS {
+        for n in SIZES {
+            let pts = gen(&mut rng, n);
+            let mut items = items_of(&pts);
+            let tree = KdTree::build(&mut items);
+            for case in 0..12 {
+                let origin = rng.vec() * 1.4 - Vec3::splat(0.2);
+                let dir = match case % 4 {
+                    0 => Vec3::X,
+                    1 => -Vec3::Z,
+                    _ => (rng.vec() - Vec3::splat(0.5)).normalize(),
+                };
+                let (t0, t1) = (rng.range(-0.2, 0.3), rng.range(0.3, 1.5));
+                let radius = [0.0, 0.01, 0.05, 0.2][case % 4];
+                let mut found = Vec::new();
+                tree.for_each_near_segment(&items, (origin, dir), (t0, t1), radius, |slot, t, d2| {
+                    found.push((slot, t, d2));
+                });
+                found.sort_by_key(|f| f.0);
+                let mut expected = Vec::new();
+                for (slot, it) in items.iter().enumerate() {
+                    let v = it.pos - origin;
+                    let t = v.dot(dir);
+                    let d2 = (v.length_squared() - t * t).max(0.0);
+                    if t >= t0 && t <= t1 && d2 < radius * radius {
+                        expected.push((slot as u32, t, d2));
+                    }
+                }
+                assert_eq!(found, expected, "{name} n={n} case {case}");
+            }
+        }
+    }
+}
