@@ -106,7 +106,7 @@ pub struct RenderHints {
     /// Gather radius in scene units (pbrt's sppm `radius`).
     pub radius: Option<f32>,
     /// A medium scatters light: the physical model renders the scene (the course model knows
-    /// no media), and gi refuses it.
+    /// no media).
     pub scattering_media: bool,
     /// The output file the scene names (pbrt's `Film "filename"`), as written.
     pub output: Option<PathBuf>,

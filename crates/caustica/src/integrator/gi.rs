@@ -14,8 +14,13 @@
 //!
 //! A gather ray that reaches a light, directly or by a specular chain, adds nothing: next-event
 //! estimation and the caustic map already count those paths.
+//!
+//! In media, photons are also stored where they scatter (Jensen's volume photon map): a camera
+//! path that scatters in a medium takes next-event estimation and the volume photons that did
+//! not come straight from a light within a ball (as `ppm` does), and a gather ray that scatters
+//! reads every volume photon there, as it reads the global map on a surface.
 
-use super::direct::{bsdf_can_reach_light, direct_light, emitted, power_heuristic};
+use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light, emitted, power_heuristic};
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
 use super::specular_chain::camera_chain;
@@ -23,9 +28,10 @@ use super::tiles::sample_pass;
 use super::Progressive;
 use crate::bsdf::{Bsdf, Transport};
 use crate::math::{Ray, Vec3};
+use crate::photon::light_walk::{Passage, Step};
 use crate::photon::map::PhotonMap;
-use crate::photon::trace::trace_count;
-use crate::photon::{is_caustic, needed_bounces_left};
+use crate::photon::trace::trace_count_in_media;
+use crate::photon::{is_caustic, is_direct, needed_bounces_left};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::Scene;
@@ -76,8 +82,15 @@ pub struct GiMaps {
     pub global: PhotonMap,
     /// Photons that came by mirrors and glass only.
     pub caustic: PhotonMap,
+    /// Every photon stored where it scattered in a medium (gather rays read it)...
+    pub volume: PhotonMap,
+    /// ...and those that did not come straight from a light (camera paths read them beside
+    /// next-event estimation).
+    pub volume_indirect: PhotonMap,
     /// Twice the typical distance to the k-th nearest global photon.
     global_radius: f32,
+    /// The same among the volume photons.
+    volume_radius: f32,
     /// This pass's shrink factor of the gather radii.
     caustic_factor: f32,
 }
@@ -118,7 +131,7 @@ impl<'a> Gi<'a> {
 
     /// The maps of pass `pass`, at the pass's wavelengths `wl`.
     pub fn maps(&self, pass: u64, wl: &Wavelengths, control: Control) -> GiMaps {
-        let photons = trace_count(
+        let (photons, volume) = trace_count_in_media(
             self.scene,
             self.settings.photons_per_pass,
             (self.seed ^ PHOTON_SEED, pass),
@@ -127,14 +140,25 @@ impl<'a> Gi<'a> {
             control,
         );
         let caustic: Vec<_> = photons.iter().copied().filter(is_caustic).collect();
+        let volume_indirect: Vec<_> = volume.iter().copied().filter(|p| !is_direct(p)).collect();
         let global = PhotonMap::new(photons);
         let caustic = PhotonMap::new(caustic);
+        let volume = PhotonMap::new(volume);
+        let volume_indirect = PhotonMap::new(volume_indirect);
         // Largest radii: past these a k-NN estimate reaches across the scene for nothing.
         let global_radius = global.typical_radius(self.settings.k_global) * 2.0;
+        let volume_radius = if volume.is_empty() {
+            0.0
+        } else {
+            volume.typical_radius(self.settings.k_global) * 2.0
+        };
         GiMaps {
             global,
             caustic,
+            volume,
+            volume_indirect,
             global_radius,
+            volume_radius,
             caustic_factor: radius_factor(pass, self.settings.alpha),
         }
     }
@@ -151,12 +175,28 @@ impl<'a> Gi<'a> {
             |hit, bsdf, wo, path_length, dispersed, left, _caustic_only, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
                 let min_left = needed_bounces_left(s.max_depth, left);
-                direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng)
+                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
+                if bsdf.is_phase() {
+                    // In a medium: the volume photons within a ball, as ppm gathers them.
+                    let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
+                    let indirect = &maps.volume_indirect;
+                    return direct
+                        + indirect.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
+                }
+                direct
                     + maps
                         .caustic
                         .radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
             },
             |hit, sample, path_length, dispersed, left, rng| {
+                if hit.is_in_medium() {
+                    // The volume photons counted the rest.
+                    return if self.mis {
+                        sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
+                    } else {
+                        Spectrum::ZERO
+                    };
+                }
                 let origin = hit.ray_origin(sample.wi);
                 let gather = Gather {
                     from: Some((hit.point, sample.pdf)),
@@ -164,6 +204,7 @@ impl<'a> Gi<'a> {
                     dispersed,
                     level: 0,
                     left,
+                    medium: hit.media.towards(hit.geometric_normal, sample.wi),
                 };
                 sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
             },
@@ -193,21 +234,41 @@ impl<'a> Gi<'a> {
         let mut emitted_first = Spectrum::ZERO;
         let mut direct_from = at.from.filter(|_| self.mis);
         let mut left = at.left;
+        let mut passage = Passage::new(scene, at.medium);
         loop {
-            let Some(isect) = scene.intersect(&ray, f32::INFINITY) else {
-                if let Some((_, pdf)) = direct_from {
-                    return lights.escaped_weighted(ray.dir, Some(pdf), wl);
+            let hit = match passage.next(scene, &ray, &mut beta, wl, rng) {
+                Step::Escaped => {
+                    if let Some((_, pdf)) = direct_from {
+                        return beta * lights.escaped_weighted(ray.dir, Some(pdf), wl);
+                    }
+                    break;
                 }
-                break;
+                Step::Medium(hit) => {
+                    // Scattered in a medium: every volume photon there.
+                    if left == 0 {
+                        break;
+                    }
+                    let wo = -ray.dir.normalize();
+                    let medium = scene.medium(hit.media.back);
+                    let phase = Bsdf::phase(medium.phase.g, wo, wl);
+                    let r = maps.volume_radius * 0.5 * maps.caustic_factor;
+                    let min_left = needed_bounces_left(s.max_depth, left - 1);
+                    let sigma_s = medium.sigma_s_at(hit.point, wl);
+                    let l = maps
+                        .volume
+                        .in_scattered_within(hit.point, &phase, wo, (r, min_left), dispersed, sigma_s);
+                    return emitted_first + beta * l;
+                }
+                Step::Surface(hit) => hit,
             };
-            let hit = scene.surface(&ray, &isect);
-            path_length += isect.t;
-            segment += isect.t;
+            // (Gather rays' directions are unit: the parameter is the distance.)
+            path_length += hit.t;
+            segment += hit.t;
             let wo = -ray.dir;
             if let Some((point, pdf)) = direct_from.take() {
                 let le = emitted(scene, &hit, wo, wl);
                 if le != Spectrum::ZERO {
-                    emitted_first = le * power_heuristic(pdf, lights.pdf_direct(point, &hit));
+                    emitted_first = beta * le * power_heuristic(pdf, lights.pdf_direct(point, &hit));
                 }
             }
             // Past the surfaces `--depth` allows, only what this one emits counts.
@@ -246,6 +307,7 @@ impl<'a> Gi<'a> {
                         dispersed: next_dispersed,
                         level: at.level + 1,
                         left,
+                        medium: hit.media.towards(hit.geometric_normal, sample.wi),
                     };
                     l += weight * self.gather(maps, next, deeper, wl, rng);
                 }
@@ -258,6 +320,7 @@ impl<'a> Gi<'a> {
             if sample.dispersive {
                 wl.terminate_secondary(&mut beta, &mut dispersed);
             }
+            passage.cross(scene, &hit, &sample);
             ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
         }
         emitted_first
@@ -266,8 +329,8 @@ impl<'a> Gi<'a> {
 
 /// Where a gather ray starts: the point and pdf it left by (for weighting the emission it meets
 /// straight away; none after a specular lobe), the camera path's length so far, whether the
-/// camera path has dispersed, how many gathers deep it is, and at how many more surfaces the
-/// path may scatter beyond the one it leaves.
+/// camera path has dispersed, how many gathers deep it is, at how many more surfaces the path
+/// may scatter beyond the one it leaves, and the medium it starts in.
 #[derive(Clone, Copy, Debug)]
 struct Gather {
     from: Option<(Vec3, f32)>,
@@ -275,6 +338,8 @@ struct Gather {
     dispersed: bool,
     level: u32,
     left: u32,
+    /// The medium the ray starts in.
+    medium: u32,
 }
 
 /// Gather bounces computed exactly, rather than read from the global map, for close surfaces.

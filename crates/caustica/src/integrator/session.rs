@@ -200,11 +200,10 @@ impl<'a> RenderSession<'a> {
     /// A session for `scene`; the options are checked here.
     pub fn new(scene: &'a Scene, options: RenderOptions) -> Result<RenderSession<'a>> {
         options.integrator.validate()?;
-        if scene.scatters() && matches!(options.integrator, Integrator::Whitted(_) | Integrator::Gi(_)) {
-            return Err(crate::error::Error::InvalidSettings(format!(
-                "the scene has a medium that scatters light, which --integrator vcm, path, lt and ppm render (not {})",
-                options.integrator.name()
-            )));
+        if scene.scatters() && matches!(options.integrator, Integrator::Whitted(_)) {
+            return Err(crate::error::Error::InvalidSettings(
+                "the scene has a medium that scatters light, which --integrator vcm, path, lt, ppm and gi render (not the course model)".into(),
+            ));
         }
         let (width, height) = image_size(scene.camera(), options.width, options.height);
         check_image_size(width, height)?;

@@ -220,6 +220,7 @@ fn single_scattering_of_a_point_light_matches_its_integral() {
         ("lt", 16, 100_000),
         ("vcm", 64, 4_000),
         ("ppm", 256, 1_000),
+        ("gi", 256, 1_000),
     ] {
         let got = mean(&render(&scene, integrator, SIZE, passes, photons, Some(0)));
         eprintln!("{integrator}: {got} against {expected}");
@@ -250,9 +251,14 @@ fn an_albedo_one_medium_in_a_white_furnace_is_the_furnace() {
     };
     // ppm's ball of photons loses what lies past the medium's edge: at 8 px its radius (a
     // pixel's footprint) is a fifth of the ball's and the image 12% dark; at 128 px, 0.5%. So
-    // do vcm's beam queries (their tube near the curved edge): 8% dark at 8 px, 1.1% at 128.
-    for (integrator, size, passes, photons) in [("path", 8, 256, 0), ("vcm", 128, 64, 4_000), ("ppm", 128, 64, 50_000)]
-    {
+    // do vcm's beam queries (their tube near the curved edge): 8% dark at 8 px, 1.1% at 128,
+    // and gi's (ppm's estimate at camera paths' scattering points, and at its gather rays').
+    for (integrator, size, passes, photons) in [
+        ("path", 8, 256, 0),
+        ("vcm", 128, 64, 4_000),
+        ("ppm", 128, 64, 50_000),
+        ("gi", 128, 64, 50_000),
+    ] {
         let got = mean(&render(&furnace("3 2 1"), integrator, size, passes, photons, None));
         eprintln!("{integrator}: {got}");
         assert!(
@@ -323,7 +329,7 @@ fn a_medium_of_zero_density_changes_nothing() {
         ))
     };
     let (with, without) = (scene(true), scene(false));
-    for integrator in ["path", "lt", "ppm", "vcm"] {
+    for integrator in ["path", "lt", "ppm", "vcm", "gi"] {
         let a = render(&with, integrator, 12, 2, 5_000, None);
         let b = render(&without, integrator, 12, 2, 5_000, None);
         assert_eq!(a.pixels, b.pixels, "{integrator}");
@@ -399,6 +405,7 @@ fn path_and_light_tracing_agree_in_fog() {
         ("lt", 16, 16, 200_000),
         ("vcm", 64, 64, 20_000),
         ("ppm", 16, 64, 100_000),
+        ("gi", 16, 64, 100_000),
     ] {
         let path = if size == 64 { path64 } else { path16 };
         let got = mean(&render(&scene, integrator, size, passes, photons, None));
@@ -416,6 +423,7 @@ fn path_and_light_tracing_agree_in_fog() {
 #[test]
 fn media_keep_renders_deterministic_and_mergeable() {
     use crate::common::assert_deterministic_and_merges;
+    use caustica::integrator::gi::{Gi, GiSettings};
     use caustica::integrator::lt::{LightTracer, LtSettings};
     use caustica::integrator::path::{PathSettings, PathTracer};
     use caustica::integrator::ppm::{Ppm, PpmSettings};
@@ -464,12 +472,17 @@ fn media_keep_renders_deterministic_and_mergeable() {
         photons_per_pass: 5_000,
         ..PpmSettings::default()
     };
-    let renderers: [&dyn Progressive; 5] = [
+    let gi = GiSettings {
+        photons_per_pass: 5_000,
+        ..GiSettings::default()
+    };
+    let renderers: [&dyn Progressive; 6] = [
         &PathTracer::new(&scene, PathSettings::default(), 24, 24, 7),
         &LightTracer::new(&scene, lt, 24, 24, 7),
         &vcm,
         &vcm_in_fog,
         &Ppm::new(&scene, ppm, 24, 24, 7),
+        &Gi::new(&scene, gi, 24, 24, 7),
     ];
     for renderer in renderers {
         assert_deterministic_and_merges(renderer, 24, 24);
