@@ -23,7 +23,7 @@
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light, emitted, power_heuristic};
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::camera_chain;
+use super::specular_chain::{camera_chain, NoAlong};
 use super::tiles::sample_pass;
 use super::Progressive;
 use crate::bsdf::{Bsdf, Transport};
@@ -34,7 +34,7 @@ use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of the photon-map global illumination integrator.
@@ -172,42 +172,52 @@ impl<'a> Gi<'a> {
             (s.specular_camera_paths, false),
             wl,
             rng,
-            |hit, bsdf, wo, path_length, dispersed, left, _caustic_only, rng| {
-                let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                let min_left = needed_bounces_left(s.max_depth, left);
-                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
-                if bsdf.is_phase() {
-                    // In a medium: the volume photons within a ball, as ppm gathers them.
-                    let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
-                    let indirect = &maps.volume_indirect;
-                    return direct
-                        + indirect.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
-                }
-                direct
-                    + maps
-                        .caustic
-                        .radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
-            },
-            |hit, sample, path_length, dispersed, left, rng| {
-                if hit.is_in_medium() {
-                    // The volume photons counted the rest.
-                    return if self.mis {
-                        sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
-                    } else {
-                        Spectrum::ZERO
+            (
+                |hit: &SurfaceHit,
+                 bsdf: &Bsdf,
+                 wo: Vec3,
+                 path_length: f32,
+                 dispersed: bool,
+                 left: u32,
+                 _caustic_only: bool,
+                 rng: &mut Rng| {
+                    let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
+                    let min_left = needed_bounces_left(s.max_depth, left);
+                    let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
+                    if bsdf.is_phase() {
+                        // In a medium: the volume photons within a ball, as ppm gathers them.
+                        let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
+                        let indirect = &maps.volume_indirect;
+                        return direct
+                            + indirect.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
+                    }
+                    direct
+                        + maps
+                            .caustic
+                            .radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
+                },
+                |hit, sample, path_length, dispersed, left, rng| {
+                    if hit.is_in_medium() {
+                        // The volume photons counted the rest.
+                        return if self.mis {
+                            sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
+                        } else {
+                            Spectrum::ZERO
+                        };
+                    }
+                    let origin = hit.ray_origin(sample.wi);
+                    let gather = Gather {
+                        from: Some((hit.point, sample.pdf)),
+                        path_length,
+                        dispersed,
+                        level: 0,
+                        left,
+                        medium: hit.media.towards(hit.geometric_normal, sample.wi),
                     };
-                }
-                let origin = hit.ray_origin(sample.wi);
-                let gather = Gather {
-                    from: Some((hit.point, sample.pdf)),
-                    path_length,
-                    dispersed,
-                    level: 0,
-                    left,
-                    medium: hit.media.towards(hit.geometric_normal, sample.wi),
-                };
-                sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
-            },
+                    sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
+                },
+            ),
+            &mut NoAlong,
         )
     }
 

@@ -11,16 +11,18 @@
 
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::camera_chain;
+use super::specular_chain::{camera_chain, Along};
 use super::tiles::sample_pass;
 use super::Progressive;
+use crate::bsdf::{Bsdf, BsdfSample};
 use crate::math::{Ray, Vec3};
+use crate::photon::light_walk::Passage;
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left, Photon};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of progressive photon mapping.
@@ -170,26 +172,126 @@ impl<'a> Ppm<'a> {
             (self.settings.specular_camera_paths, self.settings.glossy_camera_paths),
             wl,
             rng,
-            |hit, bsdf, wo, path_length, dispersed, left, caustic_only, rng| {
-                let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
-                let min_left = needed_bounces_left(self.settings.max_depth, left);
-                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
-                if bsdf.is_phase() {
-                    // In a medium: the volume photons within a ball of the same radius.
-                    let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
-                    return direct + volume.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
-                }
-                let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
-                direct + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
-            },
-            |hit, sample, _, _, _, rng| {
-                if self.mis {
-                    sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
-                } else {
-                    Spectrum::ZERO
-                }
+            (
+                |hit: &SurfaceHit,
+                 bsdf: &Bsdf,
+                 wo: Vec3,
+                 path_length: f32,
+                 dispersed: bool,
+                 left: u32,
+                 caustic_only: bool,
+                 rng: &mut Rng| {
+                    let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
+                    let min_left = needed_bounces_left(self.settings.max_depth, left);
+                    let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
+                    if bsdf.is_phase() {
+                        // In a medium: the volume photons within a ball of the same radius.
+                        let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
+                        return direct
+                            + volume.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
+                    }
+                    let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
+                    direct + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
+                },
+                |hit: &SurfaceHit, sample: &BsdfSample, _: f32, _: bool, _: u32, rng: &mut Rng| {
+                    if self.mis {
+                        sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
+                    } else {
+                        Spectrum::ZERO
+                    }
+                },
+            ),
+            &mut Beams {
+                ppm: self,
+                volume,
+                radius_factor,
+                wl,
             },
         )
+    }
+}
+
+/// ppm's beam queries ([`Along`]): a camera path passes the media before its first smooth
+/// surface and gathers along each segment next-event estimation at one point a free flight picks
+/// (light straight from a light) and the volume photons within the pass's radius of the ray
+/// (the rest; the beam radiance estimate, Jarosz et al. 2008), each dimmed on its way to the
+/// segment's start. The radius is the surfaces' (pixels wide at each point's distance).
+struct Beams<'p, 'a> {
+    ppm: &'p Ppm<'a>,
+    volume: &'p PhotonMap,
+    radius_factor: f32,
+    wl: &'p Wavelengths,
+}
+
+impl Along for Beams<'_, '_> {
+    fn passes(&self, medium: u32) -> bool {
+        let medium = self.ppm.scene.medium(medium);
+        !self.volume.is_empty() && !medium.only_absorbs() && !medium.is_clear()
+    }
+
+    fn gather(
+        &mut self,
+        ray: &Ray,
+        passage: &Passage,
+        (_, dispersed): (Spectrum, bool),
+        (path_length, left): (f32, u32),
+        rng: &mut Rng,
+    ) -> Spectrum {
+        let (ppm, wl) = (self.ppm, self.wl);
+        let scene = ppm.scene;
+        let dir = ray.dir.normalize();
+        let ray = Ray::new(ray.origin, dir);
+        let wo = -dir;
+        let min_left = needed_bounces_left(ppm.settings.max_depth, left);
+        let radius = |t: f32| ppm.settings.initial_radius.at(ppm.pixel_angle, path_length + t) * self.radius_factor;
+        let mut l = Spectrum::ZERO;
+        // What the media before the stretch keep.
+        let mut kept = wl.grey(1.0);
+        let mut steps = Vec::new();
+        passage.pieces(scene, &ray, |id, t0, t1| {
+            let medium = scene.medium(id);
+            if !self.passes(id) {
+                kept *= medium.transmittance(&ray, (t0, t1), wl, rng);
+                return;
+            }
+            let phase = Bsdf::phase(medium.phase.g, wo, wl);
+            let mut carried = kept;
+            if let Some(t) = medium.sample_flight(&ray, (t0, t1), wl, &mut carried, rng) {
+                // Nothing is sampled from this point on: the light sample counts in full.
+                let hit = SurfaceHit::in_medium(ray.at(t), id);
+                l += carried * direct_light(scene, &hit, &phase, wo, false, wl, rng);
+            }
+            medium.transmittance_steps(&ray, (t0, t1), wl, rng, &mut steps);
+            let step_at = |t: f32| match steps.partition_point(|s| s.0 <= t) {
+                0 => wl.grey(1.0),
+                i => steps[i - 1].1,
+            };
+            let homogeneous = medium.grid.is_none();
+            // As vcm's beams: a radius beyond the ends makes up for a boundary met obliquely.
+            let reach = radius(t1);
+            let span = (t0 - if t0 > 0.0 { reach } else { 0.0 }, t1 + reach);
+            l += self.volume.in_scattered_along(
+                (ray.origin, dir),
+                span,
+                (reach, |t: f32| radius(t.clamp(t0, t1))),
+                (&phase, wo),
+                (min_left, dispersed),
+                |t| {
+                    let t = t.clamp(t0, t1);
+                    kept * if homogeneous {
+                        medium.transmittance(&ray, (t0, t), wl, rng)
+                    } else {
+                        step_at(t)
+                    }
+                },
+            );
+            kept *= if homogeneous {
+                medium.transmittance(&ray, (t0, t1), wl, rng)
+            } else {
+                step_at(t1)
+            };
+        });
+        l
     }
 }
 

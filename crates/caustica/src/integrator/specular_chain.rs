@@ -4,7 +4,7 @@
 use super::camera_walk::{bounce_as_surface, visit_as_surface, walk_camera, CameraArrival, CameraVisitor};
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
-use crate::photon::light_walk::MediumArrival;
+use crate::photon::light_walk::{MediumArrival, Passage};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -29,6 +29,9 @@ use crate::spectrum::{Spectrum, Wavelengths};
 /// diffuse bounce, which a photon estimate would weigh by the lobe's peak, is found further
 /// along instead; emitters and the sky the path meets after going on through the glossy lobe
 /// count no more (the BSDF sample there and those photons have counted them).
+///
+/// `along` may have the chain pass media up to its first smooth surface and gather the light
+/// scattered along the way instead ([`Along`]).
 #[allow(clippy::too_many_arguments)]
 pub fn camera_chain<S, B>(
     scene: &Scene,
@@ -37,8 +40,8 @@ pub fn camera_chain<S, B>(
     (through_specular, through_glossy): (bool, bool),
     wl: &Wavelengths,
     rng: &mut Rng,
-    at_smooth: S,
-    beyond: B,
+    (at_smooth, beyond): (S, B),
+    along: &mut dyn Along,
 ) -> Spectrum
 where
     S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum,
@@ -51,6 +54,8 @@ where
         through: (through_specular, through_glossy),
         at_smooth,
         beyond,
+        along,
+        smooth_seen: false,
         l: Spectrum::ZERO,
         path_length: 0.0,
         past_highlight: false,
@@ -59,6 +64,38 @@ where
     // No roulette: a chain ends at its first smooth surface, or after `max_depth` mirrors.
     walk_camera(scene, ray, wl, (max_depth.saturating_add(1), u32::MAX), rng, &mut chain);
     chain.l
+}
+
+/// What a camera chain gathers along its segments through media before its first smooth
+/// surface, passing those media without stopping (`ppm`'s beam queries).
+pub trait Along {
+    /// Whether the chain passes `medium` and gathers along it.
+    fn passes(&self, medium: u32) -> bool;
+
+    /// The light gathered along `ray` (from the chain's last vertex, `path_length` from the
+    /// eye), the chain carrying `(throughput, dispersed)`, light gathered there having
+    /// scattered at most `left` more times.
+    fn gather(
+        &mut self,
+        ray: &Ray,
+        passage: &Passage,
+        carried: (Spectrum, bool),
+        path_length_left: (f32, u32),
+        rng: &mut Rng,
+    ) -> Spectrum;
+}
+
+/// Nothing along the way: the chain stops in media by free flights, as anywhere.
+pub struct NoAlong;
+
+impl Along for NoAlong {
+    fn passes(&self, _medium: u32) -> bool {
+        false
+    }
+
+    fn gather(&mut self, _: &Ray, _: &Passage, _: (Spectrum, bool), _: (f32, u32), _: &mut Rng) -> Spectrum {
+        Spectrum::ZERO
+    }
 }
 
 /// A camera chain on its walk (see [`camera_chain`]).
@@ -79,6 +116,9 @@ struct Chain<'c, S, B> {
     past_highlight: bool,
     /// The surface reached is the chain's last: its sample is drawn, but not followed.
     last: bool,
+    along: &'c mut dyn Along,
+    /// A smooth surface was reached: no more gathering along segments.
+    smooth_seen: bool,
 }
 
 impl<S, B> CameraVisitor for Chain<'_, S, B>
@@ -93,9 +133,23 @@ where
         }
     }
 
+    fn passes(&self, medium: u32) -> bool {
+        !self.smooth_seen && self.along.passes(medium)
+    }
+
+    fn segment(&mut self, ray: &Ray, passage: &Passage, carried: (Spectrum, bool), length: u32, rng: &mut Rng) {
+        let depth = length - 1;
+        if self.smooth_seen || depth > self.max_depth {
+            return;
+        }
+        let left = self.max_depth - depth;
+        self.l += carried.0 * self.along.gather(ray, passage, carried, (self.path_length, left), rng);
+    }
+
     fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
         let (hit, bsdf, wo) = (at.hit, at.bsdf, at.wo);
         self.path_length += at.t;
+        self.smooth_seen |= bsdf.is_smooth();
         // Only the camera and specular chains reach here: emission counts in full.
         if !self.past_highlight {
             self.l += at.throughput * super::direct::emitted(self.scene, hit, wo, self.wl);

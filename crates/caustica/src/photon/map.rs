@@ -476,6 +476,38 @@ impl PhotonMap {
         Spectrum::select(sigma_s.cmpgt(Spectrum::ZERO), density / sigma_s, Spectrum::ZERO)
     }
 
+    /// The beam radiance estimate: light scattered towards `wo` along the segment
+    /// `origin + t dir` (`dir` unit, `t` within `span`) from the volume photons square to it
+    /// within `radius(t)` (at most `max_radius`) that may still bounce `min_left` times: each
+    /// one's power through `phase`, times `kept(t)` (what reaches the segment's start from
+    /// there), over π radius(t)².
+    #[allow(clippy::too_many_arguments)]
+    pub fn in_scattered_along(
+        &self,
+        (origin, dir): (Vec3, Vec3),
+        span: (f32, f32),
+        (max_radius, radius): (f32, impl Fn(f32) -> f32),
+        (phase, wo): (&Bsdf, Vec3),
+        (min_left, dispersed): (u8, bool),
+        mut kept: impl FnMut(f32) -> Spectrum,
+    ) -> Spectrum {
+        if self.photons.is_empty() || max_radius.is_nan() || max_radius <= 0.0 {
+            return Spectrum::ZERO;
+        }
+        let mut sum = Spectrum::ZERO;
+        self.tree
+            .for_each_near_segment(&self.photons, (origin, dir), span, max_radius, |slot, t, d2| {
+                let photon = &self.photons[slot as usize];
+                let r = radius(t);
+                if d2 >= r * r || photon.bounces_left() < min_left {
+                    return;
+                }
+                let light = phase.eval(wo, -photon.direction()) * photon_power(photon, dispersed);
+                sum += kept(t) * light / (PI * r * r);
+            });
+        sum
+    }
+
     /// Reflected radiance at `point` towards `wo` from the `k` nearest photons within
     /// `max_radius`, the radius being the distance to the k-th.
     pub fn radiance_nearest(
