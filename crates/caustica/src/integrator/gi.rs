@@ -34,7 +34,7 @@ use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::{Scene, SurfaceHit};
+use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of the photon-map global illumination integrator.
@@ -173,14 +173,7 @@ impl<'a> Gi<'a> {
             wl,
             rng,
             (
-                |hit: &SurfaceHit,
-                 bsdf: &Bsdf,
-                 wo: Vec3,
-                 path_length: f32,
-                 dispersed: bool,
-                 left: u32,
-                 _caustic_only: bool,
-                 rng: &mut Rng| {
+                |hit, bsdf, wo, path_length, dispersed, left, _caustic_only, rng| {
                     let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
                     let min_left = needed_bounces_left(s.max_depth, left);
                     let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);

@@ -14,7 +14,7 @@ use super::radius::{pixel_angle, radius_factor, InitialRadius};
 use super::specular_chain::{camera_chain, Along};
 use super::tiles::sample_pass;
 use super::Progressive;
-use crate::bsdf::{Bsdf, BsdfSample};
+use crate::bsdf::Bsdf;
 use crate::math::{Ray, Vec3};
 use crate::photon::light_walk::Passage;
 use crate::photon::map::PhotonMap;
@@ -173,14 +173,7 @@ impl<'a> Ppm<'a> {
             wl,
             rng,
             (
-                |hit: &SurfaceHit,
-                 bsdf: &Bsdf,
-                 wo: Vec3,
-                 path_length: f32,
-                 dispersed: bool,
-                 left: u32,
-                 caustic_only: bool,
-                 rng: &mut Rng| {
+                |hit, bsdf, wo, path_length, dispersed, left, caustic_only, rng| {
                     let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
                     let min_left = needed_bounces_left(self.settings.max_depth, left);
                     let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
@@ -193,7 +186,7 @@ impl<'a> Ppm<'a> {
                     let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
                     direct + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
                 },
-                |hit: &SurfaceHit, sample: &BsdfSample, _: f32, _: bool, _: u32, rng: &mut Rng| {
+                |hit, sample, _, _, _, rng| {
                     if self.mis {
                         sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
                     } else {
