@@ -307,15 +307,21 @@ impl Medium {
             return wl.grey(1.0);
         }
         let Some(grid) = &self.grid else {
-            if self.only_absorbs() {
-                return beer_lambert(self.sigma_a, t1 - t0, wl);
-            }
-            let (_, sigma_t) = self.coefficients(wl);
-            return kept(sigma_t, t1 - t0);
+            return self.kept_homogeneous(t1 - t0, wl);
         };
         let mut tr = wl.grey(1.0);
         self.ratio_tracking(grid, ray, (t0, t1), wl, rng, |_, kept| tr = kept);
         tr
+    }
+
+    /// What light keeps over `distance` of the medium were it homogeneous (its grid left out):
+    /// exp(−σt d).
+    pub fn kept_homogeneous(&self, distance: f32, wl: &Wavelengths) -> Spectrum {
+        if self.only_absorbs() {
+            return beer_lambert(self.sigma_a, distance, wl);
+        }
+        let (_, sigma_t) = self.coefficients(wl);
+        kept(sigma_t, distance)
     }
 
     /// What light keeps along `ray` from `t0` to every point up to `t1`, at once: an unbiased

@@ -238,52 +238,32 @@ impl Along for Beams<'_, '_> {
         let min_left = needed_bounces_left(ppm.settings.max_depth, left);
         let radius = |t: f32| ppm.settings.initial_radius.at(ppm.pixel_angle, path_length + t) * self.radius_factor;
         let mut l = Spectrum::ZERO;
-        // What the media before the stretch keep.
-        let mut kept = wl.grey(1.0);
-        let mut steps = Vec::new();
-        passage.pieces(scene, &ray, |id, t0, t1| {
-            let medium = scene.medium(id);
-            if !self.passes(id) {
-                kept *= medium.transmittance(&ray, (t0, t1), wl, rng);
-                return;
-            }
-            let phase = Bsdf::phase(medium.phase.g, wo, wl);
-            let mut carried = kept;
-            if let Some(t) = medium.sample_flight(&ray, (t0, t1), wl, &mut carried, rng) {
-                // Nothing is sampled from this point on: the light sample counts in full.
-                let hit = SurfaceHit::in_medium(ray.at(t), id);
-                l += carried * direct_light(scene, &hit, &phase, wo, false, wl, rng);
-            }
-            medium.transmittance_steps(&ray, (t0, t1), wl, rng, &mut steps);
-            let step_at = |t: f32| match steps.partition_point(|s| s.0 <= t) {
-                0 => wl.grey(1.0),
-                i => steps[i - 1].1,
-            };
-            let homogeneous = medium.grid.is_none();
-            // As vcm's beams: a radius beyond the ends makes up for a boundary met obliquely.
-            let reach = radius(t1);
-            let span = (t0 - if t0 > 0.0 { reach } else { 0.0 }, t1 + reach);
-            l += self.volume.in_scattered_along(
-                (ray.origin, dir),
-                span,
-                (reach, |t: f32| radius(t.clamp(t0, t1))),
-                (&phase, wo),
-                (min_left, dispersed),
-                |t| {
-                    let t = t.clamp(t0, t1);
-                    kept * if homogeneous {
-                        medium.transmittance(&ray, (t0, t), wl, rng)
-                    } else {
-                        step_at(t)
-                    }
-                },
-            );
-            kept *= if homogeneous {
-                medium.transmittance(&ray, (t0, t1), wl, rng)
-            } else {
-                step_at(t1)
-            };
-        });
+        passage.along_media(
+            scene,
+            &ray,
+            wl,
+            rng,
+            |id| self.passes(id),
+            |stretch, rng| {
+                let (medium, (t0, t1)) = (stretch.medium, stretch.span);
+                let phase = Bsdf::phase(medium.phase.g, wo, wl);
+                let mut carried = stretch.before;
+                if let Some(t) = medium.sample_flight(&ray, (t0, t1), wl, &mut carried, rng) {
+                    // Nothing is sampled from this point on: the light sample counts in full.
+                    let hit = SurfaceHit::in_medium(ray.at(t), stretch.id);
+                    l += carried * direct_light(scene, &hit, &phase, wo, false, wl, rng);
+                }
+                let reach = radius(t1);
+                l += self.volume.in_scattered_along(
+                    (ray.origin, dir),
+                    stretch.reach(reach),
+                    (reach, |t: f32| radius(t.clamp(t0, t1))),
+                    (&phase, wo),
+                    (min_left, dispersed),
+                    |t| stretch.kept(t),
+                );
+            },
+        );
         l
     }
 }

@@ -11,7 +11,7 @@
 
 use crate::bsdf::{adjoint_correction, Bsdf, BsdfSample, Transport};
 use crate::math::Ray;
-use crate::medium::{Media, Phase, VACUUM};
+use crate::medium::{Media, Medium, Phase, VACUUM};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -249,6 +249,42 @@ impl Passage {
         }
     }
 
+    /// Walks the media along `ray` (unit direction) as [`Passage::pieces`] finds them, for a
+    /// camera ray that passes them and gathers the light scattered along its way (the beam
+    /// queries of vcm and ppm): `f(stretch, rng)` for each stretch of a medium for which
+    /// `gathers` holds, which reads what light keeps from the ray's origin to any point of it;
+    /// the media of the other stretches only dim those after them.
+    pub fn along_media(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        gathers: impl Fn(u32) -> bool,
+        mut f: impl FnMut(&Stretch, &mut Rng),
+    ) {
+        let mut before = wl.grey(1.0);
+        let mut steps = Vec::new();
+        self.pieces(scene, ray, |id, t0, t1| {
+            let medium = scene.medium(id);
+            if !gathers(id) {
+                before *= medium.transmittance(ray, (t0, t1), wl, rng);
+                return;
+            }
+            medium.transmittance_steps(ray, (t0, t1), wl, rng, &mut steps);
+            let stretch = Stretch {
+                id,
+                medium,
+                span: (t0, t1),
+                before,
+                steps: &steps,
+                wl,
+            };
+            f(&stretch, rng);
+            before = stretch.kept(t1);
+        });
+    }
+
     /// After a bounce at the surface `hit` that goes on along `sample`: through the surface,
     /// the walk is in the medium beyond it.
     #[inline]
@@ -256,6 +292,47 @@ impl Passage {
         if sample.transmitted && scene.has_media() {
             self.medium = scene.medium_beyond(hit, sample.wi, self.medium, &mut self.outer);
         }
+    }
+}
+
+/// A stretch of one medium along a ray ([`Passage::along_media`]).
+pub struct Stretch<'s> {
+    /// The medium's number.
+    pub id: u32,
+    /// The medium.
+    pub medium: &'s Medium,
+    /// Where it starts and ends along the ray.
+    pub span: (f32, f32),
+    /// What the media before it keep.
+    pub before: Spectrum,
+    /// A density grid's transmittance from the start, a step function (empty: homogeneous).
+    steps: &'s [(f32, Spectrum)],
+    wl: &'s Wavelengths,
+}
+
+impl Stretch<'_> {
+    /// What light keeps from the ray's origin to `t` (held within the stretch).
+    pub fn kept(&self, t: f32) -> Spectrum {
+        let (t0, t1) = self.span;
+        let t = t.clamp(t0, t1);
+        self.before
+            * if self.medium.grid.is_none() {
+                self.medium.kept_homogeneous(t - t0, self.wl)
+            } else {
+                match self.steps.partition_point(|s| s.0 <= t) {
+                    0 => self.wl.grey(1.0),
+                    i => self.steps[i - 1].1,
+                }
+            }
+    }
+
+    /// Where a beam query of `radius` looks: a radius beyond where the medium starts at a surface
+    /// (not at the ray's origin) and where it ends. Met obliquely, the tube around the ray
+    /// reaches past such a surface on one side and misses the medium's light on the other; the
+    /// light beyond the ends makes up for it (exactly, for a flat boundary met at up to 45°).
+    pub fn reach(&self, radius: f32) -> (f32, f32) {
+        let (t0, t1) = self.span;
+        (t0 - if t0 > 0.0 { radius } else { 0.0 }, t1 + radius)
     }
 }
 

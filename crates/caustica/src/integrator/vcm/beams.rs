@@ -66,16 +66,9 @@ impl Vcm<'_> {
         let (f, radius) = (&pass.factors, pass.radius);
         let vertices = &pass.paths.volume_vertices;
         let (mut merged, mut direct) = (Spectrum::ZERO, Spectrum::ZERO);
-        // What the media before the stretch keep.
-        let mut kept = wl.grey(1.0);
-        // A density grid's transmittance from the stretch's start, as a step function.
-        let mut steps = Vec::new();
-        passage.pieces(self.scene, &ray, |id, t0, t1| {
-            let medium = self.scene.medium(id);
-            if !self.merges_in_medium(id) {
-                kept *= medium.transmittance(&ray, (t0, t1), wl, rng);
-                return;
-            }
+        let gathers = |id| self.merges_in_medium(id);
+        passage.along_media(self.scene, &ray, wl, rng, gathers, |stretch, rng| {
+            let (id, medium, (t0, t1)) = (stretch.id, stretch.medium, stretch.span);
             let sigma = medium.majorant();
             let at = |t: f32| {
                 let mut at = *camera;
@@ -83,7 +76,7 @@ impl Vcm<'_> {
                 at
             };
             // Next-event estimation where a free flight stops (it goes no further).
-            let mut carried = kept;
+            let mut carried = stretch.before;
             if length < self.max_length {
                 if let Some(t) = medium.sample_flight(&ray, (t0, t1), wl, &mut carried, rng) {
                     let hit = SurfaceHit::in_medium(ray.at(t), id);
@@ -101,17 +94,7 @@ impl Vcm<'_> {
                     direct += self.direct(&v, f, wl, rng, work);
                 }
             }
-            medium.transmittance_steps(&ray, (t0, t1), wl, rng, &mut steps);
-            let step_at = |t: f32| match steps.partition_point(|s| s.0 <= t) {
-                0 => wl.grey(1.0),
-                i => steps[i - 1].1,
-            };
-            // Where the medium starts or ends at a surface met obliquely, the tube around the ray
-            // reaches past it on one side of the ray and misses the medium's light on the other:
-            // the light vertices within a radius beyond the ends make up for it (exactly, for a
-            // flat boundary met at up to 45°).
-            let reach_before = if t0 > 0.0 { radius } else { 0.0 };
-            let span = (t0 - reach_before, t1 + radius);
+            let span = stretch.reach(radius);
             pass.volume_tree
                 .for_each_near_segment(vertices, (ray.origin, dir), span, radius, |slot, t, _| {
                     work.candidates += 1;
@@ -120,21 +103,11 @@ impl Vcm<'_> {
                         return;
                     }
                     let t = t.clamp(t0, t1);
-                    let tr = kept
-                        * if medium.grid.is_some() {
-                            step_at(t)
-                        } else {
-                            medium.transmittance(&ray, (t0, t), wl, rng)
-                        };
                     let phase = medium.phase.eval(wo, z.wo);
                     let weight = mis::beam(f, &at(t), direct_share(z.direct, sigma, t));
-                    merged += tr * z.throughput * (phase * weight * both_dispersed(dispersed, z.dispersed));
+                    merged +=
+                        stretch.kept(t) * z.throughput * (phase * weight * both_dispersed(dispersed, z.dispersed));
                 });
-            kept *= if medium.grid.is_some() {
-                step_at(t1)
-            } else {
-                medium.transmittance(&ray, (t0, t1), wl, rng)
-            };
         });
         let merged = merged / (std::f32::consts::PI * radius * radius * f.light_paths);
         throughput * (merged + direct)
