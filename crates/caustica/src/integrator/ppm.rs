@@ -230,6 +230,10 @@ impl Along for Beams<'_, '_> {
         (path_length, left): (f32, u32),
         rng: &mut Rng,
     ) -> Spectrum {
+        if self.volume.is_empty() {
+            // No medium is passed (no ray to cast for its stretches).
+            return Spectrum::ZERO;
+        }
         let (ppm, wl) = (self.ppm, self.wl);
         let scene = ppm.scene;
         let dir = ray.dir.normalize();

@@ -248,6 +248,9 @@ pub struct Vcm<'a> {
     seed: u64,
     sensor: Sensor,
     emitters: Emitters,
+    /// Some medium scatters (beam queries have something to gather; a glass that only absorbs
+    /// casts no ray for them).
+    scatters: bool,
     /// Where a share of the light subpaths' diffuse bounces is aimed.
     bounce_aim: Option<Aim>,
     spectral: bool,
@@ -331,6 +334,7 @@ impl<'a> Vcm<'a> {
                 None
             },
             spectral: settings_spectral(&settings.spectral, scene),
+            scatters: settings.beams && scene.scatters(),
             // Segments: one more than the surfaces light may scatter at.
             max_length: super::config::scattering_surfaces(settings.max_depth).saturating_add(1),
             pilot_radius: radius,

@@ -191,7 +191,7 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
 impl CameraSubpath<'_, '_> {
     /// Whether the path's segments gather light by beam queries: before its first smooth vertex.
     fn gathers_beams(&self) -> bool {
-        !self.smooth_before && self.pass.factors.merge > 0.0
+        !self.smooth_before && self.pass.factors.merge > 0.0 && self.vcm.scatters
     }
 }
 
