@@ -4,7 +4,10 @@ smoke. The smoke is a pbrt-v4 `uniformgrid` density (puffs of smoke summed on a 
 the bottle a glass ball of index 1.33; the ball focuses the lamp into a beam that lights the
 smoke in front of it and a caustic on the table.
 
-    scripts/scenes/smoke.py [OUT]
+With --puff it writes instead one small, dense puff in an otherwise empty box (no haze): the
+sparse grid the benchmarks use for the majorant grid (BENCHMARKS.md, "Density grids").
+
+    scripts/scenes/smoke.py [--puff] [OUT]
 """
 import math
 import sys
@@ -22,16 +25,20 @@ PUFFS = [
 ]
 
 
-def density(x, y, z):
-    d = 0.15  # a thin haze everywhere in the box
-    for (cx, cy, cz), r, a in PUFFS:
+# The sparse variant: one dense puff, nothing around it.
+PUFF = [((-0.3, 0.9, 0.0), 0.35, 12.0)]
+
+
+def density(x, y, z, puffs=None):
+    d = 0.15 if puffs is None else 0.0  # a thin haze everywhere in the box
+    for (cx, cy, cz), r, a in PUFFS if puffs is None else puffs:
         q = ((x - cx) ** 2 + (y - cy) ** 2 + (z - cz) ** 2) / (r * r)
         d += a * math.exp(-2.0 * q)
     # Thinner towards the top, as smoke rising and spreading.
     return d * (1.0 - 0.3 * y / BOX[1][1])
 
 
-def grid():
+def grid(puffs=None):
     (x0, y0, z0), (x1, y1, z1) = BOX
     values = []
     for k in range(NZ):
@@ -40,12 +47,12 @@ def grid():
                 x = x0 + (x1 - x0) * (i + 0.5) / NX
                 y = y0 + (y1 - y0) * (j + 0.5) / NY
                 z = z0 + (z1 - z0) * (k + 0.5) / NZ
-                values.append(f"{density(x, y, z):.4f}")
+                values.append(f"{density(x, y, z, puffs):.4f}")
     return values
 
 
-def scene():
-    values = grid()
+def scene(puffs=None):
+    values = grid(puffs)
     rows = "\n        ".join(" ".join(values[i:i + 20]) for i in range(0, len(values), 20))
     (x0, y0, z0), (x1, y1, z1) = BOX
     return f"""# pbrt-v4, written by scripts/scenes/smoke.py: a lamp behind a round bottle of water on a
@@ -81,6 +88,10 @@ AttributeEnd
 
 
 if __name__ == "__main__":
-    out = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "scenes" / "smoke.pbrt"
-    out.write_text(scene())
+    args = sys.argv[1:]
+    puffs = PUFF if "--puff" in args else None
+    args = [a for a in args if a != "--puff"]
+    name = "smoke_puff.pbrt" if puffs else "smoke.pbrt"
+    out = Path(args[0]) if args else Path(__file__).resolve().parents[2] / "scenes" / name
+    out.write_text(scene(puffs))
     print(f"wrote {out}")

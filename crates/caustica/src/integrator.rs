@@ -8,6 +8,7 @@
 //!   passes that converge: a path tracer, progressive photon mapping, Jensen's photon mapping
 //!   with final gathering, light tracing, vertex connection and merging.
 
+pub mod beam_estimate;
 pub mod camera_walk;
 pub mod config;
 pub mod darkness;

@@ -16,14 +16,16 @@
 //! estimation and the caustic map already count those paths.
 //!
 //! In media, photons are also stored where they scatter (Jensen's volume photon map): a camera
-//! path that scatters in a medium takes next-event estimation and the volume photons that did
-//! not come straight from a light within a ball (as `ppm` does), and a gather ray that scatters
-//! reads every volume photon there, as it reads the global map on a surface.
+//! path passes the media before its first smooth surface and gathers along the way, as `ppm`
+//! does, next-event estimation and the volume photons that did not come straight from a light
+//! (the beam radiance estimate, [`BeamEstimate`]); a gather ray that scatters reads every
+//! volume photon there, as it reads the global map on a surface.
 
+use super::beam_estimate::BeamEstimate;
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light, emitted, power_heuristic};
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::{camera_chain, NoAlong};
+use super::specular_chain::camera_chain;
 use super::tiles::sample_pass;
 use super::Progressive;
 use crate::bsdf::{Bsdf, Transport};
@@ -210,7 +212,15 @@ impl<'a> Gi<'a> {
                     sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
                 },
             ),
-            &mut NoAlong,
+            &mut BeamEstimate {
+                scene: self.scene,
+                volume: &maps.volume_indirect,
+                radius: s.caustic_radius,
+                pixel_angle: self.pixel_angle,
+                factor: maps.caustic_factor,
+                max_depth: s.max_depth,
+                wl,
+            },
         )
     }
 

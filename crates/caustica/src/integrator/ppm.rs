@@ -9,20 +9,19 @@
 //! light comes from next-event estimation and everything else (caustics, indirect diffuse light)
 //! from the photons within the pass's radius.
 
+use super::beam_estimate::BeamEstimate;
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::{camera_chain, Along};
+use super::specular_chain::camera_chain;
 use super::tiles::sample_pass;
 use super::Progressive;
-use crate::bsdf::Bsdf;
 use crate::math::{Ray, Vec3};
-use crate::photon::light_walk::Passage;
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left, Photon};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::{Scene, SurfaceHit};
+use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of progressive photon mapping.
@@ -194,81 +193,16 @@ impl<'a> Ppm<'a> {
                     }
                 },
             ),
-            &mut Beams {
-                ppm: self,
+            &mut BeamEstimate {
+                scene: self.scene,
                 volume,
-                radius_factor,
+                radius: self.settings.initial_radius,
+                pixel_angle: self.pixel_angle,
+                factor: radius_factor,
+                max_depth: self.settings.max_depth,
                 wl,
             },
         )
-    }
-}
-
-/// ppm's beam queries ([`Along`]): a camera path passes the media before its first smooth
-/// surface and gathers along each segment next-event estimation at one point a free flight picks
-/// (light straight from a light) and the volume photons within the pass's radius of the ray
-/// (the rest; the beam radiance estimate, Jarosz et al. 2008), each dimmed on its way to the
-/// segment's start. The radius is the surfaces' (pixels wide at each point's distance).
-struct Beams<'p, 'a> {
-    ppm: &'p Ppm<'a>,
-    volume: &'p PhotonMap,
-    radius_factor: f32,
-    wl: &'p Wavelengths,
-}
-
-impl Along for Beams<'_, '_> {
-    fn passes(&self, medium: u32) -> bool {
-        let medium = self.ppm.scene.medium(medium);
-        !self.volume.is_empty() && !medium.only_absorbs() && !medium.is_clear()
-    }
-
-    fn gather(
-        &mut self,
-        ray: &Ray,
-        passage: &Passage,
-        (_, dispersed): (Spectrum, bool),
-        (path_length, left): (f32, u32),
-        rng: &mut Rng,
-    ) -> Spectrum {
-        if self.volume.is_empty() {
-            // No medium is passed (no ray to cast for its stretches).
-            return Spectrum::ZERO;
-        }
-        let (ppm, wl) = (self.ppm, self.wl);
-        let scene = ppm.scene;
-        let dir = ray.dir.normalize();
-        let ray = Ray::new(ray.origin, dir);
-        let wo = -dir;
-        let min_left = needed_bounces_left(ppm.settings.max_depth, left);
-        let radius = |t: f32| ppm.settings.initial_radius.at(ppm.pixel_angle, path_length + t) * self.radius_factor;
-        let mut l = Spectrum::ZERO;
-        passage.along_media(
-            scene,
-            &ray,
-            wl,
-            rng,
-            |id| self.passes(id),
-            |stretch, rng| {
-                let (medium, (t0, t1)) = (stretch.medium, stretch.span);
-                let phase = Bsdf::phase(medium.phase.g, wo, wl);
-                let mut carried = stretch.before;
-                if let Some(t) = medium.sample_flight(&ray, (t0, t1), wl, &mut carried, rng) {
-                    // Nothing is sampled from this point on: the light sample counts in full.
-                    let hit = SurfaceHit::in_medium(ray.at(t), stretch.id);
-                    l += carried * direct_light(scene, &hit, &phase, wo, false, wl, rng);
-                }
-                let reach = radius(t1);
-                l += self.volume.in_scattered_along(
-                    (ray.origin, dir),
-                    stretch.reach(reach),
-                    (reach, |t: f32| radius(t.clamp(t0, t1))),
-                    (&phase, wo),
-                    (min_left, dispersed),
-                    |t| stretch.kept(t),
-                );
-            },
-        );
-        l
     }
 }
 

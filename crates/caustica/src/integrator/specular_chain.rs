@@ -67,7 +67,7 @@ where
 }
 
 /// What a camera chain gathers along its segments through media before its first smooth
-/// surface, passing those media without stopping (`ppm`'s beam queries).
+/// surface, passing those media without stopping ([`BeamEstimate`](super::beam_estimate::BeamEstimate)).
 pub trait Along {
     /// Whether the chain passes `medium` and gathers along it.
     fn passes(&self, medium: u32) -> bool;
@@ -83,19 +83,6 @@ pub trait Along {
         path_length_left: (f32, u32),
         rng: &mut Rng,
     ) -> Spectrum;
-}
-
-/// Nothing along the way: the chain stops in media by free flights, as anywhere.
-pub struct NoAlong;
-
-impl Along for NoAlong {
-    fn passes(&self, _medium: u32) -> bool {
-        false
-    }
-
-    fn gather(&mut self, _: &Ray, _: &Passage, _: (Spectrum, bool), _: (f32, u32), _: &mut Rng) -> Spectrum {
-        Spectrum::ZERO
-    }
 }
 
 /// A camera chain on its walk (see [`camera_chain`]).

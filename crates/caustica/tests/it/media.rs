@@ -252,7 +252,7 @@ fn an_albedo_one_medium_in_a_white_furnace_is_the_furnace() {
     // ppm's ball of photons loses what lies past the medium's edge: at 8 px its radius (a
     // pixel's footprint) is a fifth of the ball's and the image 12% dark; at 128 px, 0.5%. So
     // do vcm's beam queries (their tube near the curved edge): 8% dark at 8 px, 1.1% at 128,
-    // and gi's (ppm's estimate at camera paths' scattering points, and at its gather rays').
+    // and gi's (ppm's beam queries, and its gather rays' balls: none here, with no surface).
     for (integrator, size, passes, photons) in [
         ("path", 8, 256, 0),
         ("vcm", 128, 64, 4_000),
