@@ -48,7 +48,12 @@ def command(renderer, scene, budget, seed, out, ref, caustica, extra=()):
     if renderer.startswith('mi-'):
         return [sys.executable, os.path.join(HERE, 'mitsuba_render.py'), scene, integ, str(budget),
                 '-o', out, '--seed', str(seed), '--ref-dir', ref, '--max-depth', str(MI_MAX_DEPTH), *extra]
-    return [caustica, 'render', os.path.join(ref, f'cornell_caustics_{scene}.ray'), '--model', 'physical',
+    if scene in SCENES:
+        source = [os.path.join(ref, f'cornell_caustics_{scene}.ray'), '--model', 'physical']
+    else:
+        import throughput_scenes
+        source = [throughput_scenes.caustica_scene(scene)]
+    return [caustica, 'render', *source,
             '--integrator', integ, '--time', str(budget), '--threads', '1', '--width', str(SIZE),
             '--depth', str(CS_DEPTH), '--seed', str(seed), '-o', out, '--json', *extra]
 

@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Render the shared reference's Cornell box with Mitsuba 3 for a time budget, on one core.
 
-usage: mitsuba_render.py {point|area} {ptracer|path} SECONDS -o OUT.exr [--seed S] [options]
+usage: mitsuba_render.py {point|area|glass|mesh} {ptracer|path} SECONDS -o OUT.exr [--seed S] [options]
 
-The scene is the reference's own: ../shared/reference/mitsuba_cornell_ref.py is executed with
-mi.load_dict intercepted, so its dict is captured without rendering or copying the script. Only
+The Cornell boxes (point, area) are the reference's own: ../shared/reference/mitsuba_cornell_ref.py is executed with
+mi.load_dict intercepted, so its dict is captured without rendering or copying the script; the
+throughput benchmark's glass and mesh scenes come from throughput_scenes.py. Only
 the integrator is replaced ({'type': ptracer|path, 'max_depth': 10}, the reference's cut).
 
 Passes of a fixed size (1 spp for ptracer, 4 for path: Dr.Jit's kernels bake the sample count in,
@@ -56,7 +57,8 @@ def scene_dict(mi, light, ref):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
-    ap.add_argument('scene', choices=common.SCENES)
+    import throughput_scenes
+    ap.add_argument('scene', choices=common.SCENES + throughput_scenes.SCENES)
     ap.add_argument('integrator', choices=common.MI_INTEGRATORS)
     ap.add_argument('seconds', type=float)
     ap.add_argument('-o', '--output', required=True)
@@ -80,7 +82,10 @@ def main():
     t_import = time.perf_counter() - T_START
 
     spp = a.spp_per_pass or (1 if a.integrator == 'ptracer' else 4)
-    d = scene_dict(mi, a.scene, common.ref_dir(a.ref_dir))
+    if a.scene in throughput_scenes.SCENES:
+        d = throughput_scenes.mitsuba_dict(mi, a.scene)
+    else:
+        d = scene_dict(mi, a.scene, common.ref_dir(a.ref_dir))
     d['integrator'] = {'type': a.integrator, 'max_depth': a.max_depth}
     t0 = time.perf_counter()
     scene = mi.load_dict(d)

@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """Camera paths per second on one core: caustica's path against Mitsuba 3's path (llvm_ad_rgb)
-on both reference scenes. The issue's target: caustica's path at least as fast as Mitsuba's.
+on both reference scenes (point, area) and the benchmark's own (glass: a glass ball over a floor
+under a small sphere light; mesh: a 1M-triangle ball there; throughput_scenes.py). The issue's
+target: caustica's path at least as fast as Mitsuba's.
 
 A camera path is one sample of one pixel: spp x 160 x 160 per run. Counted per wall second of
 the render (caustica: its --json render seconds; Mitsuba: its timed loop, warm kernels) and per
@@ -44,7 +46,7 @@ def table(rows):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n\n')[0])
-    ap.add_argument('--scenes', default='point,area', help='comma-separated (default: %(default)s)')
+    ap.add_argument('--scenes', default='point,area,glass,mesh', help='comma-separated (default: %(default)s)')
     ap.add_argument('--seconds', type=float, default=8, help='budget of each run (default: %(default)s)')
     ap.add_argument('--runs', type=int, default=2, help='runs of each setting, seeds 1..N (default: %(default)s)')
     ap.add_argument('--mi-spp-per-pass', default='4,16', help='Mitsuba pass sizes to try (default: %(default)s)')
