@@ -911,10 +911,33 @@ impl Scene {
             if !self.is_boundary(&isect) {
                 return Some((ray, isect));
             }
+            if let Some(solid) = self.solid_at_boundary(&ray, &isect) {
+                return Some((ray, solid));
+            }
             let boundary = self.surface(&ray, &isect);
             ray = Ray::new(boundary.ray_origin(ray.dir), ray.dir);
         }
         None
+    }
+
+    /// A surface that is not a boundary within a hair of the boundary hit `isect` along `ray`
+    /// (a floor that a cube of fog rests on, the cube's bottom face in the floor's plane): a
+    /// walk meets that surface there, inside the medium, instead of crossing the boundary —
+    /// past it, the continuing ray would start beyond the floor too. `None` without one.
+    pub fn solid_at_boundary(&self, ray: &Ray, isect: &Intersection) -> Option<Intersection> {
+        let point = ray.at(isect.t);
+        // A hair: a relative step, in units of the ray's direction.
+        let hair = 1e-4 * (1.0 + point.abs().max_element()) / ray.dir.length().max(1e-30);
+        let start = (isect.t - hair).max(0.0);
+        let probe = Ray::new(ray.at(start), ray.dir);
+        let mut solid: Option<Intersection> = None;
+        self.any_hit(&probe, isect.t + hair - start, |h| {
+            if !self.is_boundary(h) && solid.is_none_or(|s| h.t < s.t) {
+                solid = Some(*h);
+            }
+            false
+        });
+        solid.map(|s| Intersection { t: start + s.t, ..s })
     }
 
     /// Calls `visit(hit)` for each primitive the segment `(0, t_max)` meets (its nearest hit

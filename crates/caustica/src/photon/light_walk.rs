@@ -181,9 +181,14 @@ impl Passage {
                     return Step::Medium(hit);
                 }
             }
-            let Some(isect) = isect else {
+            let Some(mut isect) = isect else {
                 return Step::Escaped;
             };
+            if scene.is_boundary(&isect) {
+                if let Some(solid) = scene.solid_at_boundary(&ray, &isect) {
+                    isect = solid;
+                }
+            }
             let mut hit = scene.surface(&ray, &isect);
             if scene.is_boundary(&isect) {
                 self.medium = scene.medium_beyond(&hit, dir, self.medium, &mut self.outer);
@@ -235,7 +240,8 @@ impl Passage {
                     };
                 }
             }
-            let Some(isect) = isect.filter(|i| scene.is_boundary(i)) else {
+            let crossed = isect.filter(|i| scene.is_boundary(i) && scene.solid_at_boundary(&piece, i).is_none());
+            let Some(isect) = crossed else {
                 break;
             };
             let hit = scene.surface(&piece, &isect);
