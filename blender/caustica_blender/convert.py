@@ -223,9 +223,9 @@ class Conversion:
 
     def volume(self, output, what):
         """The medium an output node's Volume socket holds, as Cycles reads it: Volume Scatter
-        (σs = colour × density, g = anisotropy), Volume Absorption (σa = (1 − colour) × density)
-        and an Add shader of them; None when nothing is linked (or, with a warning, what is not
-        read)."""
+        (σs = colour × density, g = anisotropy), Volume Absorption (σa = (1 − colour) × density),
+        Principled Volume (both, its absorption colour taking part) and an Add shader of them;
+        None when nothing is linked (or, with a warning, what is not read)."""
         socket = output.inputs.get("Volume")
         if socket is None or not socket.is_linked:
             return None
@@ -255,6 +255,21 @@ class Conversion:
         if node.type == "VOLUME_ABSORPTION":
             sigma = np.clip(1.0 - constant("Color"), 0.0, None) * max(constant("Density"), 0.0)
             medium["absorption"] = list(np.array(medium["absorption"]) + sigma)
+            return True
+        if node.type == "PRINCIPLED_VOLUME":
+            # As Cycles reads it: σs = colour × density and σa = (1 − colour) × (1 − √absorption
+            # colour) × density, each clamped at 0 (a mesh has no density attribute: the
+            # input's value is the density).
+            colour = np.clip(constant("Color"), 0.0, None)
+            density = max(constant("Density"), 0.0)
+            absorption = np.clip(1.0 - colour, 0.0, None) * np.clip(
+                1.0 - np.sqrt(np.clip(constant("Absorption Color"), 0.0, None)), 0.0, None
+            )
+            medium["scattering"] = list(np.array(medium["scattering"]) + colour * density)
+            medium["absorption"] = list(np.array(medium["absorption"]) + absorption * density)
+            medium["g"] = float(np.clip(constant("Anisotropy"), -0.99, 0.99))
+            if constant("Emission Strength") > 0.0 or constant("Blackbody Intensity") > 0.0:
+                self.warn(f"{what}: the volume's emission is not rendered")
             return True
         self.warn(f"{what}: the {node.name} volume node is not read: no medium")
         return False
