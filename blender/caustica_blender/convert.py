@@ -54,9 +54,15 @@ class Conversion:
             obj = instance.object
             matrix = np.array(instance.matrix_world, dtype=np.float64)
             if obj.type == "MESH":
+                if any(m.type == "FLUID" and m.fluid_type == "DOMAIN" for m in obj.original.modifiers):
+                    self.warn(
+                        f"{obj.name}: a fluid simulation's grids are not read: its volume fills the domain evenly"
+                    )
                 self.mesh(obj, self.mesh_key(instance, obj), matrix)
             elif obj.type == "LIGHT":
                 self.light(obj.data, matrix)
+            elif obj.type == "VOLUME":
+                self.warn(f"{obj.name}: a volume object (OpenVDB grids) is not read: left out")
         description = {
             "camera": self.camera(),
             "materials": self.materials,
