@@ -58,7 +58,7 @@ def scene(puffs=None):
     return f"""# pbrt-v4, written by scripts/scenes/smoke.py: a lamp behind a round bottle of water on a
 # table, in smoke (a uniformgrid density). The bottle focuses the lamp into a beam in the smoke.
 #   caustica render scenes/smoke.pbrt
-LookAt 0 1.3 4.6   0 0.7 0   0 1 0
+# (The medium comes before LookAt: a grid lies in the space of the transform where it is made.)
 MakeNamedMedium "smoke" "string type" "uniformgrid"
     "rgb sigma_a" [0.05 0.05 0.05] "rgb sigma_s" [0.5 0.5 0.5] "float g" [0.5]
     "integer nx" [{NX}] "integer ny" [{NY}] "integer nz" [{NZ}]
@@ -66,6 +66,7 @@ MakeNamedMedium "smoke" "string type" "uniformgrid"
     "float density" [
         {rows}
     ]
+LookAt 0 1.3 4.6   0 0.7 0   0 1 0
 MediumInterface "" "smoke"
 Camera "perspective" "float fov" [38]
 Film "rgb" "integer xresolution" [400] "integer yresolution" [300] "string filename" "smoke.png"

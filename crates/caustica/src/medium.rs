@@ -289,7 +289,7 @@ impl Majorants {
     const CELLS: usize = 16;
     /// What stepping into a cell costs, in tentative collisions. At 0.25 the smoke scene (two
     /// collisions across its box) keeps one majorant and a dense puff in an empty box walks
-    /// cells: its path tracer 40% faster (BENCHMARKS.md); at 1 the puff kept one too.
+    /// cells: its path tracer twice as fast (BENCHMARKS.md); at 1 the puff kept one too.
     const STEP_COST: f32 = 0.25;
 
     fn of(grid: &DensityGrid) -> Majorants {
