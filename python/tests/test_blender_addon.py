@@ -528,10 +528,17 @@ scene = bpy.context.scene
 white_world(scene)
 grey_floor(20.0)
 bpy.ops.mesh.primitive_cube_add(size=2.0, location=(0.0, 0.0, 1.1))
-fog = bpy.data.materials.new("Fog")
-fog.use_nodes = True
-nodes, links = fog.node_tree.nodes, fog.node_tree.links
-nodes.remove(nodes["Principled BSDF"])
+
+
+# A material with no surface shader: its nodes and links, the Volume socket left to fill.
+def volume_only(name):
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    material.node_tree.nodes.remove(material.node_tree.nodes["Principled BSDF"])
+    return material, material.node_tree.nodes, material.node_tree.links
+
+
+fog, nodes, links = volume_only("Fog")
 scatter = nodes.new("ShaderNodeVolumeScatter")
 scatter.inputs["Color"].default_value = (0.9, 0.7, 0.5, 1.0)
 scatter.inputs["Density"].default_value = 1.5
@@ -548,10 +555,7 @@ camera(scene, (0.0, -6.0, 2.5), (math.radians(75.0), 0.0, 0.0))
 caustica_settings(scene, "PATH", 256, 24, 24)
 cube = bpy.context.object
 # The same cube of Principled Volume: a colour, a density, an absorption colour, an anisotropy.
-principled = bpy.data.materials.new("Principled fog")
-principled.use_nodes = True
-nodes, links = principled.node_tree.nodes, principled.node_tree.links
-nodes.remove(nodes["Principled BSDF"])
+principled, nodes, links = volume_only("Principled fog")
 volume = nodes.new("ShaderNodeVolumePrincipled")
 volume.inputs["Color"].default_value = (0.5, 0.35, 0.2, 1.0)
 volume.inputs["Density"].default_value = 1.5
