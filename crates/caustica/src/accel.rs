@@ -1,3 +1,5 @@
-//! Acceleration structures: the bounding volume hierarchy over all shapes.
+//! Acceleration structures: the bounding volume hierarchy over all shapes, and the packets
+//! that stand in for it in scenes of few squares and spheres.
 
 pub mod bvh;
+pub mod shape_packets;

@@ -18,7 +18,7 @@ pub mod torus;
 pub mod triangle;
 pub mod triangle_packet;
 
-pub use shape::{Shape, ShapeKind, ShapeSettings};
+pub use shape::{PacketForm, Shape, ShapeKind, ShapeSettings};
 
 use crate::math::{Vec2, Vec3};
 

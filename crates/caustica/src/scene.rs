@@ -7,6 +7,7 @@ pub mod summary;
 pub use build::{build, BuildSettings};
 
 use crate::accel::bvh::{Bvh, TriangleBvh, TriangleBvhHit};
+use crate::accel::shape_packets::ShapePackets;
 use crate::camera::Camera;
 use crate::description::EmittingFaces;
 use crate::geometry::triangle::Triangle;
@@ -181,6 +182,9 @@ pub struct Scene {
     hints: crate::description::RenderHints,
     /// Hierarchy over the analytic shapes (primitive ids `0..shapes.len()`).
     shape_bvh: Bvh,
+    /// The shapes in packets, tested instead of `shape_bvh` where there are few squares and
+    /// round spheres and nothing else.
+    shape_packets: Option<ShapePackets>,
     /// Hierarchy over the triangles, tested four at a time (primitive id `shapes.len() + i`).
     triangle_bvh: TriangleBvh,
     /// Whether some mesh has cut-outs (a material with coverage): only then are hits tested.
@@ -324,6 +328,7 @@ impl Scene {
         }
         let shape_bounds: Vec<Aabb> = shapes.iter().map(|s| s.bounds).collect();
         let shape_bvh = Bvh::build_reporting(&shape_bounds, progress);
+        let shape_packets = ShapePackets::new(&shapes);
         let triangle_bvh = TriangleBvh::build_reporting(&triangles, progress);
         let mut scene = Scene {
             camera,
@@ -351,6 +356,7 @@ impl Scene {
                 .collect(),
             hints,
             shape_bvh,
+            shape_packets,
             triangle_bvh,
             cutouts: false,
             media: Vec::new(),
@@ -816,12 +822,18 @@ impl Scene {
         let n_shapes = self.shapes.len() as u32;
         // `own` is passed over before it is intersected: the segment ends on it, so the test
         // would find it on nearly every call only to throw the hit away.
-        let blocked = self.shape_bvh.any_hit(&ray, t_max, |prim, t_max| {
+        let blocks = |prim: u32| {
             prim != own
                 && self
                     .intersect_shape(prim, &ray, t_max)
                     .is_some_and(|h| !self.is_boundary(&h))
-        }) || self.triangle_bvh.each_hit(&ray, t_max, |h| {
+        };
+        let blocked = match &self.shape_packets {
+            // Without boundaries a shape the packets find blocks: its own test is theirs.
+            Some(packets) if !self.boundaries => packets.each(&ray, t_max, |prim| prim != own),
+            Some(packets) => packets.each(&ray, t_max, blocks),
+            None => self.shape_bvh.any_hit(&ray, t_max, |prim, _| blocks(prim)),
+        } || self.triangle_bvh.each_hit(&ray, t_max, |h| {
             n_shapes + h.prim != own
                 && !self.is_hole(&ray, &h)
                 && !(self.boundaries && self.is_boundary(&self.triangle_intersection(h)))
@@ -893,6 +905,18 @@ impl Scene {
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Intersection> {
         let mut best = self.closest_triangle(ray, t_max).map(|h| self.triangle_intersection(h));
         let t_max = best.map_or(t_max, |h| h.t);
+        if let Some(packets) = &self.shape_packets {
+            // The packets pick the shape; its own test (the same arithmetic) gives the record.
+            // Should that test disagree, the hierarchy decides.
+            match packets.closest(ray, t_max) {
+                None => return best,
+                Some((prim, _)) => {
+                    if let Some(hit) = self.intersect_shape(prim, ray, t_max) {
+                        return Some(hit);
+                    }
+                }
+            }
+        }
         self.shape_bvh.closest_hit(ray, t_max, |prim, t_max| {
             let hit = self.intersect_shape(prim, ray, t_max)?;
             best = Some(hit);
@@ -943,11 +967,15 @@ impl Scene {
     /// Calls `visit(hit)` for each primitive the segment `(0, t_max)` meets (its nearest hit
     /// within the segment), until `visit` returns true; returns whether it did.
     pub fn any_hit(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(&Intersection) -> bool) -> bool {
-        self.shape_bvh.any_hit(ray, t_max, |prim, t_max| {
-            self.intersect_shape(prim, ray, t_max).is_some_and(|h| visit(&h))
-        }) || self.triangle_bvh.each_hit(ray, t_max, |h| {
-            !self.is_hole(ray, &h) && visit(&self.triangle_intersection(h))
-        })
+        let mut shape = |prim: u32| self.intersect_shape(prim, ray, t_max).is_some_and(|h| visit(&h));
+        let shapes = match &self.shape_packets {
+            Some(packets) => packets.each(ray, t_max, &mut shape),
+            None => self.shape_bvh.any_hit(ray, t_max, |prim, _| shape(prim)),
+        };
+        shapes
+            || self.triangle_bvh.each_hit(ray, t_max, |h| {
+                !self.is_hole(ray, &h) && visit(&self.triangle_intersection(h))
+            })
     }
 
     /// A triangle hit as an intersection.

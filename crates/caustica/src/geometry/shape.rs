@@ -62,6 +62,26 @@ pub struct Shape {
     round_sphere: Option<(Vec3, f32)>,
 }
 
+/// A shape as a packet test sees it ([`crate::accel::shape_packets`]): the world-space
+/// constants of its own test.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PacketForm {
+    /// A square.
+    Square {
+        /// The rows of `object_from_world`'s upper 3×3.
+        rows: [Vec3; 3],
+        /// The square's centre in the world.
+        origin: Vec3,
+    },
+    /// A sphere kept round by its transform.
+    Sphere {
+        /// World centre.
+        center: Vec3,
+        /// World radius.
+        radius: f32,
+    },
+}
+
 /// A hit on a shape, in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShapeHit {
@@ -232,6 +252,18 @@ impl Shape {
             uv: if self.needs_uv { hit.uv } else { Vec2::ZERO },
             part: 0,
         })
+    }
+
+    /// The form in which packets test this shape, if it is a square or a round sphere.
+    pub fn packet_form(&self) -> Option<PacketForm> {
+        match (&self.kind, self.round_sphere) {
+            (ShapeKind::Square, _) => Some(PacketForm::Square {
+                rows: self.object_rows,
+                origin: self.origin,
+            }),
+            (ShapeKind::Sphere, Some((center, radius))) => Some(PacketForm::Sphere { center, radius }),
+            _ => None,
+        }
     }
 
     /// [`square::intersect`] on the ray as the object sees it, from only the rows of the

@@ -24,6 +24,10 @@ const STREAM: usize = 8;
 /// Id of an unused packet lane.
 const NO_TRIANGLE: u32 = u32::MAX;
 
+/// Packets tested one after another, without a walk: for a floor of two triangles the walk's
+/// set-up and box tests cost more than the packet they would cull.
+const FEW_PACKETS: usize = 2;
+
 /// Closest hit in a [`TriangleBvh`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TriangleBvhHit {
@@ -145,6 +149,22 @@ impl TriangleBvh {
         let tr = TriangleRay::new(ray);
         let mut t = t_max;
         let mut best = None;
+        if self.packets.len() <= FEW_PACKETS {
+            if super::walkable(ray) {
+                for (packet, p) in self.packets.iter().enumerate() {
+                    if let Some((lane, h)) = p.closest_hit(&tr, t) {
+                        t = h.t;
+                        best = Some(LeafHit {
+                            packet,
+                            lane,
+                            u: h.u,
+                            v: h.v,
+                        });
+                    }
+                }
+            }
+            return best.map(|b| self.hit(t, b));
+        }
         self.bvh.traverse_any_stack(ray, &mut t, |_, first, t_max| {
             self.closest_in_leaf(&tr, first, t_max, &mut best);
             false
@@ -361,20 +381,25 @@ impl TriangleBvh {
             return false;
         }
         let tr = TriangleRay::new(ray);
+        let mut packet = |i: usize, t_max: f32| {
+            let ids = &self.ids[i];
+            self.packets[i].each_hit(&tr, t_max, |lane, h| {
+                visit(TriangleBvhHit {
+                    t: h.t,
+                    prim: ids[lane],
+                    u: h.u,
+                    v: h.v,
+                })
+            })
+        };
+        if self.packets.len() <= FEW_PACKETS {
+            return super::walkable(ray) && (0..self.packets.len()).any(|i| packet(i, t_max));
+        }
         let mut t = t_max;
         self.bvh.traverse_any_stack(ray, &mut t, |order, first, t_max| {
             let mut i = first;
             loop {
-                let ids = &self.ids[i];
-                let stop = self.packets[i].each_hit(&tr, *t_max, |lane, h| {
-                    visit(TriangleBvhHit {
-                        t: h.t,
-                        prim: ids[lane],
-                        u: h.u,
-                        v: h.v,
-                    })
-                });
-                if stop {
+                if packet(i, *t_max) {
                     return true;
                 }
                 if order[i] & END != 0 {
