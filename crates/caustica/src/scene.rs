@@ -810,7 +810,7 @@ impl Scene {
         } else {
             f32::INFINITY
         };
-        !self.any_hit(&Ray::new(origin, wi), t_max, |h| !self.is_boundary(h))
+        !self.blocked(&Ray::new(origin, wi), t_max, u32::MAX)
     }
 
     /// As [`Scene::unoccluded`], but primitive `own` never blocks (the light whose point the
@@ -818,27 +818,34 @@ impl Scene {
     pub fn unoccluded_except(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> bool {
         let (point, origin) = (hit.point, hit.ray_origin(wi));
         let t_max = (distance - (origin - point).length()) * (1.0 - 1e-5);
-        let ray = Ray::new(origin, wi);
+        !self.blocked(&Ray::new(origin, wi), t_max, own)
+    }
+
+    /// Whether a surface other than primitive `own` (`u32::MAX`: none) and other than a
+    /// boundary between media meets `ray` in `(0, t_max)`.
+    #[inline]
+    fn blocked(&self, ray: &Ray, t_max: f32, own: u32) -> bool {
         let n_shapes = self.shapes.len() as u32;
         // `own` is passed over before it is intersected: the segment ends on it, so the test
         // would find it on nearly every call only to throw the hit away.
         let blocks = |prim: u32| {
             prim != own
                 && self
-                    .intersect_shape(prim, &ray, t_max)
+                    .intersect_shape(prim, ray, t_max)
                     .is_some_and(|h| !self.is_boundary(&h))
         };
-        let blocked = match &self.shape_packets {
+        let shape_blocks = match &self.shape_packets {
             // Without boundaries a shape the packets find blocks: its own test is theirs.
-            Some(packets) if !self.boundaries => packets.each(&ray, t_max, |prim| prim != own),
-            Some(packets) => packets.each(&ray, t_max, blocks),
-            None => self.shape_bvh.any_hit(&ray, t_max, |prim, _| blocks(prim)),
-        } || self.triangle_bvh.each_hit(&ray, t_max, |h| {
-            n_shapes + h.prim != own
-                && !self.is_hole(&ray, &h)
-                && !(self.boundaries && self.is_boundary(&self.triangle_intersection(h)))
-        });
-        !blocked
+            Some(packets) if !self.boundaries => packets.each(ray, t_max, |prim| prim != own),
+            Some(packets) => packets.each(ray, t_max, blocks),
+            None => self.shape_bvh.any_hit(ray, t_max, |prim, _| blocks(prim)),
+        };
+        shape_blocks
+            || self.triangle_bvh.each_hit(ray, t_max, |h| {
+                n_shapes + h.prim != own
+                    && !self.is_hole(ray, &h)
+                    && !(self.boundaries && self.is_boundary(&self.triangle_intersection(h)))
+            })
     }
 
     /// World bounds of everything.
