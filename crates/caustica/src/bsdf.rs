@@ -562,6 +562,22 @@ impl Bsdf {
         self.eval_in(wo, wi, Transport::Radiance)
     }
 
+    /// Whether light arriving from `wi` can reach the smooth lobes: `false` only where
+    /// [`Bsdf::eval_in`] is zero whatever `wo` (a surface that only reflects, lit from behind),
+    /// so that next-event estimation spares such a sample its shadow ray.
+    #[inline]
+    pub fn may_take(&self, wi: Vec3) -> bool {
+        if self.rough > 0.0 {
+            return true;
+        }
+        let (cos_i, cos_g) = (self.frame.z.dot(wi), self.ng.dot(wi));
+        if cos_i < 0.0 && cos_g < 0.0 {
+            return self.diffuse_transmission != Spectrum::ZERO || self.clear.weight > 0.0;
+        }
+        // As `eval_in` tests it, so that NaN cosines go on to the evaluation as there.
+        !(cos_i <= 0.0 || cos_g <= 0.0)
+    }
+
     /// The smooth lobes' f(wo, wi) for the transport `mode`: a walk from a light evaluates the
     /// adjoint, which differs where rough glass refracts (by η²).
     #[inline]

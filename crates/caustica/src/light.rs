@@ -330,9 +330,18 @@ pub(crate) struct DirectQuery<'a> {
     pub wl: &'a Wavelengths,
     /// The probability of taking this light.
     pub choice: f32,
+    /// Whether the shading point can take light from a direction ([`Bsdf::may_take`]).
+    pub takes: &'a dyn Fn(Vec3) -> bool,
 }
 
 impl DirectQuery<'_> {
+    /// Whether light from `wi` counts at the shading point: it can take it, and nothing blocks
+    /// the segment of `distance` towards it. Samples that cannot count skip their shadow rays.
+    #[inline]
+    pub fn unoccluded(&self, wi: Vec3, distance: f32) -> bool {
+        (self.takes)(wi) && self.scene.unoccluded(self.hit, wi, distance)
+    }
+
     /// The sample of a light no ray meets, at `point` (its unit `normal` there, or zero), of
     /// solid-angle density `pdf` (a point light's: d², so that `value` is its intensity), its
     /// cosine at the light `cos_light`; `None` when something is in between.
@@ -343,7 +352,7 @@ impl DirectQuery<'_> {
             return None;
         }
         let wi = to / distance;
-        self.scene.unoccluded(self.hit, wi, distance).then(|| DirectSample {
+        self.unoccluded(wi, distance).then(|| DirectSample {
             wi,
             distance,
             contribution: self.wl.unbounded(value / pdf) / self.choice,
@@ -512,11 +521,11 @@ impl LightSet {
 
     /// Direct-light samples for the point `hit` (visibility included), each with its own pdf
     /// for MIS: one per light when [`LightSet::samples_every_light`], otherwise one light
-    /// chosen by power; `add` receives each sample that carries light.
+    /// chosen by power; `add` receives each sample that carries light and comes from a
+    /// direction the point `takes` light from (others may be dropped before their shadow rays).
     pub fn sample_direct(
         &self,
-        scene: &Scene,
-        hit: &SurfaceHit,
+        (scene, hit, takes): (&Scene, &SurfaceHit, &dyn Fn(Vec3) -> bool),
         wl: &Wavelengths,
         rng: &mut Rng,
         mut add: impl FnMut(DirectSample),
@@ -524,25 +533,26 @@ impl LightSet {
         if self.samples_every_light() {
             for index in 0..self.lights.len() {
                 if self.probabilities[index] > 0.0 {
-                    if let Some(sample) = self.sample_light(index, 1.0, scene, hit, wl, rng) {
+                    if let Some(sample) = self.sample_light(index, 1.0, (scene, hit, takes), wl, rng) {
                         add(sample);
                     }
                 }
             }
         } else if let Some((index, p_pick)) = self.pick(rng.uniform()) {
-            if let Some(sample) = self.sample_light(index, p_pick, scene, hit, wl, rng) {
+            if let Some(sample) = self.sample_light(index, p_pick, (scene, hit, takes), wl, rng) {
                 add(sample);
             }
         }
     }
 
-    /// Samples light `index`, taken with probability `p_pick`, for the point `hit`.
+    /// Samples light `index`, taken with probability `p_pick`, for the point `hit`; a sample
+    /// from a direction the point does not `take` light from may be dropped before its shadow
+    /// ray (not in scenes with media, where the transmittance's draws follow each sample).
     pub fn sample_light(
         &self,
         index: usize,
         p_pick: f32,
-        scene: &Scene,
-        hit: &SurfaceHit,
+        (scene, hit, takes): (&Scene, &SurfaceHit, &dyn Fn(Vec3) -> bool),
         wl: &Wavelengths,
         rng: &mut Rng,
     ) -> Option<DirectSample> {
@@ -552,6 +562,7 @@ impl LightSet {
             hit,
             wl,
             choice: p_pick,
+            takes: if scene.has_media() { &|_| true } else { takes },
         };
         let sample = match &self.lights[index] {
             light @ (Light::Point { .. } | Light::Spot { .. }) => point::sample_direct(&q, light),

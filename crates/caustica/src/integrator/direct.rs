@@ -23,7 +23,8 @@ pub fn direct_light(
     rng: &mut Rng,
 ) -> Spectrum {
     let mut l = Spectrum::ZERO;
-    scene.lights().sample_direct(scene, hit, wl, rng, |sample| {
+    let takes = |wi: Vec3| bsdf.may_take(wi);
+    scene.lights().sample_direct((scene, hit, &takes), wl, rng, |sample| {
         let f = bsdf.eval(wo, sample.wi);
         if f == Spectrum::ZERO {
             return;
@@ -44,15 +45,17 @@ pub fn direct_light(
 /// samples hit).
 pub fn direct_in_medium(scene: &Scene, at: &MediumArrival, mis: bool, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
     let mut l = Spectrum::ZERO;
-    scene.lights().sample_direct(scene, at.hit, wl, rng, |sample| {
-        let p = at.phase.eval(at.wo, sample.wi);
-        let weight = if mis && sample.pdf > 0.0 {
-            power_heuristic(sample.pdf, p)
-        } else {
-            1.0
-        };
-        l += sample.contribution * (p * weight);
-    });
+    scene
+        .lights()
+        .sample_direct((scene, at.hit, &|_| true), wl, rng, |sample| {
+            let p = at.phase.eval(at.wo, sample.wi);
+            let weight = if mis && sample.pdf > 0.0 {
+                power_heuristic(sample.pdf, p)
+            } else {
+                1.0
+            };
+            l += sample.contribution * (p * weight);
+        });
     l
 }
 

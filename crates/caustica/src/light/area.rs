@@ -512,6 +512,9 @@ impl AreaLight {
             return None;
         }
         let wi = to / d;
+        if !(q.takes)(wi) {
+            return None;
+        }
         let le = visible_emission(scene, light, hit, &drawn, wi, d, wl)?;
         let pdf = p_pick * drawn.pdf_solid;
         Some(DirectSample {

@@ -19,7 +19,7 @@ pub(super) fn sample_direct(q: &DirectQuery, light: &Light, u: Vec2) -> Option<D
     match light {
         Light::Directional { direction, color } => {
             let wi = -*direction;
-            q.scene.unoccluded(q.hit, wi, f32::INFINITY).then(|| DirectSample {
+            q.unoccluded(wi, f32::INFINITY).then(|| DirectSample {
                 wi,
                 distance: f32::INFINITY,
                 contribution: q.wl.unbounded(*color) / p_pick,
@@ -39,7 +39,7 @@ pub(super) fn sample_direct(q: &DirectQuery, light: &Light, u: Vec2) -> Option<D
         } => {
             let wi = sample_uniform_cone(u, -*direction, *cos_max);
             let pdf = p_pick * sun_cone_pdf(*one_minus_cos);
-            q.scene.unoccluded(q.hit, wi, f32::INFINITY).then(|| DirectSample {
+            q.unoccluded(wi, f32::INFINITY).then(|| DirectSample {
                 wi,
                 distance: f32::INFINITY,
                 contribution: q.wl.unbounded(light.sun_radiance()) / pdf,

@@ -231,7 +231,7 @@ impl Environment {
     /// included.
     pub(super) fn sample_direct(&self, q: &DirectQuery, u: Vec2) -> Option<DirectSample> {
         let s = self.sample(u)?;
-        if s.radiance == Vec3::ZERO || !q.scene.unoccluded(q.hit, s.wi, f32::INFINITY) {
+        if s.radiance == Vec3::ZERO || !q.unoccluded(s.wi, f32::INFINITY) {
             return None;
         }
         let pdf = q.choice * s.pdf;

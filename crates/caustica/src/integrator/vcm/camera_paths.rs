@@ -325,6 +325,7 @@ impl<'a> Vcm<'a> {
         }
         let lights = self.scene.lights();
         let mut l = Spectrum::ZERO;
+        let takes = |wi: Vec3| v.bsdf.may_take(wi);
         let mut one = |number: usize, pick: f32, rng: &mut Rng| {
             work.rays += 1;
             if self.emitters.emits(number) {
@@ -335,7 +336,7 @@ impl<'a> Vcm<'a> {
                 };
                 for _ in 0..samples {
                     let choice = lights.direct_probability(number);
-                    let Some(s) = lights.sample_light(number, choice, self.scene, v.hit, wl, rng) else {
+                    let Some(s) = lights.sample_light(number, choice, (self.scene, v.hit, &takes), wl, rng) else {
                         continue;
                     };
                     let value = v.bsdf.eval(v.wo, s.wi);
@@ -371,7 +372,7 @@ impl<'a> Vcm<'a> {
                     };
                     l += v.throughput * value * s.contribution * (cos_here * weight / samples as f32);
                 }
-            } else if let Some(s) = lights.sample_light(number, pick, self.scene, v.hit, wl, rng) {
+            } else if let Some(s) = lights.sample_light(number, pick, (self.scene, v.hit, &takes), wl, rng) {
                 // Far lights and lights with a size: the camera's strategies only.
                 let value = v.bsdf.eval(v.wo, s.wi);
                 // (A point a free flight picked on a beam's segment is not scattered from.)
