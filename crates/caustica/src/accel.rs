@@ -2,4 +2,5 @@
 //! that stand in for it in scenes of few squares and spheres.
 
 pub mod bvh;
+pub mod lanes;
 pub mod shape_packets;

@@ -1,19 +1,23 @@
 //! A scene of a few squares and round spheres (a Cornell box's walls and balls) tested without
-//! a hierarchy: the squares four to a packet, the spheres four to a packet, each packet one SIMD
-//! test. A ray meets every packet; for a handful of shapes that costs less than setting up a walk
-//! and testing boxes, which is most of what a ray costs there.
+//! a hierarchy: the squares in packets, the spheres in packets, each packet one SIMD test, four
+//! lanes wide or eight where the CPU has AVX ([`crate::accel::lanes`]). A ray meets every packet;
+//! for a handful of shapes that costs less than setting up a walk and testing boxes, which is
+//! most of what a ray costs there.
 //!
 //! The lanes run the shapes' own scalar tests ([`Shape::intersect_object_normal`]) operation for
-//! operation, so a lane hits exactly where the shape's test does, at the same `t`. The packets
-//! only pick the shape; its hit record comes from its own test.
+//! operation, so a lane hits exactly where the shape's test does, at the same `t`, at either
+//! width. The packets only pick the shape; its hit record comes from its own test.
 
 use glam::Vec4;
 
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{in_avx, Avx, F32x8};
+use super::lanes::{Lanes, Width};
 use crate::geometry::{PacketForm, Shape};
 use crate::math::Ray;
 
-/// Lanes per packet.
-const LANES: usize = 4;
+/// Most lanes of any width.
+const MAX_LANES: usize = 8;
 
 /// Most shapes tested this way: past it a hierarchy's box tests cull more than they cost.
 pub const MAX_SHAPES: usize = 16;
@@ -26,49 +30,62 @@ pub const MIN_SHAPES: usize = 3;
 /// Id of an unused lane.
 const NO_SHAPE: u32 = u32::MAX;
 
-/// Up to four squares: the rows of each one's world-to-object rotation and scale, and its
-/// origin, as lanes. Unused lanes have zero rows and never hit.
+/// Squares, one a lane: the rows of each one's world-to-object rotation and scale, and its
+/// origin. Unused lanes have zero rows and never hit.
 #[derive(Clone, Copy, Debug)]
-struct SquarePacket {
-    rows: [[Vec4; 3]; 3],
-    origin: [Vec4; 3],
-    ids: [u32; LANES],
+struct SquarePacket<L> {
+    rows: [[L; 3]; 3],
+    origin: [L; 3],
+    ids: [u32; MAX_LANES],
 }
 
-/// Up to four spheres kept round by their transforms: world centres and radii as lanes.
-/// Unused lanes have NaN radii and never hit.
+/// Spheres kept round by their transforms, one a lane: world centres and radii. Unused lanes
+/// have NaN radii and never hit.
 #[derive(Clone, Copy, Debug)]
-struct SpherePacket {
-    center: [Vec4; 3],
-    radius: Vec4,
+struct SpherePacket<L> {
+    center: [L; 3],
+    radius: L,
     /// The lanes in use (bit per lane): the test stops early when the ray passes wide of all
     /// of them, which an unused lane must not prevent.
     used: u32,
-    ids: [u32; LANES],
+    ids: [u32; MAX_LANES],
+}
+
+/// The packets of one width.
+#[derive(Clone, Debug)]
+struct Packets<L> {
+    squares: Vec<SquarePacket<L>>,
+    spheres: Vec<SpherePacket<L>>,
 }
 
 /// The shapes of a scene of few squares and round spheres, in packets.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct ShapePackets {
-    squares: Vec<SquarePacket>,
-    spheres: Vec<SpherePacket>,
+    lanes: PacketLanes,
+}
+
+#[derive(Clone, Debug)]
+enum PacketLanes {
+    Four(Packets<Vec4>),
+    #[cfg(target_arch = "x86_64")]
+    Eight(Avx, Packets<F32x8>),
 }
 
 /// Per-ray values every packet uses.
-struct PacketRay {
-    origin: [Vec4; 3],
-    dir: [Vec4; 3],
+struct PacketRay<L> {
+    origin: [L; 3],
+    dir: [L; 3],
     /// `dir · dir`, as the sphere test forms it.
     dir2: f32,
 }
 
-impl PacketRay {
+impl<L: Lanes> PacketRay<L> {
     #[inline(always)]
-    fn new(ray: &Ray) -> PacketRay {
+    fn new(ray: &Ray) -> PacketRay<L> {
         let (o, d) = (ray.origin, ray.dir);
         PacketRay {
-            origin: [o.x, o.y, o.z].map(Vec4::splat),
-            dir: [d.x, d.y, d.z].map(Vec4::splat),
+            origin: [o.x, o.y, o.z].map(L::splat),
+            dir: [d.x, d.y, d.z].map(L::splat),
             dir2: d.dot(d),
         }
     }
@@ -76,74 +93,128 @@ impl PacketRay {
 
 /// `a · b` for three lanes of vectors, summed in the order of `Vec3::dot`.
 #[inline(always)]
-fn dot(a: &[Vec4; 3], b: &[Vec4; 3]) -> Vec4 {
+fn dot<L: Lanes>(a: &[L; 3], b: &[L; 3]) -> L {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-/// Lane-wise square root (exact, as the scalar one).
-#[inline(always)]
-fn sqrt(v: Vec4) -> Vec4 {
-    Vec4::from_array(v.to_array().map(f32::sqrt))
+/// The forms of the shapes a packet test can take, with their ids.
+struct Forms {
+    squares: Vec<(u32, [[f32; 3]; 3], [f32; 3])>,
+    spheres: Vec<(u32, [f32; 3], f32)>,
 }
 
 impl ShapePackets {
-    /// Packets of `shapes` (ids are indices into it), or `None` if there are fewer than
-    /// [`MIN_SHAPES`] or more than [`MAX_SHAPES`], or one is neither a square nor a round
-    /// sphere. Shapes a hierarchy would leave out (empty or non-finite bounds) are left out.
+    /// Packets of `shapes` (ids are indices into it) as wide as the CPU runs, or `None` if
+    /// there are fewer than [`MIN_SHAPES`] or more than [`MAX_SHAPES`], or one is neither a
+    /// square nor a round sphere. Shapes a hierarchy would leave out (empty or non-finite
+    /// bounds) are left out.
     pub fn new(shapes: &[Shape]) -> Option<ShapePackets> {
+        ShapePackets::with_width(shapes, Width::of_host())
+    }
+
+    /// [`ShapePackets::new`] at the lane width `width`.
+    pub fn with_width(shapes: &[Shape], width: Width) -> Option<ShapePackets> {
         if !(MIN_SHAPES..=MAX_SHAPES).contains(&shapes.len()) {
             return None;
         }
-        let (mut squares, mut spheres) = (Vec::new(), Vec::new());
+        let mut forms = Forms {
+            squares: Vec::new(),
+            spheres: Vec::new(),
+        };
         for (id, shape) in shapes.iter().enumerate() {
             let b = shape.bounds;
             if b.is_empty() || !b.min.is_finite() || !b.max.is_finite() {
                 continue;
             }
             match shape.packet_form()? {
-                PacketForm::Square { rows, origin } => squares.push((id as u32, rows, origin)),
-                PacketForm::Sphere { center, radius } => spheres.push((id as u32, center, radius)),
+                PacketForm::Square { rows, origin } => {
+                    forms
+                        .squares
+                        .push((id as u32, rows.map(|r| r.to_array()), origin.to_array()))
+                }
+                PacketForm::Sphere { center, radius } => forms.spheres.push((id as u32, center.to_array(), radius)),
             }
         }
-        let lanes = |v: &dyn Fn(usize) -> f32, n: usize, unused: f32| {
-            Vec4::from_array(std::array::from_fn(|lane| if lane < n { v(lane) } else { unused }))
+        let lanes = match width {
+            Width::Four => PacketLanes::Four(Packets::new(&forms)),
+            #[cfg(target_arch = "x86_64")]
+            Width::Eight(avx) => PacketLanes::Eight(avx, in_avx(avx, || Packets::new(&forms))),
         };
-        let ids = |chunk: &[u32]| std::array::from_fn(|lane| chunk.get(lane).copied().unwrap_or(NO_SHAPE));
-        let squares = squares
-            .chunks(LANES)
-            .map(|c| SquarePacket {
-                rows: std::array::from_fn(|row| {
-                    std::array::from_fn(|axis| lanes(&|lane| c[lane].1[row][axis], c.len(), 0.0))
-                }),
-                origin: std::array::from_fn(|axis| lanes(&|lane| c[lane].2[axis], c.len(), 0.0)),
-                ids: ids(&c.iter().map(|s| s.0).collect::<Vec<_>>()),
-            })
-            .collect();
-        let spheres = spheres
-            .chunks(LANES)
-            .map(|c| SpherePacket {
-                center: std::array::from_fn(|axis| lanes(&|lane| c[lane].1[axis], c.len(), 0.0)),
-                radius: lanes(&|lane| c[lane].2, c.len(), f32::NAN),
-                used: (1 << c.len()) - 1,
-                ids: ids(&c.iter().map(|s| s.0).collect::<Vec<_>>()),
-            })
-            .collect();
-        Some(ShapePackets { squares, spheres })
+        Some(ShapePackets { lanes })
     }
 
     /// The shape whose own test finds the nearest hit with `0 < t < t_max`, and that `t`.
     /// Ties go to the shape tested first.
     #[inline]
     pub fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, f32)> {
-        let pr = PacketRay::new(ray);
+        match &self.lanes {
+            PacketLanes::Four(p) => p.closest(ray, t_max),
+            #[cfg(target_arch = "x86_64")]
+            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.closest(ray, t_max)),
+        }
+    }
+
+    /// Calls `visit(shape)` for each shape whose own test finds a hit with `0 < t < t_max`,
+    /// until it returns `true`; returns whether it did.
+    #[inline]
+    pub fn each(&self, ray: &Ray, t_max: f32, visit: impl FnMut(u32) -> bool) -> bool {
+        match &self.lanes {
+            PacketLanes::Four(p) => p.each(ray, t_max, visit),
+            #[cfg(target_arch = "x86_64")]
+            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.each(ray, t_max, visit)),
+        }
+    }
+}
+
+impl<L: Lanes> Packets<L> {
+    /// Packets of `forms`, [`Lanes::N`] shapes to a packet.
+    #[inline(always)]
+    fn new(forms: &Forms) -> Packets<L> {
+        let lanes = |n: usize, value: &dyn Fn(usize) -> f32, unused: f32| {
+            let v: [f32; MAX_LANES] = std::array::from_fn(|lane| if lane < n { value(lane) } else { unused });
+            L::from_slice(&v)
+        };
+        let ids = |chunk: &mut dyn Iterator<Item = u32>| {
+            let mut ids = [NO_SHAPE; MAX_LANES];
+            ids.iter_mut().zip(chunk).for_each(|(slot, id)| *slot = id);
+            ids
+        };
+        let squares = forms
+            .squares
+            .chunks(L::N)
+            .map(|c| SquarePacket {
+                rows: std::array::from_fn(|row| {
+                    std::array::from_fn(|axis| lanes(c.len(), &|lane| c[lane].1[row][axis], 0.0))
+                }),
+                origin: std::array::from_fn(|axis| lanes(c.len(), &|lane| c[lane].2[axis], 0.0)),
+                ids: ids(&mut c.iter().map(|s| s.0)),
+            })
+            .collect();
+        let spheres = forms
+            .spheres
+            .chunks(L::N)
+            .map(|c| SpherePacket {
+                center: std::array::from_fn(|axis| lanes(c.len(), &|lane| c[lane].1[axis], 0.0)),
+                radius: lanes(c.len(), &|lane| c[lane].2, f32::NAN),
+                used: (1 << c.len()) - 1,
+                ids: ids(&mut c.iter().map(|s| s.0)),
+            })
+            .collect();
+        Packets { squares, spheres }
+    }
+
+    #[inline(always)]
+    fn closest(&self, ray: &Ray, t_max: f32) -> Option<(u32, f32)> {
+        let pr = PacketRay::<L>::new(ray);
         let mut best: Option<(u32, f32)> = None;
-        let mut keep = |mask: u32, t: Vec4, ids: &[u32; LANES]| {
-            let t = t.to_array();
+        let mut keep = |mask: u32, t: L, ids: &[u32; MAX_LANES]| {
+            let mut ts = [0.0; MAX_LANES];
+            t.write_to(&mut ts);
             let mut rest = mask;
             while rest != 0 {
                 let lane = rest.trailing_zeros() as usize;
-                if best.is_none_or(|(_, b)| t[lane] < b) {
-                    best = Some((ids[lane], t[lane]));
+                if best.is_none_or(|(_, b)| ts[lane] < b) {
+                    best = Some((ids[lane], ts[lane]));
                 }
                 rest &= rest - 1;
             }
@@ -159,12 +230,10 @@ impl ShapePackets {
         best
     }
 
-    /// Calls `visit(shape)` for each shape whose own test finds a hit with `0 < t < t_max`,
-    /// until it returns `true`; returns whether it did.
-    #[inline]
-    pub fn each(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(u32) -> bool) -> bool {
-        let pr = PacketRay::new(ray);
-        let mut any = |mask: u32, ids: &[u32; LANES]| {
+    #[inline(always)]
+    fn each(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(u32) -> bool) -> bool {
+        let pr = PacketRay::<L>::new(ray);
+        let mut any = |mask: u32, ids: &[u32; MAX_LANES]| {
             let mut rest = mask;
             while rest != 0 {
                 if visit(ids[rest.trailing_zeros() as usize]) {
@@ -179,64 +248,64 @@ impl ShapePackets {
     }
 }
 
-impl SquarePacket {
+impl<L: Lanes> SquarePacket<L> {
     /// The lanes hit with `0 < t < t_max` (bit per lane) and their `t`: the square test of
     /// `Shape::intersect_square`, lane by lane.
     #[inline(always)]
-    fn hits(&self, ray: &PacketRay, t_max: f32) -> (u32, Vec4) {
+    fn hits(&self, ray: &PacketRay<L>, t_max: f32) -> (u32, L) {
         let [row_x, row_y, row_z] = &self.rows;
-        let zero = Vec4::ZERO;
+        let zero = L::splat(0.0);
         let dir_z = dot(row_z, &ray.dir);
-        let to_origin: [Vec4; 3] = std::array::from_fn(|axis| self.origin[axis] - ray.origin[axis]);
+        let to_origin: [L; 3] = std::array::from_fn(|axis| self.origin[axis] - ray.origin[axis]);
         let distance_z = dot(row_z, &to_origin);
         // Behind the ray, parallel to it, or beyond `t_max`.
-        let facing = distance_z.cmpgt(zero) ^ dir_z.cmpgt(zero);
-        let far = distance_z.abs().cmpge(Vec4::splat(t_max) * dir_z.abs());
-        let turned_away = dir_z.cmpeq(zero) | facing | far;
-        if (!turned_away).bitmask() == 0 {
+        let facing = distance_z.gt(zero) ^ dir_z.gt(zero);
+        let far = distance_z.abs().ge(L::splat(t_max) * dir_z.abs());
+        let turned_away = dir_z.eq(zero) | facing | far;
+        if L::bitmask(!turned_away) == 0 {
             return (0, zero);
         }
         let t = distance_z / dir_z;
-        let in_range = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
-        let offset: [Vec4; 3] = std::array::from_fn(|axis| ray.origin[axis] + ray.dir[axis] * t - self.origin[axis]);
-        let half = Vec4::splat(0.5);
-        let outside = dot(row_x, &offset).abs().cmpgt(half) | dot(row_y, &offset).abs().cmpgt(half);
-        ((!turned_away & in_range & !outside).bitmask(), t)
+        let in_range = t.gt(zero) & t.lt(L::splat(t_max));
+        let offset: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] + ray.dir[axis] * t - self.origin[axis]);
+        let half = L::splat(0.5);
+        let outside = dot(row_x, &offset).abs().gt(half) | dot(row_y, &offset).abs().gt(half);
+        (L::bitmask(!turned_away & in_range & !outside), t)
     }
 }
 
-impl SpherePacket {
+impl<L: Lanes> SpherePacket<L> {
     /// The lanes hit with `0 < t < t_max` (bit per lane) and their `t`: the round-sphere test of
     /// `Shape::intersect_round_sphere` with [`crate::geometry::quadratic_roots`], lane by lane.
     #[inline(always)]
-    fn hits(&self, ray: &PacketRay, t_max: f32) -> (u32, Vec4) {
-        let zero = Vec4::ZERO;
-        let oc: [Vec4; 3] = std::array::from_fn(|axis| ray.origin[axis] - self.center[axis]);
-        let a = Vec4::splat(ray.dir2);
+    fn hits(&self, ray: &PacketRay<L>, t_max: f32) -> (u32, L) {
+        let zero = L::splat(0.0);
+        let oc: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] - self.center[axis]);
+        let a = L::splat(ray.dir2);
         let half_b = dot(&oc, &ray.dir);
         let k = half_b / a;
-        let l: [Vec4; 3] = std::array::from_fn(|axis| oc[axis] - ray.dir[axis] * k);
+        let l: [L; 3] = std::array::from_fn(|axis| oc[axis] - ray.dir[axis] * k);
         let (l2, r2) = (dot(&l, &l), self.radius * self.radius);
-        let near = !l2.cmpgt(r2);
-        if near.bitmask() & self.used == 0 {
+        let near = !l2.gt(r2);
+        if L::bitmask(near) & self.used == 0 {
             return (0, zero);
         }
-        let l_len = sqrt(l2);
+        let l_len = l2.sqrt();
         let disc = a * ((self.radius - l_len) * (self.radius + l_len));
         let c = dot(&oc, &oc) - r2;
-        let real = disc.cmpge(zero) & disc.is_finite_mask();
-        let q = -(half_b + sqrt(disc).copysign(half_b));
-        let q_zero = q.cmpeq(zero);
-        let t0 = Vec4::select(q_zero, zero, q / a);
-        let t1 = Vec4::select(q_zero, zero, c / q);
+        let real = disc.ge(zero) & disc.is_finite();
+        let q = -(half_b + disc.sqrt().copysign(half_b));
+        let q_zero = q.eq(zero);
+        let t0 = L::select(q_zero, zero, q / a);
+        let t1 = L::select(q_zero, zero, c / q);
         let (lo, hi) = (t0.min(t1), t0.max(t1));
-        let t = Vec4::select(lo.cmpgt(zero), lo, hi);
-        let in_range = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
+        let t = L::select(lo.gt(zero), lo, hi);
+        let in_range = t.gt(zero) & t.lt(L::splat(t_max));
         // `a == 0` (a zero direction) takes the scalar test's other branch: no lane claims it.
         let mask = if ray.dir2 == 0.0 {
             0
         } else {
-            (near & real & in_range).bitmask()
+            L::bitmask(near & real & in_range)
         };
         (mask, t)
     }
@@ -296,12 +365,17 @@ mod tests {
     }
 
     /// On 200,000 random rays — from inside the box, from far outside, grazing, and bounded
-    /// by a random `t_max` — the packets pick the shape and `t` (to the bit) that testing each
-    /// shape by its own test picks, and `each` visits exactly the shapes those tests hit.
+    /// by a random `t_max` — the packets of every width this CPU runs pick the shape and `t` (to
+    /// the bit) that testing each shape by its own test picks, and `each` visits exactly the
+    /// shapes those tests hit.
     #[test]
     fn packets_find_what_each_shapes_own_test_finds() {
         let shapes = shapes();
-        let packets = ShapePackets::new(&shapes).expect("all squares and round spheres");
+        let widths = Width::on_host();
+        let packets: Vec<ShapePackets> = widths
+            .iter()
+            .map(|&w| ShapePackets::with_width(&shapes, w).expect("all squares and round spheres"))
+            .collect();
         let mut rng = Rng::new(7, 0);
         let mut random = |scale: f32| Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * scale;
         let (mut hits, mut several) = (0, 0);
@@ -327,19 +401,21 @@ mod tests {
                     }
                 }
             }
-            let found = packets.closest(&ray, t_max);
-            assert_eq!(
-                found.map(|(id, t)| (id, t.to_bits())),
-                expected.map(|(id, t)| (id, t.to_bits())),
-                "{ray:?} {t_max}"
-            );
-            let mut each_found = vec![];
-            packets.each(&ray, t_max, |id| {
-                each_found.push(id);
-                false
-            });
-            each_found.sort();
-            assert_eq!(each_found, each_expected, "{ray:?} {t_max}");
+            for (packets, width) in packets.iter().zip(&widths) {
+                let found = packets.closest(&ray, t_max);
+                assert_eq!(
+                    found.map(|(id, t)| (id, t.to_bits())),
+                    expected.map(|(id, t)| (id, t.to_bits())),
+                    "{width:?}: {ray:?} {t_max}"
+                );
+                let mut each_found = vec![];
+                packets.each(&ray, t_max, |id| {
+                    each_found.push(id);
+                    false
+                });
+                each_found.sort();
+                assert_eq!(each_found, each_expected, "{width:?}: {ray:?} {t_max}");
+            }
             hits += usize::from(expected.is_some());
             several += usize::from(each_expected.len() > 1);
         }

@@ -1,0 +1,306 @@
+//! The SIMD vectors that packet tests run on: four lanes everywhere (glam's `Vec4`: SSE2 on
+//! every x86-64 CPU), eight where the CPU has AVX, chosen when the scene is built
+//! ([`Width::of_host`]). The build targets baseline x86-64, so the eight-lane code is compiled
+//! for AVX inside [`in_avx`] and entered only with the proof ([`Avx`]) that the CPU has it. This
+//! is the crate's one module with `unsafe` code: the AVX intrinsics and that entry.
+//!
+//! Both widths do the same IEEE operations (no fused multiply-adds; `min`, `max` and the
+//! comparisons treat NaN as SSE does), so a packet test finds the same hits, to the bit, at
+//! either width.
+
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
+
+use glam::{BVec4A, Vec4};
+
+/// How many lanes a packet has.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Width {
+    /// Four (SSE2, or glam's scalar fallback off x86-64).
+    Four,
+    /// Eight, with the proof that this CPU has AVX.
+    #[cfg(target_arch = "x86_64")]
+    Eight(Avx),
+}
+
+impl Width {
+    /// The widest this CPU runs: eight lanes with AVX.
+    pub fn of_host() -> Width {
+        Width::on_host().pop().unwrap_or(Width::Four)
+    }
+
+    /// Every width this CPU runs, narrowest first.
+    pub fn on_host() -> Vec<Width> {
+        let mut widths = vec![Width::Four];
+        #[cfg(target_arch = "x86_64")]
+        widths.extend(Avx::detect().map(Width::Eight));
+        widths
+    }
+}
+
+/// Proof that the CPU has AVX: made only by [`Avx::detect`].
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Avx(());
+
+#[cfg(target_arch = "x86_64")]
+impl Avx {
+    /// The proof, if the CPU reports AVX.
+    pub fn detect() -> Option<Avx> {
+        std::arch::is_x86_feature_detected!("avx").then_some(Avx(()))
+    }
+}
+
+/// Calls `f` from a function compiled for AVX, so that the eight-lane arithmetic inlined into
+/// it runs as AVX instructions. `f` should be `#[inline(always)]` down to its lanes.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+#[inline(always)]
+pub(crate) fn in_avx<R>(_proof: Avx, f: impl FnOnce() -> R) -> R {
+    #[target_feature(enable = "avx")]
+    unsafe fn run<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
+    // SAFETY: `Avx` exists only where the CPU reported AVX.
+    unsafe { run(f) }
+}
+
+/// Lane-wise `f32` arithmetic, comparisons to masks, and selection.
+pub(crate) trait Lanes:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
+{
+    /// A lane-wise truth value.
+    type Mask: Copy
+        + BitAnd<Output = Self::Mask>
+        + BitOr<Output = Self::Mask>
+        + BitXor<Output = Self::Mask>
+        + Not<Output = Self::Mask>;
+    /// Lanes per vector.
+    const N: usize;
+    /// Every lane `v`.
+    fn splat(v: f32) -> Self;
+    /// The first [`Lanes::N`] values of `v`.
+    fn from_slice(v: &[f32]) -> Self;
+    /// The lanes into the first [`Lanes::N`] places of `out`.
+    fn write_to(self, out: &mut [f32]);
+    fn abs(self) -> Self;
+    fn sqrt(self) -> Self;
+    /// `self`'s magnitude with `sign`'s sign.
+    fn copysign(self, sign: Self) -> Self;
+    /// SSE's `minps`: `other` where either is NaN.
+    fn min(self, other: Self) -> Self;
+    /// SSE's `maxps`: `other` where either is NaN.
+    fn max(self, other: Self) -> Self;
+    /// Ordered comparisons: false where either is NaN.
+    fn lt(self, other: Self) -> Self::Mask;
+    fn gt(self, other: Self) -> Self::Mask;
+    fn ge(self, other: Self) -> Self::Mask;
+    fn eq(self, other: Self) -> Self::Mask;
+    /// Lanes that are neither infinite nor NaN.
+    fn is_finite(self) -> Self::Mask;
+    /// `if_true` where `mask` holds, else `if_false`.
+    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+    /// Bit `i` set where lane `i` of `mask` holds.
+    fn bitmask(mask: Self::Mask) -> u32;
+}
+
+impl Lanes for Vec4 {
+    type Mask = BVec4A;
+    const N: usize = 4;
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        Vec4::splat(v)
+    }
+    #[inline(always)]
+    fn from_slice(v: &[f32]) -> Self {
+        Vec4::from_slice(v)
+    }
+    #[inline(always)]
+    fn write_to(self, out: &mut [f32]) {
+        self.write_to_slice(out)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Vec4::abs(self)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Vec4::from_array(self.to_array().map(f32::sqrt))
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        Vec4::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        Vec4::min(self, other)
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        Vec4::max(self, other)
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> BVec4A {
+        self.cmplt(other)
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> BVec4A {
+        self.cmpgt(other)
+    }
+    #[inline(always)]
+    fn ge(self, other: Self) -> BVec4A {
+        self.cmpge(other)
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> BVec4A {
+        self.cmpeq(other)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> BVec4A {
+        self.is_finite_mask()
+    }
+    #[inline(always)]
+    fn select(mask: BVec4A, if_true: Self, if_false: Self) -> Self {
+        Vec4::select(mask, if_true, if_false)
+    }
+    #[inline(always)]
+    fn bitmask(mask: BVec4A) -> u32 {
+        mask.bitmask()
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+pub(crate) use avx::F32x8;
+
+/// Eight lanes in an AVX register. Every function here runs AVX instructions: they may only be
+/// called inside [`in_avx`] (which needs the proof that the CPU has AVX), where they are inlined.
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+mod avx {
+    use std::arch::x86_64::*;
+    use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
+
+    use super::Lanes;
+
+    /// Eight `f32` lanes.
+    #[derive(Clone, Copy, Debug)]
+    pub(crate) struct F32x8(__m256);
+
+    /// Eight lane-wise truth values (all bits set or clear).
+    #[derive(Clone, Copy, Debug)]
+    pub(crate) struct M32x8(__m256);
+
+    /// Runs one AVX intrinsic.
+    macro_rules! avx {
+        ($e:expr) => {
+            // SAFETY: called only inside `in_avx`, which is entered only where the CPU reported
+            // AVX (see the module's documentation).
+            unsafe { $e }
+        };
+    }
+
+    macro_rules! binary {
+        ($trait:ident, $method:ident, $ty:ident, $intrinsic:ident) => {
+            impl $trait for $ty {
+                type Output = $ty;
+                #[inline(always)]
+                fn $method(self, other: $ty) -> $ty {
+                    $ty(avx!($intrinsic(self.0, other.0)))
+                }
+            }
+        };
+    }
+    binary!(Add, add, F32x8, _mm256_add_ps);
+    binary!(Sub, sub, F32x8, _mm256_sub_ps);
+    binary!(Mul, mul, F32x8, _mm256_mul_ps);
+    binary!(Div, div, F32x8, _mm256_div_ps);
+    binary!(BitAnd, bitand, M32x8, _mm256_and_ps);
+    binary!(BitOr, bitor, M32x8, _mm256_or_ps);
+    binary!(BitXor, bitxor, M32x8, _mm256_xor_ps);
+
+    impl Neg for F32x8 {
+        type Output = F32x8;
+        #[inline(always)]
+        fn neg(self) -> F32x8 {
+            F32x8(avx!(_mm256_xor_ps(self.0, _mm256_set1_ps(-0.0))))
+        }
+    }
+
+    impl Not for M32x8 {
+        type Output = M32x8;
+        #[inline(always)]
+        fn not(self) -> M32x8 {
+            M32x8(avx!(_mm256_xor_ps(self.0, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))))
+        }
+    }
+
+    impl Lanes for F32x8 {
+        type Mask = M32x8;
+        const N: usize = 8;
+        #[inline(always)]
+        fn splat(v: f32) -> Self {
+            F32x8(avx!(_mm256_set1_ps(v)))
+        }
+        #[inline(always)]
+        fn from_slice(v: &[f32]) -> Self {
+            assert!(v.len() >= 8, "eight lanes");
+            F32x8(avx!(_mm256_loadu_ps(v.as_ptr())))
+        }
+        #[inline(always)]
+        fn write_to(self, out: &mut [f32]) {
+            assert!(out.len() >= 8, "eight lanes");
+            avx!(_mm256_storeu_ps(out.as_mut_ptr(), self.0))
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            F32x8(avx!(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)))
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            F32x8(avx!(_mm256_sqrt_ps(self.0)))
+        }
+        #[inline(always)]
+        fn copysign(self, sign: Self) -> Self {
+            let mask = avx!(_mm256_set1_ps(-0.0));
+            F32x8(avx!(_mm256_or_ps(
+                _mm256_and_ps(sign.0, mask),
+                _mm256_andnot_ps(mask, self.0)
+            )))
+        }
+        #[inline(always)]
+        fn min(self, other: Self) -> Self {
+            F32x8(avx!(_mm256_min_ps(self.0, other.0)))
+        }
+        #[inline(always)]
+        fn max(self, other: Self) -> Self {
+            F32x8(avx!(_mm256_max_ps(self.0, other.0)))
+        }
+        #[inline(always)]
+        fn lt(self, other: Self) -> M32x8 {
+            M32x8(avx!(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, other.0)))
+        }
+        #[inline(always)]
+        fn gt(self, other: Self) -> M32x8 {
+            M32x8(avx!(_mm256_cmp_ps::<_CMP_GT_OQ>(self.0, other.0)))
+        }
+        #[inline(always)]
+        fn ge(self, other: Self) -> M32x8 {
+            M32x8(avx!(_mm256_cmp_ps::<_CMP_GE_OQ>(self.0, other.0)))
+        }
+        #[inline(always)]
+        fn eq(self, other: Self) -> M32x8 {
+            M32x8(avx!(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, other.0)))
+        }
+        #[inline(always)]
+        fn is_finite(self) -> M32x8 {
+            self.abs().lt(F32x8::splat(f32::INFINITY))
+        }
+        #[inline(always)]
+        fn select(mask: M32x8, if_true: Self, if_false: Self) -> Self {
+            F32x8(avx!(_mm256_blendv_ps(if_false.0, if_true.0, mask.0)))
+        }
+        #[inline(always)]
+        fn bitmask(mask: M32x8) -> u32 {
+            avx!(_mm256_movemask_ps(mask.0)) as u32
+        }
+    }
+}
