@@ -1608,6 +1608,89 @@ mod tests {
         assert_eq!(bsdf.eval(wo, -Vec3::Z), Vec4::new(0.5 / PI, 0.5 / PI, 0.5 / PI, 0.0));
     }
 
+    /// Next-event estimation drops a light sample without its shadow ray where `may_take`
+    /// says no: there `eval` must be zero for every `wo`. Checked on 20,000 random pairs of
+    /// directions for Phong lobes under a tilted shading normal, a coated diffuse (smooth and
+    /// rough coat), a diffuse transmitter and an opaque Lambertian under a clear coat; the
+    /// reflectors must also turn away a good share of directions (the samples it saves).
+    #[test]
+    fn may_take_is_false_only_where_eval_is_zero() {
+        let tilted = Vec3::new(0.3, 0.1, 1.0).normalize();
+        let coat = |roughness: f32| PhysicalMaterial::CoatedDiffuse {
+            reflectance: Vec3::splat(0.7),
+            eta: 1.5,
+            roughness,
+            coat_tint: Vec3::ONE,
+            layering: Coating::Fresnel,
+        };
+        let through = PhysicalMaterial::DiffuseTransmission {
+            reflectance: Vec3::splat(0.3),
+            transmittance: Vec3::splat(0.5),
+        };
+        let opaque = PhysicalMaterial::DiffuseTransmission {
+            reflectance: Vec3::splat(0.6),
+            transmittance: Vec3::ZERO,
+        };
+        let clear = ClearCoat {
+            weight: 1.0,
+            eta: 1.5,
+            alpha: 0.0,
+        };
+        let mut rng = Rng::new(17, 0);
+        let direction = |rng: &mut Rng| {
+            let (z, phi) = (2.0 * rng.uniform() - 1.0, 2.0 * PI * rng.uniform());
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Vec3::new(r * phi.cos(), r * phi.sin(), z)
+        };
+        let wo0 = Vec3::new(0.2, 0.0, 0.98).normalize();
+        let cases: Vec<(&str, Bsdf, bool)> = vec![
+            (
+                "phong",
+                Bsdf::new(
+                    &Lobes::new(&params(0.5, 0.4, 30.0)),
+                    tilted,
+                    Vec3::Z,
+                    wo0,
+                    &RGB,
+                    None,
+                    None,
+                ),
+                true,
+            ),
+            (
+                "smooth coat",
+                Bsdf::physical(&coat(0.0), tilted, Vec3::Z, wo0, &RGB),
+                true,
+            ),
+            (
+                "rough coat",
+                Bsdf::physical(&coat(0.3), Vec3::Z, Vec3::Z, wo0, &RGB),
+                false,
+            ),
+            (
+                "transmitter",
+                Bsdf::physical(&through, Vec3::Z, Vec3::Z, wo0, &RGB),
+                false,
+            ),
+            (
+                "clear-coated",
+                Bsdf::physical(&opaque, Vec3::Z, Vec3::Z, wo0, &RGB).with_clearcoat(clear, wo0),
+                false,
+            ),
+        ];
+        for (name, bsdf, reflector) in cases {
+            let mut refused = 0;
+            for _ in 0..20_000 {
+                let (wo, wi) = (direction(&mut rng), direction(&mut rng));
+                if !bsdf.may_take(wi) {
+                    refused += 1;
+                    assert_eq!(bsdf.eval(wo, wi), Spectrum::ZERO, "{name}: wo {wo} wi {wi}");
+                }
+            }
+            assert!(!reflector || refused > 8_000, "{name}: {refused} refused");
+        }
+    }
+
     #[test]
     fn thin_glass_reflects_both_faces_and_passes_the_rest_straight() {
         let m = PhysicalMaterial::ThinDielectric {
