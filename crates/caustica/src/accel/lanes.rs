@@ -30,10 +30,11 @@ impl Width {
 
     /// Every width this CPU runs, narrowest first.
     pub fn on_host() -> Vec<Width> {
-        let mut widths = vec![Width::Four];
         #[cfg(target_arch = "x86_64")]
-        widths.extend(Avx::detect().map(Width::Eight));
-        widths
+        if let Some(avx) = Avx::detect() {
+            return vec![Width::Four, Width::Eight(avx)];
+        }
+        vec![Width::Four]
     }
 }
 
