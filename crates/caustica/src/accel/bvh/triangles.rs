@@ -151,16 +151,8 @@ impl TriangleBvh {
         let mut best = None;
         if self.packets.len() <= FEW_PACKETS {
             if super::walkable(ray) {
-                for (packet, p) in self.packets.iter().enumerate() {
-                    if let Some((lane, h)) = p.closest_hit(&tr, t) {
-                        t = h.t;
-                        best = Some(LeafHit {
-                            packet,
-                            lane,
-                            u: h.u,
-                            v: h.v,
-                        });
-                    }
+                for packet in 0..self.packets.len() {
+                    self.closest_in_packet(&tr, packet, &mut t, &mut best);
                 }
             }
             return best.map(|b| self.hit(t, b));
@@ -326,19 +318,26 @@ impl TriangleBvh {
     fn closest_in_leaf(&self, tr: &TriangleRay, first: usize, t_max: &mut f32, best: &mut Option<LeafHit>) {
         let mut i = first;
         loop {
-            if let Some((lane, h)) = self.packets[i].closest_hit(tr, *t_max) {
-                *t_max = h.t;
-                *best = Some(LeafHit {
-                    packet: i,
-                    lane,
-                    u: h.u,
-                    v: h.v,
-                });
-            }
+            self.closest_in_packet(tr, i, t_max, best);
             if self.bvh.order[i] & END != 0 {
                 return;
             }
             i += 1;
+        }
+    }
+
+    /// Tests packet `i` for hits closer than `t_max`, shrinking `t_max` and recording the
+    /// closest in `best`.
+    #[inline(always)]
+    fn closest_in_packet(&self, tr: &TriangleRay, i: usize, t_max: &mut f32, best: &mut Option<LeafHit>) {
+        if let Some((lane, h)) = self.packets[i].closest_hit(tr, *t_max) {
+            *t_max = h.t;
+            *best = Some(LeafHit {
+                packet: i,
+                lane,
+                u: h.u,
+                v: h.v,
+            });
         }
     }
 
