@@ -2,7 +2,8 @@
 //! every x86-64 CPU), eight where the CPU has AVX, chosen when the scene is built
 //! ([`Width::of_host`]). The build targets baseline x86-64, so the eight-lane code is compiled
 //! for AVX inside [`in_avx`] and entered only with the proof ([`Avx`]) that the CPU has it. This
-//! is the crate's one module with `unsafe` code: the AVX intrinsics and that entry.
+//! is the crate's one module with `unsafe` code: the AVX intrinsics, that entry and the cache
+//! prefetch hint ([`prefetch`]).
 //!
 //! Both widths do the same IEEE operations (no fused multiply-adds; `min`, `max` and the
 //! comparisons treat NaN as SSE does), so a packet test finds the same hits, to the bit, at
@@ -63,6 +64,20 @@ pub(crate) fn in_avx<R>(_proof: Avx, f: impl FnOnce() -> R) -> R {
     }
     // SAFETY: `Avx` exists only where the CPU reported AVX.
     unsafe { run(f) }
+}
+
+/// Asks the cache for the line holding `*p`, so a read soon after does not wait on memory. A
+/// hint only: it reads nothing the program sees and changes no result; any address is allowed.
+#[allow(unsafe_code)]
+#[inline(always)]
+pub(crate) fn prefetch<T>(p: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE is part of x86-64; a prefetch never faults, whatever the address.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(p.cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = p;
 }
 
 /// Lane-wise `f32` arithmetic, comparisons to masks, and selection.
