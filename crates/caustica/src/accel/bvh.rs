@@ -1,7 +1,9 @@
 //! Bounding volume hierarchy over arbitrary primitives, given by their bounds.
 //!
 //! Built as a binned-SAH binary tree and collapsed into wide nodes whose child boxes are
-//! stored as structure-of-arrays, so one node visit tests its boxes with SSE arithmetic.
+//! stored as structure-of-arrays, so one node visit tests its boxes with SSE arithmetic: four
+//! children a node for a scene's shapes, eight for a triangle mesh's [`TriangleBvh`], where
+//! fewer levels mean fewer dependent cache misses a ray.
 //! Traversal is near-first with a fixed-size stack; primitives are handed to a caller's
 //! closure (generic, so it inlines).
 
@@ -28,47 +30,44 @@ const END: u32 = 1 << 31;
 /// ray touches (flat boxes of axis-aligned triangles included).
 /// Applied to the inverse direction, so it also covers that product's rounding.
 const ROBUST: f32 = 1.0 + 4.0 * f32::EPSILON;
-/// Children per node.
-const WIDTH: usize = 4;
+/// Children per node, at most.
+const MAX_WIDTH: usize = 8;
 
 /// Leaf entries (primitives, or a triangle BVH's packets of four) at most this many are tested
 /// leaf by leaf from the root's boxes, without the walk's stack: a floor of two triangles, two
 /// balls. The glass ball over a floor renders 7% faster (BENCHMARKS.md); brute force at 8
 /// entries cost the Cornell box's seven shapes 6% more instructions.
 const FEW: usize = 2;
-/// Four-lane vectors per row of child bounds.
-const HALVES: usize = WIDTH / 4;
 /// Stack sizes of the traversal variants: a query uses the smallest that the tree's depth
 /// allows, because a stack the query owns (ray streams, queries nested in another's callback)
 /// is cleared when made, and clearing a larger one than needed cost 5–10% of an incoherent query
 /// (the `bvh` bench, 37k and 1M triangles). Single queries borrow the thread's scratch stack,
-/// which needs no clearing. Each level pushes at most `WIDTH - 1` entries: 8 entries hold trees
-/// of two levels (scenes of a few shapes), 32 of ten (tens of thousands of triangles), 64 of
-/// twenty-one (millions).
+/// which needs no clearing. Each level pushes at most one entry fewer than a node's width: in
+/// four-wide trees 8 entries hold two levels (scenes of a few shapes), 32 ten, 64 twenty-one;
+/// in eight-wide ones 64 entries hold nine levels (millions of triangles).
 const TINY_STACK: usize = 8;
 const SMALL_STACK: usize = 32;
 const MEDIUM_STACK: usize = 64;
 const LARGE_STACK: usize = 512;
 
-/// A wide node: child boxes as `[axis][min, max]` rows of lanes, then child references
-/// (inner node index, or `LEAF | first` for leaves). A whole number of cache lines.
+/// A wide node of `R` rows of four children: child boxes as `[axis][min, max]` rows of lanes,
+/// then child references (inner node index, or `LEAF | first` for leaves). A whole number of
+/// cache lines.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
-pub(crate) struct Node {
-    bounds: [[[Vec4; HALVES]; 2]; 3],
-    children: [u32; WIDTH],
-    _pad: [u32; WIDTH],
+pub(crate) struct Node<const R: usize> {
+    bounds: [[[Vec4; R]; 2]; 3],
+    children: [[u32; 4]; R],
 }
 
-impl Node {
+impl<const R: usize> Node<R> {
+    /// Children per node.
+    const WIDTH: usize = 4 * R;
+
     /// Unused slots have inverted infinite boxes, which every slab test rejects.
-    const EMPTY: Node = Node {
-        bounds: [[
-            [Vec4::splat(f32::INFINITY); HALVES],
-            [Vec4::splat(f32::NEG_INFINITY); HALVES],
-        ]; 3],
-        children: [0; WIDTH],
-        _pad: [0; WIDTH],
+    const EMPTY: Node<R> = Node {
+        bounds: [[[Vec4::splat(f32::INFINITY); R], [Vec4::splat(f32::NEG_INFINITY); R]]; 3],
+        children: [[0; 4]; R],
     };
 
     fn set_child(&mut self, slot: usize, min: Vec3, max: Vec3, child: u32) {
@@ -76,7 +75,13 @@ impl Node {
             self.bounds[axis][0][slot / 4][slot % 4] = min[axis];
             self.bounds[axis][1][slot / 4][slot % 4] = max[axis];
         }
-        self.children[slot] = child;
+        self.children[slot / 4][slot % 4] = child;
+    }
+
+    /// Child reference of `slot`.
+    #[inline(always)]
+    fn child(&self, slot: usize) -> u32 {
+        self.children[(slot / 4) % R][slot % 4]
     }
 
     /// Box of child `slot` (inverted for unused slots).
@@ -119,36 +124,49 @@ impl RayPre {
     }
 
     /// Which of the node's boxes the segment `[0, t_max]` meets (bit per slot), and the entry
-    /// distances. Reductions are balanced trees: traversal is bound by this dependency chain.
+    /// distances.
     #[inline(always)]
-    fn hit(&self, node: &Node, t_max: f32) -> (u32, [Vec4; HALVES]) {
-        let [nx, ny, nz] = self.near;
+    fn hit<const R: usize>(&self, node: &Node<R>, t_max: f32) -> (u32, [Vec4; R]) {
         let mut mask = 0;
-        let mut t_nears = [Vec4::ZERO; HALVES];
+        let mut t_nears = [Vec4::ZERO; R];
         for (h, t_near_out) in t_nears.iter_mut().enumerate() {
-            let near =
-                |axis: usize, side: usize| (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir[axis];
-            let far = |axis: usize, side: usize| {
-                (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir_far[axis]
-            };
-            let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
-            let t_far = far(0, nx ^ 1)
-                .min(far(1, ny ^ 1))
-                .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
-            mask |= t_near.cmple(t_far).bitmask() << (4 * h);
+            let (bits, t_near) = self.row(node, h, t_max);
+            mask |= bits << (4 * h);
             *t_near_out = t_near;
         }
         (mask, t_nears)
+    }
+
+    /// [`RayPre::hit`]'s mask for a node of four children or fewer.
+    #[inline(always)]
+    fn hit_first_row<const R: usize>(&self, node: &Node<R>, t_max: f32) -> u32 {
+        self.row(node, 0, t_max).0
+    }
+
+    /// The slab tests of row `h` of a node's boxes: the lanes met and their entry distances.
+    /// Reductions are balanced trees: traversal is bound by this dependency chain.
+    #[inline(always)]
+    fn row<const R: usize>(&self, node: &Node<R>, h: usize, t_max: f32) -> (u32, Vec4) {
+        let [nx, ny, nz] = self.near;
+        let near = |axis: usize, side: usize| (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir[axis];
+        let far =
+            |axis: usize, side: usize| (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir_far[axis];
+        let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
+        let t_far = far(0, nx ^ 1)
+            .min(far(1, ny ^ 1))
+            .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
+        (t_near.cmple(t_far).bitmask(), t_near)
     }
 }
 
 /// A bounding volume hierarchy over primitives given by bounding boxes.
 ///
 /// Primitives are referred to by their index in the slice passed to [`Bvh::build`].
-/// Primitives with non-finite or empty bounds are left out and never reported.
+/// Primitives with non-finite or empty bounds are left out and never reported. Nodes have `R`
+/// rows of four children.
 #[derive(Clone, Debug)]
-pub struct Bvh {
-    nodes: Vec<Node>,
+pub struct Bvh<const R: usize = 1> {
+    nodes: Vec<Node<R>>,
     /// Primitive ids in leaf order; `END` marks the last of each leaf.
     order: Vec<u32>,
     bounds: Aabb,
@@ -171,9 +189,11 @@ impl Bvh {
     pub fn build_reporting(prim_bounds: &[Aabb], progress: &dyn Progress) -> Bvh {
         Bvh::build_priced(prim_bounds, build::LeafCost::SINGLE, progress)
     }
+}
 
+impl<const R: usize> Bvh<R> {
     /// [`Bvh::build_reporting`] with leaves priced by `leaf`.
-    fn build_priced(prim_bounds: &[Aabb], leaf: build::LeafCost, progress: &dyn Progress) -> Bvh {
+    fn build_priced(prim_bounds: &[Aabb], leaf: build::LeafCost, progress: &dyn Progress) -> Bvh<R> {
         let c = build::collapse(build::build_bvh2(prim_bounds, leaf, progress));
         Bvh {
             nodes: c.nodes,
@@ -204,10 +224,11 @@ impl Bvh {
         self.order.iter().map(|&p| p & !END)
     }
 
-    /// Whether a traversal stack of `entries` suffices (each level pushes at most `WIDTH - 1`).
+    /// Whether a traversal stack of `entries` suffices (each level pushes at most one entry
+    /// fewer than a node's width).
     #[inline(always)]
     fn stack_fits(&self, entries: usize) -> bool {
-        (WIDTH - 1) * self.depth as usize <= entries
+        (Node::<R>::WIDTH - 1) * self.depth as usize <= entries
     }
 
     /// Closest hit. `intersect(prim, t_max)` tests primitive `prim` (an index into the bounds
@@ -273,8 +294,8 @@ impl Bvh {
         // Each level leaves at most `WIDTH - 1` siblings waiting, and the last pushes `WIDTH`.
         // A stack that deep and no more: clearing a fixed 8 KiB one per query was 0.4% of the
         // original's ring (135k queries around gather points).
-        let need = (WIDTH - 1) * self.depth as usize + 1;
-        let mut small = [0u32; 1 + (WIDTH - 1) * 21];
+        let need = (Node::<R>::WIDTH - 1) * self.depth as usize + 1;
+        let mut small = [0u32; 1 + 3 * 21];
         let mut large = Vec::new();
         let stack: &mut [u32] = if need <= small.len() {
             &mut small
@@ -302,14 +323,14 @@ impl Bvh {
                 continue;
             }
             let node = &self.nodes[current as usize];
-            for slot in 0..WIDTH {
+            for slot in 0..Node::<R>::WIDTH {
                 let overlaps = (0..3).all(|axis| {
                     let lo = node.bounds[axis][0][slot / 4][slot % 4];
                     let hi = node.bounds[axis][1][slot / 4][slot % 4];
                     lo <= qmax[axis] && hi >= qmin[axis]
                 });
                 if overlaps && sp < stack.len() {
-                    stack[sp] = node.children[slot];
+                    stack[sp] = node.child(slot);
                     sp += 1;
                 }
             }
@@ -340,13 +361,13 @@ impl Bvh {
         mut leaf: F,
     ) -> bool {
         /// One ray's traversal, generic over its stack size.
-        struct Walk<'a, F> {
-            bvh: &'a Bvh,
+        struct Walk<'a, const R: usize, F> {
+            bvh: &'a Bvh<R>,
             ray: &'a Ray,
             t_max: &'a mut f32,
             leaf: F,
         }
-        impl<F: FnMut(&[u32], usize, &mut f32) -> bool> StackSized for Walk<'_, F> {
+        impl<const R: usize, F: FnMut(&[u32], usize, &mut f32) -> bool> StackSized for Walk<'_, R, F> {
             type Output = bool;
             #[inline(always)]
             fn run<const N: usize>(self) -> bool {
@@ -359,12 +380,13 @@ impl Bvh {
         if self.order.len() <= FEW && walkable(ray) {
             // The root's leaves the ray meets, tested in turn: the walk's stack costs more.
             let root = &self.nodes[0];
-            let (mask, _) = RayPre::new(ray).hit(root, *t_max);
-            let slots = (0..WIDTH).filter(|&slot| mask & (1 << slot) != 0);
-            if slots.clone().all(|slot| root.children[slot] & LEAF != 0) {
+            // At most `FEW` children: the first row holds them.
+            let mask = RayPre::new(ray).hit_first_row(root, *t_max);
+            let slots = (0..4).filter(|&slot| mask & (1 << slot) != 0);
+            if slots.clone().all(|slot| root.child(slot) & LEAF != 0) {
                 return slots
                     .into_iter()
-                    .any(|slot| leaf(&self.order, (root.children[slot] & !LEAF) as usize, t_max));
+                    .any(|slot| leaf(&self.order, (root.child(slot) & !LEAF) as usize, t_max));
             }
         }
         self.with_stack(Walk {
@@ -393,8 +415,21 @@ impl Bvh {
                     .expect("no tier exceeds the scratch stack");
                 Traversal::new(ray, *t_max, stack).is_some_and(|walk| self.walk(walk, t_max, &mut leaf))
             }
-            Err(_) => Traversal::new(ray, *t_max, [(0, 0.0); N]).is_some_and(|walk| self.walk(walk, t_max, &mut leaf)),
+            Err(_) => self.traverse_nested::<N>(ray, t_max, &mut leaf),
         })
+    }
+
+    /// [`Bvh::traverse`] for a query made inside another's callback, with a stack of its own.
+    /// Kept out of line: inlined, its stack array grows every query's frame past a page.
+    #[cold]
+    #[inline(never)]
+    fn traverse_nested<const N: usize>(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        leaf: &mut impl FnMut(&[u32], usize, &mut f32) -> bool,
+    ) -> bool {
+        Traversal::new(ray, *t_max, [(0, 0.0); N]).is_some_and(|walk| self.walk(walk, t_max, leaf))
     }
 
     /// Runs `walk` to its end, handing leaves to `leaf` (see [`Bvh::traverse`]).
@@ -406,7 +441,7 @@ impl Bvh {
         leaf: &mut impl FnMut(&[u32], usize, &mut f32) -> bool,
     ) -> bool {
         let found = loop {
-            match walk.step(&self.nodes) {
+            match walk.step::<R, true>(&self.nodes) {
                 Visit::Node => {}
                 Visit::Leaf(first) => {
                     if leaf(&self.order, first, &mut walk.t_max) {
@@ -459,11 +494,12 @@ enum Visit {
 /// million triangles, +13–18% single-ray throughput (`bvh` bench). Prefetching leaves' triangle
 /// packets as well measured no better.
 #[inline(always)]
-fn fetch(nodes: &[Node], child: u32) {
+fn fetch<const R: usize>(nodes: &[Node<R>], child: u32) {
     if child & LEAF == 0 {
         let node = nodes.as_ptr().wrapping_add(child as usize);
-        super::lanes::prefetch(node);
-        super::lanes::prefetch(node.cast::<u8>().wrapping_add(64));
+        for line in 0..std::mem::size_of::<Node<R>>() / 64 {
+            super::lanes::prefetch(node.cast::<u8>().wrapping_add(64 * line));
+        }
     }
 }
 
@@ -510,9 +546,12 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
         true
     }
 
-    /// Visits the next inner node, or reports the next leaf or the end of the walk.
+    /// Visits the next inner node, or reports the next leaf or the end of the walk. With
+    /// `FETCH`, children put off are prefetched ([`fetch`]): a single walk gains, while
+    /// interleaved walks already overlap their misses and only pay the extra instructions.
     #[inline(always)]
-    fn step(&mut self, nodes: &[Node]) -> Visit {
+    fn step<const R: usize, const FETCH: bool>(&mut self, nodes: &[Node<R>]) -> Visit {
+        let width = Node::<R>::WIDTH;
         if self.cur & LEAF != 0 {
             return Visit::Leaf((self.cur & !LEAF) as usize);
         }
@@ -522,19 +561,22 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
             return if self.pop() { Visit::Node } else { Visit::Done };
         }
         // Most visits hit one or two children: handle those without sorting.
-        let first = mask.trailing_zeros() as usize % WIDTH;
+        let first = mask.trailing_zeros() as usize % width;
         let rest = mask & (mask - 1);
         if rest == 0 {
-            self.cur = node.children[first];
+            self.cur = node.child(first);
             return Visit::Node;
         }
-        let t: [f32; WIDTH] = std::array::from_fn(|i| t_near[i / 4][i % 4]);
+        let t: [f32; MAX_WIDTH] = std::array::from_fn(|i| t_near[(i / 4) % R][i % 4]);
+        let t = |slot: usize| t[slot % MAX_WIDTH];
         if rest & (rest - 1) == 0 {
-            let second = rest.trailing_zeros() as usize % WIDTH;
-            let (c0, c1) = (node.children[first], node.children[second]);
-            let (t0, t1) = (t[first], t[second]);
+            let second = rest.trailing_zeros() as usize % width;
+            let (c0, c1) = (node.child(first), node.child(second));
+            let (t0, t1) = (t(first), t(second));
             let (near, far, far_t) = if t1 < t0 { (c1, c0, t0) } else { (c0, c1, t1) };
-            fetch(nodes, far);
+            if FETCH {
+                fetch(nodes, far);
+            }
             self.stack.borrow_mut()[self.sp % N] = (far, far_t);
             self.sp += 1;
             self.cur = near;
@@ -542,28 +584,31 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
         }
         // Three or more: insertion-sort keys (distance bits, which order like non-negative
         // floats, with the slot in the low bits), farthest first.
-        let mut keys = [0u32; WIDTH];
+        let slot_bits = width as u32 - 1;
+        let mut keys = [0u32; MAX_WIDTH];
         let mut count = 0;
         let mut m = mask;
         while m != 0 {
             let slot = m.trailing_zeros();
             m &= m - 1;
-            let key = (t[slot as usize % WIDTH].to_bits() & !(WIDTH as u32 - 1)) | slot;
+            let key = (t(slot as usize).to_bits() & !slot_bits) | slot;
             let mut j = count;
             while j > 0 && keys[j - 1] < key {
                 keys[j] = keys[j - 1];
                 j -= 1;
             }
-            keys[j % WIDTH] = key;
+            keys[j % MAX_WIDTH] = key;
             count += 1;
         }
         for &key in &keys[..count - 1] {
-            let slot = (key as usize) % WIDTH;
-            fetch(nodes, node.children[slot]);
-            self.stack.borrow_mut()[self.sp % N] = (node.children[slot], f32::from_bits(key & !(WIDTH as u32 - 1)));
+            let child = node.child((key & slot_bits) as usize);
+            if FETCH {
+                fetch(nodes, child);
+            }
+            self.stack.borrow_mut()[self.sp % N] = (child, f32::from_bits(key & !slot_bits));
             self.sp += 1;
         }
-        self.cur = node.children[(keys[(count - 1) % WIDTH] as usize) % WIDTH];
+        self.cur = node.child((keys[(count - 1) % MAX_WIDTH] & slot_bits) as usize);
         Visit::Node
     }
 

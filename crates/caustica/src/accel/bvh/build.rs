@@ -4,7 +4,7 @@
 use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
-use super::{Node, END, LEAF, WIDTH};
+use super::{Node, END, LEAF, MAX_WIDTH};
 use crate::math::Aabb;
 use crate::progress::Progress;
 
@@ -497,15 +497,15 @@ fn median_split(refs: &mut [PrimRef], cbounds: &Box4) -> usize {
 
 /// The traversal tree: wide nodes collapsed from the binary tree, and the leaf order with
 /// the last primitive of each leaf flagged by `END`.
-pub(super) struct Collapsed {
-    pub(super) nodes: Vec<Node>,
+pub(super) struct Collapsed<const R: usize> {
+    pub(super) nodes: Vec<Node<R>>,
     pub(super) order: Vec<u32>,
     pub(super) bounds: Aabb,
     /// Depth of the wide tree (root = 1).
     pub(super) depth: u32,
 }
 
-pub(super) fn collapse(bvh2: Bvh2) -> Collapsed {
+pub(super) fn collapse<const R: usize>(bvh2: Bvh2) -> Collapsed<R> {
     let Bvh2 { nodes: n2, mut ids } = bvh2;
     if n2.is_empty() {
         return Collapsed {
@@ -526,8 +526,9 @@ pub(super) fn collapse(bvh2: Bvh2) -> Collapsed {
 }
 
 /// Emits the wide node for binary node `i` and its subtree (pre-order); returns the depth.
-fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node>, ids: &mut [u32]) -> u32 {
-    let mut kids = [0usize; WIDTH];
+fn emit<const R: usize>(n2: &[Node2], i: usize, out: &mut Vec<Node<R>>, ids: &mut [u32]) -> u32 {
+    let width = Node::<R>::WIDTH;
+    let mut kids = [0usize; MAX_WIDTH];
     let mut k;
     if n2[i].count > 0 {
         // Only a leaf root gets here.
@@ -538,7 +539,7 @@ fn emit(n2: &[Node2], i: usize, out: &mut Vec<Node>, ids: &mut [u32]) -> u32 {
         kids[1] = n2[i].b as usize;
         k = 2;
         // Open the inner child with the largest area until the node is full.
-        while k < WIDTH {
+        while k < width {
             let best = (0..k)
                 .filter(|&s| n2[kids[s]].count == 0)
                 .fold(None, |best: Option<usize>, s| match best {

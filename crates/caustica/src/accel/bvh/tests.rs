@@ -191,6 +191,9 @@ fn pathological_depth_is_capped() {
     let bounds: Vec<Aabb> = tris.iter().map(Triangle::bounds).collect();
     let bvh = Bvh::build(&bounds);
     assert!(bvh.depth() < 80, "depth {}", bvh.depth());
+    // The eight-wide triangle tree's walk must fit its stack too.
+    let tbvh = TriangleBvh::new(&tris);
+    assert!(tbvh.bvh.stack_fits(LARGE_STACK), "depth {}", tbvh.depth());
     for _ in 0..2000 {
         let o = Vec3::new(-1.0, rng.f(), rng.f());
         let ray = Ray::new(o, Vec3::new(1.0, (rng.f() - 0.5) * 0.01, (rng.f() - 0.5) * 0.01));
@@ -199,6 +202,11 @@ fn pathological_depth_is_capped() {
             tris[p as usize].intersect(&ray, t).map(|h| h.t)
         });
         assert!(same_hit(&tris, &ray, got, expect), "{got:?} vs {expect:?}");
+        let fast = tbvh.closest_hit(&ray, f32::INFINITY).map(|h| (h.t, h.prim));
+        assert!(
+            same_hit(&tris, &ray, fast, expect),
+            "triangle bvh {fast:?} vs {expect:?}"
+        );
     }
 }
 
@@ -347,8 +355,10 @@ fn sphere(rings: usize, segments: usize) -> Vec<Triangle> {
 
 #[test]
 fn node_layout() {
-    assert_eq!(std::mem::size_of::<Node>(), 32 * WIDTH);
-    assert_eq!(std::mem::align_of::<Node>(), 64);
+    // Two cache lines for four children, four for eight.
+    assert_eq!(std::mem::size_of::<Node<1>>(), 128);
+    assert_eq!(std::mem::size_of::<Node<2>>(), 256);
+    assert_eq!(std::mem::align_of::<Node<2>>(), 64);
 }
 
 fn snapshot(bvh: &Bvh) -> (Vec<u32>, Vec<u32>, u32) {
@@ -362,7 +372,7 @@ fn snapshot(bvh: &Bvh) -> (Vec<u32>, Vec<u32>, u32) {
                 .flatten()
                 .flat_map(|v| v.to_array())
                 .map(f32::to_bits)
-                .chain(n.children)
+                .chain(n.children.into_iter().flatten())
         })
         .collect();
     (bits, bvh.order.clone(), bvh.depth)
@@ -402,12 +412,12 @@ fn bounds_contain_children() {
     let mut leaves = 0;
     while let Some(n) = stack.pop() {
         let node = &bvh.nodes[n as usize];
-        for slot in 0..WIDTH {
+        for slot in 0..Node::<1>::WIDTH {
             let (lo, hi) = node.child_box(slot);
             if lo.x > hi.x {
                 continue;
             }
-            let c = node.children[slot];
+            let c = node.child(slot);
             if c & LEAF == 0 {
                 stack.push(c);
                 continue;
