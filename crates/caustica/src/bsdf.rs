@@ -714,7 +714,11 @@ impl Bsdf {
         }
         if x < p_diffuse + p_glossy {
             let wi = if x < p_diffuse {
-                self.frame.to_world(sample_cosine_hemisphere(u))
+                let wi = self.frame.to_world(sample_cosine_hemisphere(u));
+                if self.rough == 0.0 && self.p_coat == 0.0 && self.glossy == Spectrum::ZERO && self.is_lambertian() {
+                    return self.lambertian_sample(wi);
+                }
+                wi
             } else {
                 let r = reflect(-wo, n);
                 let cos_a = u.x.powf(1.0 / (self.exponent + 1.0));
@@ -803,6 +807,28 @@ pub fn adjoint_correction(ns: Vec3, ng: Vec3, wo: Vec3, wi: Vec3) -> Option<f32>
 
 impl Bsdf {
     /// The sample of a smooth lobe in direction `wi`, weighted by the whole mixture.
+    /// [`Bsdf::smooth_sample`] of a purely Lambertian reflector: the same arithmetic as its
+    /// `pdf` and `eval` there, without their tests for the lobes it lacks.
+    #[inline]
+    fn lambertian_sample(&self, wi: Vec3) -> Option<BsdfSample> {
+        let cos_i = self.frame.z.dot(wi);
+        if cos_i <= 0.0 || self.ng.dot(wi) <= 0.0 {
+            return None;
+        }
+        let pdf = self.pick[0] * cos_i / PI;
+        if pdf.is_nan() || pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            weight: self.diffuse * (1.0 / PI) * cos_i.abs() / pdf,
+            pdf,
+            specular: false,
+            transmitted: false,
+            dispersive: false,
+        })
+    }
+
     fn smooth_sample(&self, wo: Vec3, wi: Vec3) -> Option<BsdfSample> {
         let pdf = self.pdf(wo, wi);
         if pdf.is_nan() || pdf <= 0.0 {
@@ -1207,6 +1233,49 @@ mod tests {
         let expected = wo.dot(ns) * wi.dot(ng) / (wo.dot(ng) * wi.dot(ns));
         assert!((c - expected).abs() < 1e-6 * expected, "{c} vs {expected}");
         assert_eq!(adjoint_correction(ns, ng, Vec3::X, wi), None);
+    }
+
+    /// A Lambertian reflector's samples skip the generic `pdf` and `eval`, with the same
+    /// arithmetic: the same bits as `smooth_sample` of the same direction, under tilted shading
+    /// normals too (where some directions fall below the geometric surface).
+    #[test]
+    fn lambertian_samples_are_the_generic_samples_bit_for_bit() {
+        let mut rng = Rng::new(7, 0);
+        let (mut taken, mut tried) = (0, 0);
+        for kd in [0.8, 0.25] {
+            for _ in 0..20_000 {
+                let ng = Vec3::Z;
+                let tilt = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, 0.0);
+                let ns = (ng + tilt).normalize();
+                let wo = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform()).normalize();
+                let bsdf = Bsdf::new(&Lobes::new(&params(kd, 0.0, 1.0)), ns, ng, wo, &RGB, None, None);
+                assert!(bsdf.is_lambertian());
+                let (u_lobe, u) = (rng.uniform(), rng.uniform2());
+                let wi = bsdf.frame.to_world(sample_cosine_hemisphere(u));
+                let fast = bsdf.sample(wo, u_lobe, u, Transport::Radiance);
+                let generic = bsdf.smooth_sample(wo, wi);
+                tried += 1;
+                taken += usize::from(fast.is_some());
+                match (fast, generic) {
+                    (Some(a), Some(b)) => {
+                        assert_eq!(a.wi, b.wi);
+                        assert_eq!(
+                            a.weight.to_array().map(f32::to_bits),
+                            b.weight.to_array().map(f32::to_bits)
+                        );
+                        assert_eq!(a.pdf.to_bits(), b.pdf.to_bits());
+                        assert_eq!(
+                            (a.specular, a.transmitted, a.dispersive),
+                            (b.specular, b.transmitted, b.dispersive)
+                        );
+                    }
+                    (None, None) => {}
+                    (a, b) => panic!("{a:?} vs {b:?}"),
+                }
+            }
+        }
+        // Most samples are taken, and some fall below the geometric surface.
+        assert!(taken > tried * 3 / 4 && taken < tried, "{taken} of {tried}");
     }
 
     #[test]
