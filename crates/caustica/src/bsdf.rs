@@ -120,12 +120,19 @@ impl Lambertian {
     /// The density of drawing `wi`, or `None` where `wi` is not on the lit side (f is zero).
     #[inline]
     pub fn pdf(&self, wi: Vec3) -> Option<f32> {
-        let cos_i = self.n.dot(wi);
-        if cos_i <= 0.0 || self.ng.dot(wi) <= 0.0 {
-            return None;
-        }
-        Some(self.pick * cos_i / PI)
+        lit_pdf(self.n, self.ng, self.pick, wi)
     }
+}
+
+/// The density of drawing `wi` from a Lambertian lobe picked with probability `pick`, under
+/// shading normal `n` and geometric normal `ng`, or `None` off the lit side.
+#[inline]
+fn lit_pdf(n: Vec3, ng: Vec3, pick: f32, wi: Vec3) -> Option<f32> {
+    let cos_i = n.dot(wi);
+    if cos_i <= 0.0 || ng.dot(wi) <= 0.0 {
+        return None;
+    }
+    Some(pick * cos_i / PI)
 }
 
 /// Whose Fresnel reflectance a microfacet lobe has.
@@ -648,10 +655,16 @@ impl Bsdf {
         Some(Lambertian {
             n: self.frame.z,
             ng: self.ng,
-            f: self.diffuse * (1.0 / PI),
+            f: self.lambertian_f(),
             pick: self.pick[0],
             reverse,
         })
+    }
+
+    /// f of a purely Lambertian reflection, as [`Bsdf::eval_in`] computes it.
+    #[inline]
+    fn lambertian_f(&self) -> Spectrum {
+        self.diffuse * (1.0 / PI)
     }
 
     /// Solid-angle pdf with which [`Bsdf::sample`] draws `wi` through its smooth lobes.
@@ -811,17 +824,13 @@ impl Bsdf {
     /// `pdf` and `eval` there, without their tests for the lobes it lacks.
     #[inline]
     fn lambertian_sample(&self, wi: Vec3) -> Option<BsdfSample> {
-        let cos_i = self.frame.z.dot(wi);
-        if cos_i <= 0.0 || self.ng.dot(wi) <= 0.0 {
-            return None;
-        }
-        let pdf = self.pick[0] * cos_i / PI;
+        let pdf = lit_pdf(self.frame.z, self.ng, self.pick[0], wi)?;
         if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {
             wi,
-            weight: self.diffuse * (1.0 / PI) * cos_i.abs() / pdf,
+            weight: self.lambertian_f() * self.frame.z.dot(wi).abs() / pdf,
             pdf,
             specular: false,
             transmitted: false,
