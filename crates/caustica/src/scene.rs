@@ -892,7 +892,13 @@ impl Scene {
     /// The nearest triangle hit in `(0, t_max)` that is not in a cut-out.
     #[inline]
     fn closest_triangle(&self, ray: &Ray, t_max: f32) -> Option<TriangleBvhHit> {
-        let hit = self.triangle_bvh.closest_hit(ray, t_max)?;
+        self.solid_triangle(ray, t_max, self.triangle_bvh.closest_hit(ray, t_max))
+    }
+
+    /// The nearest triangle hit in `(0, t_max)` not in a cut-out, given the nearest `hit` of all.
+    #[inline]
+    fn solid_triangle(&self, ray: &Ray, t_max: f32, hit: Option<TriangleBvhHit>) -> Option<TriangleBvhHit> {
+        let hit = hit?;
         if !self.is_hole(ray, &hit) {
             return Some(hit);
         }
@@ -910,7 +916,37 @@ impl Scene {
     /// The closest hit in `(0, t_max)`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Intersection> {
-        let mut best = self.closest_triangle(ray, t_max).map(|h| self.triangle_intersection(h));
+        let triangle = self.closest_triangle(ray, t_max).map(|h| self.triangle_intersection(h));
+        self.closest_shape(ray, t_max, triangle)
+    }
+
+    /// The closest hit in `(0, ∞)` of each ray, into `hits` (one per ray): [`Scene::intersect`]
+    /// ray by ray, with the same answers, the triangles' tree walked for several rays at once
+    /// when it is large ([`TriangleBvh::closest_hits`]), so their cache misses overlap.
+    ///
+    /// # Panics
+    /// If `hits` and `rays` differ in length.
+    pub fn intersect_stream(&self, rays: &[Ray], hits: &mut [Option<Intersection>]) {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        if !self.triangle_bvh.walks() {
+            for (ray, hit) in rays.iter().zip(hits) {
+                *hit = self.intersect(ray, f32::INFINITY);
+            }
+            return;
+        }
+        let mut triangles = vec![None; rays.len()];
+        self.triangle_bvh.closest_hits(rays, f32::INFINITY, &mut triangles);
+        for ((ray, hit), triangle) in rays.iter().zip(hits).zip(triangles) {
+            let triangle = self
+                .solid_triangle(ray, f32::INFINITY, triangle)
+                .map(|h| self.triangle_intersection(h));
+            *hit = self.closest_shape(ray, f32::INFINITY, triangle);
+        }
+    }
+
+    /// The closest hit in `(0, t_max)` of the shapes and `best`, the nearest triangle's.
+    #[inline]
+    fn closest_shape(&self, ray: &Ray, t_max: f32, mut best: Option<Intersection>) -> Option<Intersection> {
         let t_max = best.map_or(t_max, |h| h.t);
         if let Some(packets) = &self.shape_packets {
             // The packets pick the shape; its own test (the same arithmetic) gives the record.
@@ -1403,6 +1439,57 @@ mod tests {
             assert_eq!(visited, every, "{ray:?}");
         }
         assert!(hits > 1000, "{hits} hits");
+    }
+
+    /// A wave of rays traced together finds, ray by ray and to the bit, what each ray finds
+    /// alone: over a mesh large enough to walk its tree and over two triangles tested without
+    /// one, beside shapes in a hierarchy (a ball and a box) or in packets (squares and balls),
+    /// zero directions included.
+    #[test]
+    fn rays_traced_together_find_what_each_finds_alone() {
+        let floor = "polymesh { points = ((-2,-2,0),(2,-2,0),(2,2,0),(-2,2,0)); faces = ((0,1,2),(0,2,3));
+                     material = { diffuse = (1,1,1); } }";
+        let in_hierarchy = "translate(0.5, 0, 0.2, scale(0.6, 0.6, 0.6, sphere { material = { diffuse = (1,1,1); } }))
+                            translate(-1, 1, 0, box { material = { diffuse = (1,1,1); } })";
+        let in_packets = "translate(0.5, 0, 0.2, scale(0.6, sphere { material = { diffuse = (1,1,1); } }))
+                          translate(-1, 1, 0.3, scale(0.4, sphere { material = { diffuse = (1,1,1); } }))
+                          translate(0, 0, -0.5, scale(3, square { material = { diffuse = (1,1,1); } }))
+                          translate(1, -1, 0.5, rotate(1, 0, 0, 0.7, scale(1.5, square { material = { diffuse = (1,1,1); } })))
+                          translate(-1.5, 0, 0.5, rotate(0, 1, 0, 1.2, scale(2, square { material = { diffuse = (1,1,1); } })))";
+        for (mesh, walks) in [(build::bumpy_sheet(12), true), (floor.to_string(), false)] {
+            for (shapes, packed) in [(in_hierarchy, false), (in_packets, true)] {
+                let scene = build::test_scene(&format!("{mesh}\n{shapes}"));
+                assert_eq!(scene.triangle_bvh.walks(), walks);
+                assert_eq!(scene.shape_packets.is_some(), packed);
+                let mut f = uniform_pm1();
+                let mut rays: Vec<Ray> = (0..3000)
+                    .map(|_| {
+                        let origin = Vec3::new(f(), f(), f()) * 3.0;
+                        Ray::new(origin, Vec3::new(f(), f(), f()) * 1.5 - origin)
+                    })
+                    .collect();
+                rays.insert(17, Ray::new(Vec3::new(0.5, 0.0, 0.2), Vec3::ZERO));
+                rays.push(Ray::new(Vec3::ZERO, Vec3::ZERO));
+                let mut together = vec![None; rays.len()];
+                scene.intersect_stream(&rays, &mut together);
+                let alone: Vec<Option<Intersection>> = rays.iter().map(|r| scene.intersect(r, f32::INFINITY)).collect();
+                assert_eq!(together, alone);
+                let n_shapes = scene.shapes().len() as u32;
+                let hits = |triangle: bool| {
+                    alone
+                        .iter()
+                        .flatten()
+                        .filter(|h| (h.prim >= n_shapes) == triangle)
+                        .count()
+                };
+                assert!(
+                    hits(true) > 300 && hits(false) > 300,
+                    "{} triangle and {} shape hits",
+                    hits(true),
+                    hits(false)
+                );
+            }
+        }
     }
 
     /// Segments from a gather point, tested against the primitives near it and skipping those

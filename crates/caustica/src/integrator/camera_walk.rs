@@ -115,44 +115,116 @@ pub trait CameraVisitor {
 /// bounce on (`u32::MAX`: never). Returns the rays traced (surfaces found and the last miss).
 pub fn walk_camera(
     scene: &Scene,
-    mut ray: Ray,
+    ray: Ray,
     wl: &Wavelengths,
-    (max_surfaces, roulette_from): (u32, u32),
+    limits: (u32, u32),
     rng: &mut Rng,
     visitor: &mut impl CameraVisitor,
 ) -> u64 {
-    let mut throughput = wl.grey(1.0);
-    let mut dispersed = false;
-    let mut passage = Passage::new(scene, scene.camera_medium());
-    let mut rays = 0;
-    for length in 1..=max_surfaces {
-        rays += 1;
-        let wo = -ray.dir;
-        let step = if scene.has_media() {
-            visitor.segment(&ray, &passage, (throughput, dispersed), length, rng);
-            passage.next_passing(scene, &ray, (&mut throughput, wl), rng, |m| visitor.passes(m))
+    let mut walk = CameraWalk::new(scene, ray, wl, limits);
+    walk_to_end(scene, &mut walk, wl, rng, visitor);
+    walk.rays
+}
+
+/// Takes `walk` to its end, a ray at a time.
+fn walk_to_end(
+    scene: &Scene,
+    walk: &mut CameraWalk,
+    wl: &Wavelengths,
+    rng: &mut Rng,
+    visitor: &mut impl CameraVisitor,
+) {
+    while walk.pending().is_some() {
+        let step = walk.trace(scene, wl, rng, visitor);
+        walk.arrive(scene, step, wl, rng, visitor);
+    }
+}
+
+/// A camera walk between its rays: [`walk_camera`] takes one to its end; [`walk_cameras`]
+/// takes many a ray at a time, tracing each wave of rays together.
+#[derive(Clone, Debug)]
+pub struct CameraWalk {
+    /// The ray to follow next.
+    ray: Ray,
+    throughput: Spectrum,
+    /// Only the hero wavelength is left.
+    dispersed: bool,
+    passage: Passage,
+    /// Surfaces met once the next ray has found its own (1 for the eye's ray).
+    length: u32,
+    ended: bool,
+    max_surfaces: u32,
+    roulette_from: u32,
+    /// Rays traced so far.
+    rays: u64,
+}
+
+impl CameraWalk {
+    /// A walk starting along `ray`, through at most `max_surfaces` surfaces, Russian roulette
+    /// from the `roulette_from`-th surface's bounce on.
+    pub fn new(scene: &Scene, ray: Ray, wl: &Wavelengths, (max_surfaces, roulette_from): (u32, u32)) -> CameraWalk {
+        CameraWalk {
+            ray,
+            throughput: wl.grey(1.0),
+            dispersed: false,
+            passage: Passage::new(scene, scene.camera_medium()),
+            length: 1,
+            ended: max_surfaces == 0,
+            max_surfaces,
+            roulette_from,
+            rays: 0,
+        }
+    }
+
+    /// The ray the walk follows next; `None` once it has ended.
+    pub fn pending(&self) -> Option<&Ray> {
+        (!self.ended).then_some(&self.ray)
+    }
+
+    /// Rays traced so far.
+    pub fn rays(&self) -> u64 {
+        self.rays
+    }
+
+    /// Where the pending ray's segment ends, media sampled on the way.
+    fn trace(&mut self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng, visitor: &mut impl CameraVisitor) -> Step {
+        if scene.has_media() {
+            let carried = (self.throughput, self.dispersed);
+            visitor.segment(&self.ray, &self.passage, carried, self.length, rng);
+            self.passage
+                .next_passing(scene, &self.ray, (&mut self.throughput, wl), rng, |m| visitor.passes(m))
         } else {
-            passage.next(scene, &ray, &mut throughput, wl, rng)
-        };
+            self.passage.next(scene, &self.ray, &mut self.throughput, wl, rng)
+        }
+    }
+
+    /// Takes the pending ray's `step`: hands the vertex to `visitor`, lets it bounce, and sets
+    /// up the next ray, or ends the walk.
+    fn arrive(&mut self, scene: &Scene, step: Step, wl: &Wavelengths, rng: &mut Rng, visitor: &mut impl CameraVisitor) {
+        self.rays += 1;
+        let length = self.length;
+        // Ended unless the bounce below carries on.
+        self.ended = true;
+        let wo = -self.ray.dir;
         let (hit, sample) = match step {
             Step::Escaped => {
-                visitor.escaped(ray.dir, throughput, length);
-                break;
+                visitor.escaped(self.ray.dir, self.throughput, length);
+                return;
             }
             Step::Medium(hit) => {
                 let at = MediumArrival {
                     hit: &hit,
                     phase: scene.medium(hit.media.back).phase,
                     wo: wo.normalize(),
-                    throughput,
-                    dispersed,
+                    throughput: self.throughput,
+                    dispersed: self.dispersed,
                     length,
                 };
                 if !visitor.visit_medium(&at, rng) {
-                    break;
+                    return;
                 }
                 let Some(sample) = visitor.bounce_medium(&at, rng) else {
-                    break;
+                    return;
                 };
                 (hit, sample)
             }
@@ -163,27 +235,74 @@ pub fn walk_camera(
                     bsdf: &bsdf,
                     wo,
                     t: hit.t,
-                    throughput,
-                    dispersed,
+                    throughput: self.throughput,
+                    dispersed: self.dispersed,
                     length,
                 };
                 if !visitor.visit(&at, rng) {
-                    break;
+                    return;
                 }
                 let Some(sample) = visitor.bounce(&at, rng) else {
-                    break;
+                    return;
                 };
                 (hit, sample)
             }
         };
-        let roulette = length >= roulette_from;
-        if !continue_camera(&sample, roulette, (&mut throughput, &mut dispersed), wl, rng) {
-            break;
+        let roulette = length >= self.roulette_from;
+        if !continue_camera(&sample, roulette, (&mut self.throughput, &mut self.dispersed), wl, rng) {
+            return;
         }
-        passage.cross(scene, &hit, &sample);
-        ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+        self.passage.cross(scene, &hit, &sample);
+        self.ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
+        if length < self.max_surfaces {
+            self.length = length + 1;
+            self.ended = false;
+        }
     }
-    rays
+}
+
+/// One of the camera paths [`walk_cameras`] takes together: its walk, wavelengths, random
+/// stream and visitor.
+pub struct CameraPath<V> {
+    /// The walk.
+    pub walk: CameraWalk,
+    /// Its wavelengths.
+    pub wl: Wavelengths,
+    /// Its random stream.
+    pub rng: Rng,
+    /// What it does at each vertex.
+    pub visitor: V,
+}
+
+/// Takes every path's walk to its end, as [`walk_camera`] would one by one and with the same
+/// results, in waves: the pending rays of all live walks are traced together
+/// ([`Scene::intersect_stream`]), then each walk takes its step. In scenes with media (where a
+/// segment's end depends on the path's random numbers) the walks go one at a time.
+pub fn walk_cameras<V: CameraVisitor>(scene: &Scene, paths: &mut [CameraPath<V>]) {
+    if scene.has_media() {
+        for p in paths {
+            walk_to_end(scene, &mut p.walk, &p.wl, &mut p.rng, &mut p.visitor);
+        }
+        return;
+    }
+    let mut live: Vec<usize> = (0..paths.len())
+        .filter(|&i| paths[i].walk.pending().is_some())
+        .collect();
+    let (mut rays, mut hits) = (Vec::with_capacity(live.len()), Vec::with_capacity(live.len()));
+    while !live.is_empty() {
+        rays.clear();
+        rays.extend(live.iter().map(|&i| paths[i].walk.ray));
+        hits.resize(live.len(), None);
+        scene.intersect_stream(&rays, &mut hits);
+        let mut wave = rays.iter().zip(&hits);
+        live.retain(|&i| {
+            let (ray, &hit) = wave.next().expect("one ray per live walk");
+            let p = &mut paths[i];
+            let step = Step::without_media(scene, ray, hit);
+            p.walk.arrive(scene, step, &p.wl, &mut p.rng, &mut p.visitor);
+            p.walk.pending().is_some()
+        });
+    }
 }
 
 /// Carries a camera path's `(throughput, dispersed)` through the bounce `sample`, or ends the
@@ -233,8 +352,9 @@ mod tests {
             self.arrivals.push((at.length, at.throughput.x));
             true
         }
-        fn visit_medium(&mut self, _at: &MediumArrival, _rng: &mut Rng) -> bool {
-            unreachable!("no media here")
+        fn visit_medium(&mut self, at: &MediumArrival, _rng: &mut Rng) -> bool {
+            self.arrivals.push((at.length, at.throughput.x));
+            true
         }
     }
 
@@ -245,6 +365,53 @@ mod tests {
         }
         fn visit_medium(&mut self, _at: &MediumArrival) -> bool {
             unreachable!("no media here")
+        }
+    }
+
+    /// Camera walks taken together, a wave of rays per bounce, make the same arrivals in the
+    /// same order with the same numbers as each walk alone: in a closed room around a bumpy
+    /// mesh that walks its tree, with Russian roulette, and in the same room filled with fog
+    /// (where the walks go one at a time).
+    #[test]
+    fn walks_taken_together_are_the_walks_taken_alone() {
+        let room = "scale(6, 6, 6, sphere { material = { diffuse = (0.7, 0.6, 0.5); } })";
+        let sheet = crate::scene::build::bumpy_sheet(12);
+        let fog = "translate(0, 0, 1, scale(3, 3, 1.5, box { material = {
+                   absorption = (0.1, 0.1, 0.1); scattering = (0.3, 0.3, 0.3); boundary = true; } }))";
+        for objects in [format!("{room}\n{sheet}"), format!("{room}\n{sheet}\n{fog}")] {
+            let scene = test_scene(&objects);
+            assert_eq!(scene.has_media(), objects.contains("boundary"));
+            let wl = Wavelengths::Rgb;
+            let start = |i: u64| {
+                let mut rng = Rng::new(7, i);
+                let dir = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, -1.0);
+                (Ray::new(Vec3::new(0.0, 0.0, 2.5), dir), rng)
+            };
+            let limits = (12, 2);
+            let mut paths: Vec<CameraPath<Record>> = (0..200)
+                .map(|i| {
+                    let (ray, rng) = start(i);
+                    CameraPath {
+                        walk: CameraWalk::new(&scene, ray, &wl, limits),
+                        wl,
+                        rng,
+                        visitor: Record::default(),
+                    }
+                })
+                .collect();
+            walk_cameras(&scene, &mut paths);
+            let mut surfaces = 0;
+            for (i, together) in paths.iter_mut().enumerate() {
+                let (ray, mut rng) = start(i as u64);
+                let mut alone = Record::default();
+                let rays = walk_camera(&scene, ray, &wl, limits, &mut rng, &mut alone);
+                assert_eq!(together.visitor.arrivals, alone.arrivals, "path {i}");
+                assert_eq!(together.visitor.escaped, alone.escaped);
+                assert_eq!(together.walk.rays(), rays);
+                assert_eq!(together.rng.uniform(), rng.uniform(), "the same numbers drawn");
+                surfaces += alone.arrivals.len();
+            }
+            assert!(surfaces > 400, "{surfaces} surfaces");
         }
     }
 

@@ -4,8 +4,9 @@
 //! It cannot see caustics of point or directional lights (a path can never hit a delta light
 //! after a mirror or through glass); that is what photon mapping is for.
 
-use super::camera_walk::{walk_camera, CameraArrival, CameraVisitor};
+use super::camera_walk::{walk_camera, walk_cameras, CameraArrival, CameraPath, CameraVisitor, CameraWalk};
 use super::direct::{direct_in_medium, direct_light, emitted, power_heuristic};
+use super::tiles::PixelSample;
 use crate::bsdf::{BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
 use crate::photon::light_walk::MediumArrival;
@@ -45,22 +46,9 @@ impl Default for PathSettings {
 
 /// Radiance arriving along `ray` (unit direction) at the wavelengths `wl`.
 pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
-    let mut path = PathRadiance {
-        scene,
-        settings,
-        wl,
-        l: Spectrum::ZERO,
-        specular: true,
-        last_pdf: 0.0,
-        last_point: ray.origin,
-    };
-    let surfaces = settings.max_depth.saturating_add(1);
-    walk_camera(scene, ray, wl, (surfaces, settings.roulette_depth), rng, &mut path);
-    if path.l.is_finite() {
-        path.l
-    } else {
-        Spectrum::ZERO
-    }
+    let mut path = PathRadiance::new(scene, settings, &ray, *wl);
+    walk_camera(scene, ray, wl, path.limits(), rng, &mut path);
+    path.radiance()
 }
 
 /// A path tracer's walk: emission weighted against next-event estimation, which each smooth
@@ -68,7 +56,7 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengt
 struct PathRadiance<'p> {
     scene: &'p Scene,
     settings: &'p PathSettings,
-    wl: &'p Wavelengths,
+    wl: Wavelengths,
     /// Radiance gathered so far.
     l: Spectrum,
     /// The last bounce was specular (or the path just left the eye): emitters it hits count in
@@ -79,16 +67,45 @@ struct PathRadiance<'p> {
     last_point: Vec3,
 }
 
+impl<'p> PathRadiance<'p> {
+    /// Nothing gathered yet along the eye's `ray`.
+    fn new(scene: &'p Scene, settings: &'p PathSettings, ray: &Ray, wl: Wavelengths) -> PathRadiance<'p> {
+        PathRadiance {
+            scene,
+            settings,
+            wl,
+            l: Spectrum::ZERO,
+            specular: true,
+            last_pdf: 0.0,
+            last_point: ray.origin,
+        }
+    }
+
+    /// The walk's surfaces and roulette start ([`walk_camera`]).
+    fn limits(&self) -> (u32, u32) {
+        (self.settings.max_depth.saturating_add(1), self.settings.roulette_depth)
+    }
+
+    /// What the walk gathered, zero if it is not finite.
+    fn radiance(&self) -> Spectrum {
+        if self.l.is_finite() {
+            self.l
+        } else {
+            Spectrum::ZERO
+        }
+    }
+}
+
 impl CameraVisitor for PathRadiance<'_> {
     fn escaped(&mut self, dir: Vec3, throughput: Spectrum, _length: u32) {
         // The sky and suns, weighted against having sampled them directly.
         let lights = self.scene.lights();
-        self.l += throughput * lights.escaped_weighted(dir, (!self.specular).then_some(self.last_pdf), self.wl);
+        self.l += throughput * lights.escaped_weighted(dir, (!self.specular).then_some(self.last_pdf), &self.wl);
     }
 
     fn visit(&mut self, at: &CameraArrival, rng: &mut Rng) -> bool {
         let (scene, hit, wo) = (self.scene, at.hit, at.wo);
-        let le = emitted(scene, hit, wo, self.wl);
+        let le = emitted(scene, hit, wo, &self.wl);
         if le != Spectrum::ZERO {
             let weight = if self.specular {
                 1.0
@@ -102,7 +119,7 @@ impl CameraVisitor for PathRadiance<'_> {
             return false;
         }
         if at.bsdf.is_smooth() {
-            self.l += at.throughput * direct_light(scene, hit, at.bsdf, wo, true, self.wl, rng);
+            self.l += at.throughput * direct_light(scene, hit, at.bsdf, wo, true, &self.wl, rng);
         }
         true
     }
@@ -111,7 +128,7 @@ impl CameraVisitor for PathRadiance<'_> {
         if at.length > self.settings.max_depth {
             return false;
         }
-        self.l += at.throughput * direct_in_medium(self.scene, at, true, self.wl, rng);
+        self.l += at.throughput * direct_in_medium(self.scene, at, true, &self.wl, rng);
         true
     }
 
@@ -166,20 +183,35 @@ impl super::Progressive for PathTracer<'_> {
     fn render_pass(&self, pass: u64, control: crate::progress::Control) -> Option<Vec<Vec3>> {
         let camera = &self.camera;
         let spectral = super::ppm::settings_spectral(&self.settings.spectral, self.scene);
-        super::tiles::sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
-            // Each sample its own wavelengths: no photons need to agree with it.
-            let wl = if spectral {
-                Wavelengths::sample(rng.uniform())
-            } else {
-                Wavelengths::Rgb
-            };
-            wl.to_rgb(radiance(
-                self.scene,
-                &self.settings,
-                camera.generate_ray(sx, sy),
-                &wl,
-                rng,
-            ))
+        // A tile's paths walk together, a wave of rays per bounce.
+        super::tiles::sample_pass_tiles(self.width, self.height, self.seed, pass, control, |points| {
+            let mut paths: Vec<CameraPath<PathRadiance>> = points
+                .into_iter()
+                .map(
+                    |PixelSample {
+                         screen: (sx, sy),
+                         mut rng,
+                         ..
+                     }| {
+                        // Each sample its own wavelengths: no photons need to agree with it.
+                        let wl = if spectral {
+                            Wavelengths::sample(rng.uniform())
+                        } else {
+                            Wavelengths::Rgb
+                        };
+                        let ray = camera.generate_ray(sx, sy);
+                        let visitor = PathRadiance::new(self.scene, &self.settings, &ray, wl);
+                        CameraPath {
+                            walk: CameraWalk::new(self.scene, ray, &wl, visitor.limits()),
+                            wl,
+                            rng,
+                            visitor,
+                        }
+                    },
+                )
+                .collect();
+            walk_cameras(self.scene, &mut paths);
+            paths.iter().map(|p| p.wl.to_rgb(p.visitor.radiance())).collect()
         })
     }
 }

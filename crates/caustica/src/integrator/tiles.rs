@@ -68,6 +68,29 @@ pub(crate) fn shade_tiles<F>(width: usize, height: usize, control: Control, repo
 where
     F: Fn(usize, usize) -> Vec3 + Sync,
 {
+    shade_tile_blocks(width, height, control, report, |(x0, y0), (x1, y1)| {
+        let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
+        for y in y0..y1 {
+            for x in x0..x1 {
+                out.push(pixel(x, y));
+            }
+        }
+        out
+    })
+}
+
+/// [`shade_tiles`] a tile at a time: `tile((x0, y0), (x1, y1))` returns the pixels of the
+/// rectangle from `(x0, y0)` to `(x1, y1)` (exclusive), row by row.
+fn shade_tile_blocks<F>(
+    width: usize,
+    height: usize,
+    control: Control,
+    report: bool,
+    tile_pixels: F,
+) -> (Vec<Vec3>, bool)
+where
+    F: Fn((usize, usize), (usize, usize)) -> Vec<Vec3> + Sync,
+{
     let tiles_x = width.div_ceil(TILE);
     let tiles_y = height.div_ceil(TILE);
     let tiles: Vec<Option<Vec<Vec3>>> = (0..tiles_x * tiles_y)
@@ -78,12 +101,7 @@ where
             }
             let (x0, y0) = ((tile % tiles_x) * TILE, (tile / tiles_x) * TILE);
             let (x1, y1) = ((x0 + TILE).min(width), (y0 + TILE).min(height));
-            let mut out = Vec::with_capacity((x1 - x0) * (y1 - y0));
-            for y in y0..y1 {
-                for x in x0..x1 {
-                    out.push(pixel(x, y));
-                }
-            }
+            let out = tile_pixels((x0, y0), (x1, y1));
             if report {
                 control.progress.pixels(&PixelBlock {
                     x: x0,
@@ -131,17 +149,54 @@ pub fn sample_pass<F>(
 where
     F: Fn(f32, f32, &mut Rng) -> Vec3 + Sync,
 {
-    let (pixels, complete) = shade_tiles(width, height, control, false, |x, y| {
-        let mut rng = Rng::new(seed, (pass << 32) ^ (y * width + x) as u64);
-        let (jx, jy) = (rng.uniform(), rng.uniform());
-        let sx = (x as f32 + jx) / width as f32;
-        let sy = 1.0 - (y as f32 + jy) / height as f32;
-        let v = sample(sx, sy, &mut rng);
-        if v.is_finite() {
-            v
-        } else {
-            Vec3::ZERO
+    sample_pass_tiles(width, height, seed, pass, control, |points| {
+        points
+            .into_iter()
+            .map(|mut p| sample(p.screen.0, p.screen.1, &mut p.rng))
+            .collect()
+    })
+}
+
+/// A pixel's sample in a pass: where it looks and the random stream it draws from.
+pub struct PixelSample {
+    /// Its jittered point on the screen, in [0, 1]² (y up).
+    pub screen: (f32, f32),
+    /// Its random stream, the jitter drawn.
+    pub rng: Rng,
+}
+
+/// [`sample_pass`] a tile at a time: `samples(points)` gets the sample of each pixel of a tile,
+/// row by row, and returns their values in the same order (to trace the tile's paths
+/// together). The same random streams, so the same image.
+pub fn sample_pass_tiles<F>(
+    width: usize,
+    height: usize,
+    seed: u64,
+    pass: u64,
+    control: Control,
+    samples: F,
+) -> Option<Vec<Vec3>>
+where
+    F: Fn(Vec<PixelSample>) -> Vec<Vec3> + Sync,
+{
+    let (pixels, complete) = shade_tile_blocks(width, height, control, false, |(x0, y0), (x1, y1)| {
+        let mut points = Vec::with_capacity((x1 - x0) * (y1 - y0));
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let mut rng = Rng::new(seed, (pass << 32) ^ (y * width + x) as u64);
+                let (jx, jy) = (rng.uniform(), rng.uniform());
+                let sx = (x as f32 + jx) / width as f32;
+                let sy = 1.0 - (y as f32 + jy) / height as f32;
+                points.push(PixelSample { screen: (sx, sy), rng });
+            }
         }
+        let mut values = samples(points);
+        for v in &mut values {
+            if !v.is_finite() {
+                *v = Vec3::ZERO;
+            }
+        }
+        values
     });
     complete.then_some(pixels)
 }

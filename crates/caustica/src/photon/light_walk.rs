@@ -13,7 +13,7 @@ use crate::bsdf::{adjoint_correction, Bsdf, BsdfSample, Transport};
 use crate::math::Ray;
 use crate::medium::{Media, Medium, Phase, VACUUM};
 use crate::sampling::Rng;
-use crate::scene::{Scene, SurfaceHit};
+use crate::scene::{Intersection, Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 use glam::Vec3;
 
@@ -114,6 +114,17 @@ pub enum Step {
     Escaped,
 }
 
+impl Step {
+    /// Where a segment along `ray` through a scene without media ends, given its closest hit.
+    #[inline]
+    pub fn without_media(scene: &Scene, ray: &Ray, isect: Option<Intersection>) -> Step {
+        match isect {
+            Some(isect) => Step::Surface(scene.surface(ray, &isect)),
+            None => Step::Escaped,
+        }
+    }
+}
+
 /// What both walks carry from vertex to vertex: the medium they are in (fog, or the inside of
 /// an absorbing glass), whose free flights and absorption each segment samples, and the one
 /// that surrounded them before they entered a glass.
@@ -145,10 +156,7 @@ impl Passage {
         rng: &mut Rng,
     ) -> Step {
         if !scene.has_media() {
-            return match scene.intersect(ray, f32::INFINITY) {
-                Some(isect) => Step::Surface(scene.surface(ray, &isect)),
-                None => Step::Escaped,
-            };
+            return Step::without_media(scene, ray, scene.intersect(ray, f32::INFINITY));
         }
         self.next_passing(scene, ray, (throughput, wl), rng, |_| false)
     }

@@ -770,3 +770,28 @@ pub(crate) fn test_scene(objects: &str) -> Scene {
         format!("SBT-raytracer 1.0\ncamera {{ position = (0,0,5); viewdir = (0,0,-1); updir = (0,1,0); }}\n{objects}");
     crate::loader::from_text(&text, std::path::Path::new("."), &Default::default()).unwrap()
 }
+
+/// A `polymesh` of a bumpy sheet over [−2, 2]², `n`×`n` quads of two triangles each.
+#[cfg(test)]
+pub(crate) fn bumpy_sheet(n: usize) -> String {
+    let mut points = Vec::new();
+    for j in 0..=n {
+        for i in 0..=n {
+            let (x, y) = (4.0 * i as f32 / n as f32 - 2.0, 4.0 * j as f32 / n as f32 - 2.0);
+            points.push(format!("({x},{y},{})", 0.3 * (2.0 * x).sin() * (3.0 * y).cos()));
+        }
+    }
+    let mut faces = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            let a = j * (n + 1) + i;
+            let (b, c, d) = (a + 1, a + n + 2, a + n + 1);
+            faces.push(format!("({a},{b},{c}),({a},{c},{d})"));
+        }
+    }
+    format!(
+        "polymesh {{ points = ({}); faces = ({}); material = {{ diffuse = (0.5,0.5,0.5); }} }}",
+        points.join(","),
+        faces.join(",")
+    )
+}

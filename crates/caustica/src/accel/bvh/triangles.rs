@@ -139,6 +139,12 @@ impl TriangleBvh {
         self.packets.len()
     }
 
+    /// Whether queries walk the tree ([`TriangleBvh::closest_hits`] then pays); with a few
+    /// packets they test each one.
+    pub fn walks(&self) -> bool {
+        self.packets.len() > FEW_PACKETS
+    }
+
     /// Closest hit with `0 < t < t_max`.
     #[inline]
     pub fn closest_hit(&self, ray: &Ray, t_max: f32) -> Option<TriangleBvhHit> {
@@ -149,7 +155,7 @@ impl TriangleBvh {
         let tr = TriangleRay::new(ray);
         let mut t = t_max;
         let mut best = None;
-        if self.packets.len() <= FEW_PACKETS {
+        if !self.walks() {
             if super::walkable(ray) {
                 for packet in 0..self.packets.len() {
                     self.closest_in_packet(&tr, packet, &mut t, &mut best);
@@ -400,7 +406,7 @@ impl TriangleBvh {
                 })
             })
         };
-        if self.packets.len() <= FEW_PACKETS {
+        if !self.walks() {
             return super::walkable(ray) && (0..self.packets.len()).any(|i| packet(i, t_max));
         }
         self.each_walk(ray, t_max, packet)
