@@ -224,6 +224,19 @@ pub(crate) struct SceneParts {
     pub light_media: Vec<(usize, u32)>,
 }
 
+/// Shape `prim`'s hit as an intersection.
+#[inline]
+fn shape_intersection(prim: u32, hit: crate::geometry::shape::ShapeHit) -> Intersection {
+    Intersection {
+        t: hit.t,
+        prim,
+        normal_or_bary: hit.normal,
+        uv: hit.uv,
+        part: hit.part,
+        local_point: hit.local_point,
+    }
+}
+
 /// The minimal record of a closest hit: enough to build a [`SurfaceHit`] when needed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Intersection {
@@ -949,13 +962,14 @@ impl Scene {
     fn closest_shape(&self, ray: &Ray, t_max: f32, mut best: Option<Intersection>) -> Option<Intersection> {
         let t_max = best.map_or(t_max, |h| h.t);
         if let Some(packets) = &self.shape_packets {
-            // The packets pick the shape; its own test (the same arithmetic) gives the record.
-            // Should that test disagree, the hierarchy decides.
+            // The packets find the shape and `t` by its own test's arithmetic; the record at
+            // that `t` is its test's. Should there be none, the hierarchy decides.
             match packets.closest(ray, t_max) {
                 None => return best,
-                Some((prim, _)) => {
-                    if let Some(hit) = self.intersect_shape(prim, ray, t_max) {
-                        return Some(hit);
+                Some((prim, t)) => {
+                    let hit = self.shapes[prim as usize].packet_hit_at(ray, t);
+                    if let Some(hit) = hit {
+                        return Some(shape_intersection(prim, hit));
                     }
                 }
             }
@@ -1038,14 +1052,7 @@ impl Scene {
     #[inline]
     fn intersect_shape(&self, prim: u32, ray: &Ray, t_max: f32) -> Option<Intersection> {
         let hit = self.shapes[prim as usize].intersect_object_normal(ray, t_max)?;
-        Some(Intersection {
-            t: hit.t,
-            prim,
-            normal_or_bary: hit.normal,
-            uv: hit.uv,
-            part: hit.part,
-            local_point: hit.local_point,
-        })
+        Some(shape_intersection(prim, hit))
     }
 
     /// The nearest hit of one primitive (shapes first, then triangles) in `(0, t_max)`.

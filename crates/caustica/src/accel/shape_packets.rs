@@ -399,6 +399,8 @@ mod tests {
                     if expected.is_none_or(|(_, t)| h.t < t) {
                         expected = Some((id as u32, h.t));
                     }
+                    // The record at the hit's `t` alone is the test's record.
+                    assert_eq!(shape.packet_hit_at(&ray, h.t), Some(h), "{ray:?}");
                 }
             }
             for (packets, width) in packets.iter().zip(&widths) {

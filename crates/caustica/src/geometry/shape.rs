@@ -270,7 +270,7 @@ impl Shape {
     /// transform it needs: the plane's first, then the two in-plane ones for a hit in range.
     #[inline]
     fn intersect_square(&self, ray: &Ray, t_max: f32) -> Option<ShapeHit> {
-        let [row_x, row_y, row_z] = self.object_rows;
+        let row_z = self.object_rows[2];
         let dir_z = row_z.dot(ray.dir);
         if dir_z == 0.0 {
             return None;
@@ -285,12 +285,19 @@ impl Shape {
         if !(t > 0.0 && t < t_max) {
             return None;
         }
+        let hit = self.square_hit_at(ray, t, dir_z);
+        let (x, y) = (hit.local_point.x, hit.local_point.y);
+        (!(x.abs() > 0.5 || y.abs() > 0.5)).then_some(hit)
+    }
+
+    /// The record of the square's plane met at `t` along `ray` (`dir_z`: the ray's direction
+    /// along the plane's normal), in range or not.
+    #[inline]
+    fn square_hit_at(&self, ray: &Ray, t: f32, dir_z: f32) -> ShapeHit {
+        let [row_x, row_y, _] = self.object_rows;
         let offset = ray.origin + ray.dir * t - self.origin;
         let (x, y) = (row_x.dot(offset), row_y.dot(offset));
-        if x.abs() > 0.5 || y.abs() > 0.5 {
-            return None;
-        }
-        Some(ShapeHit {
+        ShapeHit {
             t,
             local_point: Vec3::new(x, y, 0.0),
             // Facing the incoming ray (§7).
@@ -301,7 +308,19 @@ impl Shape {
                 Vec2::ZERO
             },
             part: 0,
-        })
+        }
+    }
+
+    /// The record of the hit at `t` along `ray` of a square or round sphere whose own test (or a
+    /// packet's, the same arithmetic) found it there: that test's record, without finding `t`
+    /// again. `None` for other shapes, or where that test would have found nothing.
+    #[inline]
+    pub fn packet_hit_at(&self, ray: &Ray, t: f32) -> Option<ShapeHit> {
+        if matches!(self.kind, ShapeKind::Square) {
+            return Some(self.square_hit_at(ray, t, self.object_rows[2].dot(ray.dir)));
+        }
+        let (center, _) = self.round_sphere?;
+        self.round_sphere_hit_at(ray.origin - center, ray.dir, t)
     }
 
     /// [`sphere::intersect`] done in world space on a sphere of world `center` and `radius`: a
@@ -324,6 +343,12 @@ impl Shape {
         if !(t > 0.0 && t < t_max) {
             return None;
         }
+        self.round_sphere_hit_at(oc, d, t)
+    }
+
+    /// The record of a round sphere's hit at `t` along a ray `d` from `oc` off its centre.
+    #[inline]
+    fn round_sphere_hit_at(&self, oc: Vec3, d: Vec3, t: f32) -> Option<ShapeHit> {
         let offset = oc + d * t;
         let [row_x, row_y, row_z] = self.object_rows;
         let p = Vec3::new(row_x.dot(offset), row_y.dot(offset), row_z.dot(offset));
