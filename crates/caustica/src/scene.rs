@@ -1140,6 +1140,32 @@ impl Scene {
         })
     }
 
+    /// Asks the cache for the first thing [`Scene::surface`] reads of a triangle `hit`: its
+    /// reference to its mesh. A hint, for a wave of hits shaded one after another: it changes
+    /// no result.
+    #[inline]
+    pub(crate) fn prefetch_reference(&self, hit: &Intersection) {
+        if let Some(tri_ref) = self
+            .triangle_refs
+            .get(hit.prim.wrapping_sub(self.shapes.len() as u32) as usize)
+        {
+            crate::accel::lanes::prefetch(tri_ref);
+        }
+    }
+
+    /// [`Scene::prefetch_reference`]'s next step, once the reference is at hand: the triangle's
+    /// vertex indices.
+    #[inline]
+    pub(crate) fn prefetch_indices(&self, hit: &Intersection) {
+        if let Some(tri_ref) = self
+            .triangle_refs
+            .get(hit.prim.wrapping_sub(self.shapes.len() as u32) as usize)
+        {
+            let indices = &self.meshes[tri_ref.mesh as usize].indices;
+            crate::accel::lanes::prefetch(indices.as_ptr().wrapping_add(tri_ref.index as usize));
+        }
+    }
+
     /// Full shading data for an intersection found along `ray`.
     pub fn surface(&self, ray: &Ray, hit: &Intersection) -> SurfaceHit {
         let n_shapes = self.shapes.len() as u32;

@@ -261,6 +261,10 @@ impl CameraWalk {
     }
 }
 
+/// How many walks ahead of the one taking its step [`walk_cameras`] fetches a hit's vertex
+/// indices.
+const PREFETCH_AHEAD: usize = 4;
+
 /// One of the camera paths [`walk_cameras`] takes together: its walk, wavelengths, random
 /// stream and visitor.
 pub struct CameraPath<V> {
@@ -294,8 +298,15 @@ pub fn walk_cameras<V: CameraVisitor>(scene: &Scene, paths: &mut [CameraPath<V>]
         rays.extend(live.iter().map(|&i| paths[i].walk.ray));
         hits.resize(live.len(), None);
         scene.intersect_stream(&rays, &mut hits);
+        // A large mesh's hits miss the cache twice before shading (the triangle's reference,
+        // then its vertex indices): both are fetched ahead of the walks that read them.
+        hits.iter().flatten().for_each(|hit| scene.prefetch_reference(hit));
         let mut wave = rays.iter().zip(&hits);
+        let mut ahead = hits.iter().skip(PREFETCH_AHEAD);
         live.retain(|&i| {
+            if let Some(Some(hit)) = ahead.next() {
+                scene.prefetch_indices(hit);
+            }
             let (ray, &hit) = wave.next().expect("one ray per live walk");
             let p = &mut paths[i];
             let step = Step::without_media(scene, ray, hit);
