@@ -10,6 +10,7 @@ use crate::accel::bvh::{Bvh, TriangleBvh, TriangleBvhHit};
 use crate::accel::shape_packets::ShapePackets;
 use crate::camera::Camera;
 use crate::description::EmittingFaces;
+use crate::geometry::shape::ShapeHit;
 use crate::geometry::triangle::Triangle;
 use crate::geometry::{Shape, ShapeKind};
 use crate::light::{Light, LightSet};
@@ -226,7 +227,7 @@ pub(crate) struct SceneParts {
 
 /// Shape `prim`'s hit as an intersection.
 #[inline]
-fn shape_intersection(prim: u32, hit: crate::geometry::shape::ShapeHit) -> Intersection {
+fn shape_intersection(prim: u32, hit: ShapeHit) -> Intersection {
     Intersection {
         t: hit.t,
         prim,
@@ -1130,14 +1131,7 @@ impl Scene {
             return None;
         }
         let next = shape.intersect_object_normal(&Ray::new(ray.at(t0), ray.dir), t_max - t0)?;
-        Some(Intersection {
-            t: t0 + next.t,
-            prim: hit.prim,
-            normal_or_bary: next.normal,
-            uv: next.uv,
-            part: next.part,
-            local_point: next.local_point,
-        })
+        Some(shape_intersection(hit.prim, ShapeHit { t: t0 + next.t, ..next }))
     }
 
     /// Asks the cache for the first thing [`Scene::surface`] reads of a triangle `hit`: its
@@ -1145,10 +1139,7 @@ impl Scene {
     /// no result.
     #[inline]
     pub(crate) fn prefetch_reference(&self, hit: &Intersection) {
-        if let Some(tri_ref) = self
-            .triangle_refs
-            .get(hit.prim.wrapping_sub(self.shapes.len() as u32) as usize)
-        {
+        if let Some(tri_ref) = self.hit_triangle_ref(hit) {
             crate::accel::lanes::prefetch(tri_ref);
         }
     }
@@ -1157,13 +1148,17 @@ impl Scene {
     /// vertex indices.
     #[inline]
     pub(crate) fn prefetch_indices(&self, hit: &Intersection) {
-        if let Some(tri_ref) = self
-            .triangle_refs
-            .get(hit.prim.wrapping_sub(self.shapes.len() as u32) as usize)
-        {
+        if let Some(tri_ref) = self.hit_triangle_ref(hit) {
             let indices = &self.meshes[tri_ref.mesh as usize].indices;
             crate::accel::lanes::prefetch(indices.as_ptr().wrapping_add(tri_ref.index as usize));
         }
+    }
+
+    /// The mesh reference of a triangle `hit` (`None` for a shape's).
+    #[inline]
+    fn hit_triangle_ref(&self, hit: &Intersection) -> Option<&TriangleRef> {
+        self.triangle_refs
+            .get(hit.prim.wrapping_sub(self.shapes.len() as u32) as usize)
     }
 
     /// Full shading data for an intersection found along `ray`.
