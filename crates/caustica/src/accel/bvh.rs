@@ -3,7 +3,8 @@
 //! Built as a binned-SAH binary tree and collapsed into wide nodes whose child boxes are
 //! stored as structure-of-arrays, so one node visit tests its boxes with SSE arithmetic: four
 //! children a node for a scene's shapes, eight for a triangle mesh's [`TriangleBvh`], where
-//! fewer levels mean fewer dependent cache misses a ray.
+//! fewer levels mean fewer dependent cache misses a ray, and where the CPU has AVX the eight
+//! are tested in one register ([`SlabTest`]), to the same bits.
 //! Traversal is near-first with a fixed-size stack; primitives are handed to a caller's
 //! closure (generic, so it inlines).
 
@@ -17,6 +18,8 @@ use std::cell::RefCell;
 
 use glam::Vec4;
 
+#[cfg(target_arch = "x86_64")]
+use super::lanes::{F32x8, Lanes};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::progress::{NoProgress, Progress};
 
@@ -156,6 +159,65 @@ impl RayPre {
             .min(far(1, ny ^ 1))
             .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
         (t_near.cmple(t_far).bitmask(), t_near)
+    }
+}
+
+/// A ray's slab tests against a node's child boxes, at some lane width: which children the
+/// segment `[0, t_max]` meets (bit per slot) and their entry distances, by slot.
+pub(crate) trait SlabTest<const R: usize> {
+    fn new(ray: &Ray) -> Self;
+    fn hit(&self, node: &Node<R>, t_max: f32) -> (u32, [f32; MAX_WIDTH]);
+}
+
+impl<const R: usize> SlabTest<R> for RayPre {
+    #[inline(always)]
+    fn new(ray: &Ray) -> RayPre {
+        RayPre::new(ray)
+    }
+
+    #[inline(always)]
+    fn hit(&self, node: &Node<R>, t_max: f32) -> (u32, [f32; MAX_WIDTH]) {
+        let (mask, t_near) = RayPre::hit(self, node, t_max);
+        (mask, std::array::from_fn(|i| t_near[(i / 4) % R][i % 4]))
+    }
+}
+
+/// [`RayPre`]'s tests of an eight-wide node in one AVX register per operand: the same
+/// operations in the same order on each lane, so the same masks and distances to the bit.
+/// Made and used only inside [`in_avx`](super::lanes::in_avx).
+#[cfg(target_arch = "x86_64")]
+pub(crate) struct WideRayPre {
+    origin: [F32x8; 3],
+    inv_dir: [F32x8; 3],
+    inv_dir_far: [F32x8; 3],
+    near: [usize; 3],
+}
+
+#[cfg(target_arch = "x86_64")]
+impl SlabTest<2> for WideRayPre {
+    #[inline(always)]
+    fn new(ray: &Ray) -> WideRayPre {
+        let pre = RayPre::new(ray);
+        let splat = |v: [Vec4; 3]| v.map(|lanes| F32x8::splat(lanes.x));
+        WideRayPre {
+            origin: splat(pre.origin),
+            inv_dir: splat(pre.inv_dir),
+            inv_dir_far: splat(pre.inv_dir_far),
+            near: pre.near,
+        }
+    }
+
+    #[inline(always)]
+    fn hit(&self, node: &Node<2>, t_max: f32) -> (u32, [f32; MAX_WIDTH]) {
+        let [nx, ny, nz] = self.near;
+        let bound = |axis: usize, side: usize| F32x8::from_pair(&node.bounds[axis][side & 1]);
+        let near = |axis: usize, side: usize| (bound(axis, side) - self.origin[axis]) * self.inv_dir[axis];
+        let far = |axis: usize, side: usize| (bound(axis, side) - self.origin[axis]) * self.inv_dir_far[axis];
+        let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(F32x8::splat(0.0)));
+        let t_far = far(0, nx ^ 1)
+            .min(far(1, ny ^ 1))
+            .min(far(2, nz ^ 1).min(F32x8::splat(t_max)));
+        (F32x8::bitmask(t_near.le(t_far)), t_near.to_array())
     }
 }
 
@@ -352,26 +414,38 @@ impl<const R: usize> Bvh<R> {
         }
     }
 
-    /// [`Bvh::traverse`] with the stack size the tree needs.
+    /// [`Bvh::traverse`] with the stack size the tree needs, boxes tested by [`RayPre`].
     #[inline(always)]
     fn traverse_any_stack<F: FnMut(&[u32], usize, &mut f32) -> bool>(
+        &self,
+        ray: &Ray,
+        t_max: &mut f32,
+        leaf: F,
+    ) -> bool {
+        self.traverse_tested::<RayPre, F>(ray, t_max, leaf)
+    }
+
+    /// [`Bvh::traverse_any_stack`] with boxes tested by `T`.
+    #[inline(always)]
+    fn traverse_tested<T: SlabTest<R>, F: FnMut(&[u32], usize, &mut f32) -> bool>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
         mut leaf: F,
     ) -> bool {
         /// One ray's traversal, generic over its stack size.
-        struct Walk<'a, const R: usize, F> {
+        struct Walk<'a, const R: usize, T, F> {
             bvh: &'a Bvh<R>,
             ray: &'a Ray,
             t_max: &'a mut f32,
             leaf: F,
+            test: std::marker::PhantomData<T>,
         }
-        impl<const R: usize, F: FnMut(&[u32], usize, &mut f32) -> bool> StackSized for Walk<'_, R, F> {
+        impl<const R: usize, T: SlabTest<R>, F: FnMut(&[u32], usize, &mut f32) -> bool> StackSized for Walk<'_, R, T, F> {
             type Output = bool;
             #[inline(always)]
             fn run<const N: usize>(self) -> bool {
-                self.bvh.traverse::<N>(self.ray, self.t_max, self.leaf)
+                self.bvh.traverse::<N, T>(self.ray, self.t_max, self.leaf)
             }
         }
         if self.nodes.is_empty() {
@@ -394,13 +468,14 @@ impl<const R: usize> Bvh<R> {
             ray,
             t_max,
             leaf,
+            test: std::marker::PhantomData::<T>,
         })
     }
 
     /// Near-first traversal. `leaf(order, first, t_max)` handles the leaf starting at `first`
     /// and may shrink `t_max`; returning `true` ends the traversal (and this returns `true`).
     #[inline(always)]
-    fn traverse<const N: usize>(
+    fn traverse<const N: usize, T: SlabTest<R>>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
@@ -413,9 +488,9 @@ impl<const R: usize> Bvh<R> {
                 let stack = scratch
                     .first_chunk_mut::<N>()
                     .expect("no tier exceeds the scratch stack");
-                Traversal::new(ray, *t_max, stack).is_some_and(|walk| self.walk(walk, t_max, &mut leaf))
+                Traversal::<N, _, T>::new(ray, *t_max, stack).is_some_and(|walk| self.walk(walk, t_max, &mut leaf))
             }
-            Err(_) => self.traverse_nested::<N>(ray, t_max, &mut leaf),
+            Err(_) => self.traverse_nested::<N, T>(ray, t_max, &mut leaf),
         })
     }
 
@@ -423,20 +498,22 @@ impl<const R: usize> Bvh<R> {
     /// Kept out of line: inlined, its stack array grows every query's frame past a page.
     #[cold]
     #[inline(never)]
-    fn traverse_nested<const N: usize>(
+    fn traverse_nested<const N: usize, T: SlabTest<R>>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
         leaf: &mut impl FnMut(&[u32], usize, &mut f32) -> bool,
     ) -> bool {
-        Traversal::new(ray, *t_max, [(0, 0.0); N]).is_some_and(|walk| self.walk(walk, t_max, leaf))
+        // Out of line, this is compiled for the baseline CPU: a wide test's lanes call their
+        // AVX intrinsics here (correct, the CPU has AVX; slower, and rare).
+        Traversal::<N, _, T>::new(ray, *t_max, [(0, 0.0); N]).is_some_and(|walk| self.walk(walk, t_max, leaf))
     }
 
     /// Runs `walk` to its end, handing leaves to `leaf` (see [`Bvh::traverse`]).
     #[inline(always)]
-    fn walk<const N: usize, S: BorrowMut<[(u32, f32); N]>>(
+    fn walk<const N: usize, S: BorrowMut<[(u32, f32); N]>, T: SlabTest<R>>(
         &self,
-        mut walk: Traversal<N, S>,
+        mut walk: Traversal<N, S, T>,
         t_max: &mut f32,
         leaf: &mut impl FnMut(&[u32], usize, &mut f32) -> bool,
     ) -> bool {
@@ -505,8 +582,8 @@ fn fetch<const R: usize>(nodes: &[Node<R>], child: u32) {
 
 /// The state of one ray's near-first walk through a [`Bvh`], advanced one node at a time, so
 /// a caller can interleave the walks of several rays (see [`TriangleBvh::closest_hits`]).
-struct Traversal<const N: usize, S: BorrowMut<[(u32, f32); N]> = [(u32, f32); N]> {
-    ray: RayPre,
+struct Traversal<const N: usize, S: BorrowMut<[(u32, f32); N]> = [(u32, f32); N], T = RayPre> {
+    ray: T,
     /// Pending children with their entry distances, nearest on top: owned, or borrowed from
     /// the thread's scratch stack.
     stack: S,
@@ -517,13 +594,21 @@ struct Traversal<const N: usize, S: BorrowMut<[(u32, f32); N]> = [(u32, f32); N]
     t_max: f32,
 }
 
-impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
+impl<const N: usize, S: BorrowMut<[(u32, f32); N]>, T> Traversal<N, S, T> {
     /// A walk from the root using `stack`, whose contents need not be cleared, or `None` for a
     /// ray that is not [`walkable`].
     #[inline(always)]
-    fn new(ray: &Ray, t_max: f32, stack: S) -> Option<Traversal<N, S>> {
-        walkable(ray).then(|| Traversal {
-            ray: RayPre::new(ray),
+    fn new<const R: usize>(ray: &Ray, t_max: f32, stack: S) -> Option<Traversal<N, S, T>>
+    where
+        T: SlabTest<R>,
+    {
+        // Not `bool::then`: its closure, left out of line, would make the wide test's lanes
+        // outside the AVX code and call each intrinsic.
+        if !walkable(ray) {
+            return None;
+        }
+        Some(Traversal {
+            ray: T::new(ray),
             stack,
             sp: 0,
             cur: 0,
@@ -535,12 +620,15 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
     /// the top are never read, so they need no clearing); `false`, leaving the walk finished,
     /// for a non-finite ray.
     #[inline(always)]
-    fn restart(&mut self, ray: &Ray, t_max: f32) -> bool {
+    fn restart<const R: usize>(&mut self, ray: &Ray, t_max: f32) -> bool
+    where
+        T: SlabTest<R>,
+    {
         self.sp = 0;
         if !walkable(ray) {
             return false;
         }
-        self.ray = RayPre::new(ray);
+        self.ray = T::new(ray);
         self.cur = 0;
         self.t_max = t_max;
         true
@@ -550,7 +638,10 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
     /// `FETCH`, children put off are prefetched ([`fetch`]): a single walk gains, while
     /// interleaved walks already overlap their misses and only pay the extra instructions.
     #[inline(always)]
-    fn step<const R: usize, const FETCH: bool>(&mut self, nodes: &[Node<R>]) -> Visit {
+    fn step<const R: usize, const FETCH: bool>(&mut self, nodes: &[Node<R>]) -> Visit
+    where
+        T: SlabTest<R>,
+    {
         let width = Node::<R>::WIDTH;
         if self.cur & LEAF != 0 {
             return Visit::Leaf((self.cur & !LEAF) as usize);
@@ -567,8 +658,7 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>> Traversal<N, S> {
             self.cur = node.child(first);
             return Visit::Node;
         }
-        let t: [f32; MAX_WIDTH] = std::array::from_fn(|i| t_near[(i / 4) % R][i % 4]);
-        let t = |slot: usize| t[slot % MAX_WIDTH];
+        let t = |slot: usize| t_near[slot % MAX_WIDTH];
         if rest & (rest - 1) == 0 {
             let second = rest.trailing_zeros() as usize % width;
             let (c0, c1) = (node.child(first), node.child(second));

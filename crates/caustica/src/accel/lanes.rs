@@ -110,6 +110,7 @@ pub(crate) trait Lanes:
     fn lt(self, other: Self) -> Self::Mask;
     fn gt(self, other: Self) -> Self::Mask;
     fn ge(self, other: Self) -> Self::Mask;
+    fn le(self, other: Self) -> Self::Mask;
     fn eq(self, other: Self) -> Self::Mask;
     /// Lanes that are neither infinite nor NaN.
     fn is_finite(self) -> Self::Mask;
@@ -167,6 +168,10 @@ impl Lanes for Vec4 {
         self.cmpge(other)
     }
     #[inline(always)]
+    fn le(self, other: Self) -> BVec4A {
+        self.cmple(other)
+    }
+    #[inline(always)]
     fn eq(self, other: Self) -> BVec4A {
         self.cmpeq(other)
     }
@@ -201,6 +206,9 @@ mod avx {
     #[derive(Clone, Copy, Debug)]
     pub(crate) struct F32x8(__m256);
 
+    // Two `Vec4`s are eight consecutive `f32`s, which `F32x8::from_pair` reads as one.
+    const _: () = assert!(std::mem::size_of::<[glam::Vec4; 2]>() == 8 * std::mem::size_of::<f32>());
+
     /// Eight lane-wise truth values (all bits set or clear).
     #[derive(Clone, Copy, Debug)]
     pub(crate) struct M32x8(__m256);
@@ -225,6 +233,25 @@ mod avx {
             }
         };
     }
+
+    impl F32x8 {
+        /// The lanes of `pair[0]`, then those of `pair[1]`, in one load.
+        #[inline(always)]
+        pub(crate) fn from_pair(pair: &[glam::Vec4; 2]) -> F32x8 {
+            // SAFETY (besides AVX, as for every function here): the pointer covers the 32 bytes
+            // of `pair` (asserted above), read without an alignment requirement.
+            F32x8(avx!(_mm256_loadu_ps(pair.as_ptr().cast::<f32>())))
+        }
+
+        /// The lanes as an array.
+        #[inline(always)]
+        pub(crate) fn to_array(self) -> [f32; 8] {
+            let mut out = [0.0; 8];
+            self.write_to(&mut out);
+            out
+        }
+    }
+
     binary!(Add, add, F32x8, _mm256_add_ps);
     binary!(Sub, sub, F32x8, _mm256_sub_ps);
     binary!(Mul, mul, F32x8, _mm256_mul_ps);
@@ -301,6 +328,10 @@ mod avx {
         #[inline(always)]
         fn ge(self, other: Self) -> M32x8 {
             M32x8(avx!(_mm256_cmp_ps::<_CMP_GE_OQ>(self.0, other.0)))
+        }
+        #[inline(always)]
+        fn le(self, other: Self) -> M32x8 {
+            M32x8(avx!(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, other.0)))
         }
         #[inline(always)]
         fn eq(self, other: Self) -> M32x8 {

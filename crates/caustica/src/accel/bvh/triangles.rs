@@ -3,7 +3,12 @@
 //! a time. The tree is built with leaves priced per packet, so it favours full packets.
 
 use super::build::LeafCost;
-use super::{Bvh, StackSized, Traversal, Visit, END, LEAF};
+#[cfg(target_arch = "x86_64")]
+use super::WideRayPre;
+use super::{Bvh, RayPre, SlabTest, StackSized, Traversal, Visit, END, LEAF};
+#[cfg(target_arch = "x86_64")]
+use crate::accel::lanes::in_avx;
+use crate::accel::lanes::Width;
 use crate::geometry::triangle::{Triangle, TriangleRay};
 use crate::geometry::triangle_packet::{TrianglePacket, LANES};
 use crate::math::{Aabb, Ray};
@@ -59,6 +64,9 @@ pub struct TriangleBvh {
     packets: Vec<TrianglePacket>,
     /// Triangle ids of each packet's lanes ([`NO_TRIANGLE`] for unused lanes).
     ids: Vec<[u32; LANES]>,
+    /// The lanes the walks test a node's boxes in: eight in one AVX register where the CPU has
+    /// it, else two rows of four.
+    width: Width,
 }
 
 impl TriangleBvh {
@@ -116,7 +124,17 @@ impl TriangleBvh {
             }
         }
         bvh.order = packet_order;
-        TriangleBvh { bvh, packets, ids }
+        TriangleBvh {
+            bvh,
+            packets,
+            ids,
+            width: Width::of_host(),
+        }
+    }
+
+    /// This tree with its walks testing boxes `width` lanes at a time (the same hits at any).
+    pub fn with_width(self, width: Width) -> TriangleBvh {
+        TriangleBvh { width, ..self }
     }
 
     /// Bounds of all hittable triangles (empty if there are none).
@@ -171,8 +189,18 @@ impl TriangleBvh {
     /// two triangles: twice the instruction-cache misses, 5% slower).
     #[inline(never)]
     fn closest_walk(&self, ray: &Ray, tr: &TriangleRay, t_max: f32) -> Option<TriangleBvhHit> {
+        match self.width {
+            Width::Four => self.closest_walk_tested::<RayPre>(ray, tr, t_max),
+            #[cfg(target_arch = "x86_64")]
+            Width::Eight(avx) => in_avx(avx, || self.closest_walk_tested::<WideRayPre>(ray, tr, t_max)),
+        }
+    }
+
+    /// [`TriangleBvh::closest_walk`] with boxes tested by `T`.
+    #[inline(always)]
+    fn closest_walk_tested<T: SlabTest<2>>(&self, ray: &Ray, tr: &TriangleRay, t_max: f32) -> Option<TriangleBvhHit> {
         let (mut t, mut best) = (t_max, None);
-        self.bvh.traverse_any_stack(ray, &mut t, |_, first, t_max| {
+        self.bvh.traverse_tested::<T, _>(ray, &mut t, |_, first, t_max| {
             self.closest_in_leaf(tr, first, t_max, &mut best);
             false
         });
@@ -246,8 +274,22 @@ impl TriangleBvh {
         {
             type Output = ();
             fn run<const N: usize>(self) {
-                self.bvh
-                    .stream_with::<N, F, R>(self.rays, self.t_max, self.out, &self.leaf, &self.answer);
+                let bvh = self.bvh;
+                match bvh.width {
+                    Width::Four => {
+                        bvh.stream_with::<N, F, R, RayPre>(self.rays, self.t_max, self.out, &self.leaf, &self.answer)
+                    }
+                    #[cfg(target_arch = "x86_64")]
+                    Width::Eight(avx) => in_avx(avx, || {
+                        bvh.stream_with::<N, F, R, WideRayPre>(
+                            self.rays,
+                            self.t_max,
+                            self.out,
+                            &self.leaf,
+                            &self.answer,
+                        )
+                    }),
+                }
             }
         }
         assert_eq!(rays.len(), out.len(), "one answer slot per ray");
@@ -266,8 +308,9 @@ impl TriangleBvh {
         });
     }
 
-    /// [`TriangleBvh::stream`] with traversal stacks of `N` entries.
-    fn stream_with<const N: usize, F: Copy + Default, R>(
+    /// [`TriangleBvh::stream`] with traversal stacks of `N` entries and boxes tested by `T`.
+    #[inline(always)]
+    fn stream_with<const N: usize, F: Copy + Default, R, T: SlabTest<2>>(
         &self,
         rays: &[Ray],
         t_max: f32,
@@ -276,25 +319,29 @@ impl TriangleBvh {
         answer: &impl Fn(f32, F) -> R,
     ) {
         /// One ray of the stream.
-        struct Lane<const N: usize, F> {
+        struct Lane<const N: usize, F, T> {
             index: usize,
-            walk: Traversal<N>,
+            walk: Traversal<N, [(u32, f32); N], T>,
             tri: TriangleRay,
             found: F,
         }
         let mut pending = rays.iter().enumerate();
-        let mut lanes: Vec<Lane<N, F>> = pending
-            .by_ref()
-            .filter_map(|(index, ray)| {
-                Traversal::new(ray, t_max, [(0, 0.0); N]).map(|walk| Lane {
+        // A plain loop: an iterator adapter's closure, left out of line, would make the wide
+        // test's lanes outside the AVX code.
+        let mut lanes: Vec<Lane<N, F, T>> = Vec::with_capacity(STREAM);
+        while lanes.len() < STREAM {
+            let Some((index, ray)) = pending.next() else {
+                break;
+            };
+            if let Some(walk) = Traversal::new(ray, t_max, [(0, 0.0); N]) {
+                lanes.push(Lane {
                     index,
                     walk,
                     tri: TriangleRay::new(ray),
                     found: F::default(),
-                })
-            })
-            .take(STREAM)
-            .collect();
+                });
+            }
+        }
         while !lanes.is_empty() {
             let mut slot = 0;
             while slot < lanes.len() {
@@ -415,9 +462,24 @@ impl TriangleBvh {
     /// [`TriangleBvh::each_hit`] by walking the tree, out of line as
     /// [`TriangleBvh::closest_walk`] is.
     #[inline(never)]
-    fn each_walk(&self, ray: &Ray, t_max: f32, mut packet: impl FnMut(usize, f32) -> bool) -> bool {
+    fn each_walk(&self, ray: &Ray, t_max: f32, packet: impl FnMut(usize, f32) -> bool) -> bool {
+        match self.width {
+            Width::Four => self.each_walk_tested::<RayPre>(ray, t_max, packet),
+            #[cfg(target_arch = "x86_64")]
+            Width::Eight(avx) => in_avx(avx, || self.each_walk_tested::<WideRayPre>(ray, t_max, packet)),
+        }
+    }
+
+    /// [`TriangleBvh::each_walk`] with boxes tested by `T`.
+    #[inline(always)]
+    fn each_walk_tested<T: SlabTest<2>>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut packet: impl FnMut(usize, f32) -> bool,
+    ) -> bool {
         let mut t = t_max;
-        self.bvh.traverse_any_stack(ray, &mut t, |order, first, t_max| {
+        self.bvh.traverse_tested::<T, _>(ray, &mut t, |order, first, t_max| {
             let mut i = first;
             loop {
                 if packet(i, *t_max) {
