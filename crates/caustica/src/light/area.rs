@@ -83,6 +83,9 @@ pub struct DirectionSample {
     /// The point is the light's nearest along its direction from the shading point (a sphere
     /// drawn by its cone): no part of the light itself lies in between.
     pub nearest: bool,
+    /// The unit direction from the shading point to the point and its distance, where the
+    /// drawing found them (a sphere's cone: its direction and the hit's `t`).
+    pub toward: Option<(Vec3, f32)>,
 }
 
 impl AreaLight {
@@ -286,13 +289,16 @@ impl AreaLight {
                 return Some(DirectionSample {
                     point: AreaSample {
                         point,
-                        normal: (point - center).normalize_or_zero(),
+                        // On the sphere to rounding: dividing by the radius saves normalising's
+                        // square root, on next-event estimation's chain of dependent operations.
+                        normal: (point - center) * radius.recip(),
                         // As `sample` draws it: uniform by area.
                         pdf_area: 1.0 / (4.0 * PI * radius * radius),
                         prim: *prim,
                     },
                     pdf_solid: uniform_cone_pdf(cos_max),
                     nearest: true,
+                    toward: Some((dir, t)),
                 });
             }
         }
@@ -302,6 +308,7 @@ impl AreaLight {
             point: sample,
             pdf_solid,
             nearest: false,
+            toward: None,
         })
     }
 
@@ -506,12 +513,14 @@ impl AreaLight {
         let p = hit.point;
         let drawn = light.sample_towards(scene, p, u_pick, u)?;
         let sample = drawn.point;
-        let to = sample.point - p;
-        let d = to.length();
+        let (wi, d) = drawn.toward.unwrap_or_else(|| {
+            let to = sample.point - p;
+            let d = to.length();
+            (to / d, d)
+        });
         if d.is_nan() || d <= 0.0 {
             return None;
         }
-        let wi = to / d;
         if !(q.takes)(wi) {
             return None;
         }
