@@ -60,6 +60,9 @@ pub struct Shape {
     /// A sphere whose transform keeps it round (rotation, uniform scale, translation): its
     /// world centre and radius. It is tested in world space, without moving the ray.
     round_sphere: Option<(Vec3, f32)>,
+    /// [`Shape::world_normal`] of `+Z` and `-Z`, a square's two normals, worked out once: the
+    /// square root and division were most of a box's `Scene::surface`.
+    z_normals: [Vec3; 2],
 }
 
 /// A shape as a packet test sees it ([`crate::accel::shape_packets`]): the world-space
@@ -123,6 +126,7 @@ impl Shape {
             object_rows: [linear.x_axis, linear.y_axis, linear.z_axis],
             origin: world_from_object.w_axis.truncate(),
             round_sphere,
+            z_normals: [Vec3::Z, -Vec3::Z].map(|n| transform_normal(&normal_to_world, n)),
         })
     }
 
@@ -369,10 +373,14 @@ impl Shape {
     /// degenerate transform).
     #[inline]
     pub fn world_normal(&self, normal: Vec3) -> Vec3 {
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
         match self.kind {
             // A solid's hits carry the world normal of the leaf they lie on.
             ShapeKind::Csg(_) => normal,
-            _ => (self.normal_to_world * normal).normalize_or_zero(),
+            // The same bits as worked out here (a normal of `-0.0` components is not `+Z`'s).
+            ShapeKind::Square if bits(normal) == bits(Vec3::Z) => self.z_normals[0],
+            ShapeKind::Square if bits(normal) == bits(-Vec3::Z) => self.z_normals[1],
+            _ => transform_normal(&self.normal_to_world, normal),
         }
     }
 }
@@ -393,6 +401,12 @@ impl Shape {
             + m.w_axis.truncate().abs();
         (point, magnitude * GAMMA_5)
     }
+}
+
+/// A normal carried to the world by `normal_to_world`, unit length (zero for a degenerate map).
+#[inline]
+fn transform_normal(normal_to_world: &Mat3, normal: Vec3) -> Vec3 {
+    (*normal_to_world * normal).normalize_or_zero()
 }
 
 /// γ₅ = 5u / (1 − 5u) for the unit roundoff u of f32: the relative error bound of five rounded
@@ -520,6 +534,38 @@ mod tests {
         assert!(s
             .intersect(&Ray::new(Vec3::new(0.6, 0.0, 1.0), -Vec3::Z), f32::INFINITY)
             .is_none());
+    }
+
+    /// A square's two normals, worked out once, are the bits the transform gives them; any other
+    /// normal (a `-0.0` component included) is carried over as before.
+    #[test]
+    fn square_normals_are_the_transformed_normals() {
+        let m = Mat4::from_scale_rotation_translation(
+            Vec3::new(2.0, 0.5, 3.0),
+            glam::Quat::from_euler(glam::EulerRot::XYZ, 0.3, -1.1, 2.0),
+            Vec3::new(1.0, -2.0, 0.5),
+        ) * Mat4::from_cols_array(&[
+            1.0, 0.2, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.4, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+        ]);
+        let s = Shape::new(ShapeKind::Square, m).unwrap();
+        let direct = |n: Vec3| (s.normal_to_world * n).normalize_or_zero();
+        let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::new(-0.0, 0.0, 1.0),
+            Vec3::new(0.0, 0.6, 0.8),
+            Vec3::X,
+        ] {
+            assert_eq!(bits(s.world_normal(n)), bits(direct(n)), "{n:?}");
+        }
+        let ray = Ray::new(m.transform_point3(Vec3::Z), m.transform_vector3(-Vec3::Z));
+        let down = s.intersect_object_normal(&ray, f32::INFINITY).unwrap();
+        assert_eq!(bits(down.normal), bits(Vec3::Z));
+        assert_eq!(
+            bits(s.intersect(&ray, f32::INFINITY).unwrap().normal),
+            bits(direct(Vec3::Z))
+        );
     }
 
     /// The world-space square test against the object-space one on the ray moved into object
