@@ -184,7 +184,8 @@ impl<const R: usize> SlabTest<R> for RayPre {
 
 /// [`RayPre`]'s tests of an eight-wide node in one AVX register per operand: the same
 /// operations in the same order on each lane, so the same masks and distances to the bit.
-/// Made and used only inside [`in_avx`](super::lanes::in_avx).
+/// Made only by a tree that holds the proof the CPU has AVX (`Width::Eight`), and used inside
+/// [`in_avx`](super::lanes::in_avx) but for the cold nested walk ([`Bvh::traverse_nested`]).
 #[cfg(target_arch = "x86_64")]
 pub(crate) struct WideRayPre {
     origin: [F32x8; 3],
