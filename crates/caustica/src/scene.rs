@@ -903,10 +903,14 @@ impl Scene {
         }
     }
 
-    /// The nearest triangle hit in `(0, t_max)` that is not in a cut-out.
+    /// The closest hit in `(0, t_max)` given `triangle`, the tree's nearest triangle hit:
+    /// the nearest solid triangle's or a shape's.
     #[inline]
-    fn closest_triangle(&self, ray: &Ray, t_max: f32) -> Option<TriangleBvhHit> {
-        self.solid_triangle(ray, t_max, self.triangle_bvh.closest_hit(ray, t_max))
+    fn closest_of(&self, ray: &Ray, t_max: f32, triangle: Option<TriangleBvhHit>) -> Option<Intersection> {
+        let triangle = self
+            .solid_triangle(ray, t_max, triangle)
+            .map(|h| self.triangle_intersection(h));
+        self.closest_shape(ray, t_max, triangle)
     }
 
     /// The nearest triangle hit in `(0, t_max)` not in a cut-out, given the nearest `hit` of all.
@@ -930,8 +934,7 @@ impl Scene {
     /// The closest hit in `(0, t_max)`.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Intersection> {
-        let triangle = self.closest_triangle(ray, t_max).map(|h| self.triangle_intersection(h));
-        self.closest_shape(ray, t_max, triangle)
+        self.closest_of(ray, t_max, self.triangle_bvh.closest_hit(ray, t_max))
     }
 
     /// The closest hit in `(0, ∞)` of each ray, into `hits` (one per ray): [`Scene::intersect`]
@@ -951,10 +954,7 @@ impl Scene {
         let mut triangles = vec![None; rays.len()];
         self.triangle_bvh.closest_hits(rays, f32::INFINITY, &mut triangles);
         for ((ray, hit), triangle) in rays.iter().zip(hits).zip(triangles) {
-            let triangle = self
-                .solid_triangle(ray, f32::INFINITY, triangle)
-                .map(|h| self.triangle_intersection(h));
-            *hit = self.closest_shape(ray, f32::INFINITY, triangle);
+            *hit = self.closest_of(ray, f32::INFINITY, triangle);
         }
     }
 

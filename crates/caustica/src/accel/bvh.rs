@@ -19,7 +19,8 @@ use std::cell::RefCell;
 use glam::Vec4;
 
 #[cfg(target_arch = "x86_64")]
-use super::lanes::{F32x8, Lanes};
+use super::lanes::F32x8;
+use super::lanes::Lanes;
 use crate::math::{Aabb, Ray, Vec3};
 use crate::progress::{NoProgress, Progress};
 
@@ -150,16 +151,28 @@ impl RayPre {
     /// Reductions are balanced trees: traversal is bound by this dependency chain.
     #[inline(always)]
     fn row<const R: usize>(&self, node: &Node<R>, h: usize, t_max: f32) -> (u32, Vec4) {
-        let [nx, ny, nz] = self.near;
-        let near = |axis: usize, side: usize| (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir[axis];
-        let far =
-            |axis: usize, side: usize| (node.bounds[axis][side & 1][h] - self.origin[axis]) * self.inv_dir_far[axis];
-        let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(Vec4::ZERO));
-        let t_far = far(0, nx ^ 1)
-            .min(far(1, ny ^ 1))
-            .min(far(2, nz ^ 1).min(Vec4::splat(t_max)));
-        (t_near.cmple(t_far).bitmask(), t_near)
+        let ray = (&self.origin, &self.inv_dir, &self.inv_dir_far, self.near);
+        slabs(|axis, side| node.bounds[axis][side][h], ray, t_max)
     }
+}
+
+/// The slab tests of one ray against boxes in lanes, `bound(axis, side)` their planes (side 0
+/// the minimum): the lanes the segment `[0, t_max]` meets and their entry distances. `ray` is
+/// the splatted origin, inverse direction, the same widened by [`ROBUST`] and which side each
+/// axis enters by. Reductions are balanced trees: traversal is bound by this dependency chain.
+#[inline(always)]
+fn slabs<L: Lanes>(
+    bound: impl Fn(usize, usize) -> L,
+    (origin, inv_dir, inv_dir_far, [nx, ny, nz]): (&[L; 3], &[L; 3], &[L; 3], [usize; 3]),
+    t_max: f32,
+) -> (u32, L) {
+    let near = |axis: usize, side: usize| (bound(axis, side & 1) - origin[axis]) * inv_dir[axis];
+    let far = |axis: usize, side: usize| (bound(axis, side & 1) - origin[axis]) * inv_dir_far[axis];
+    let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(L::splat(0.0)));
+    let t_far = far(0, nx ^ 1)
+        .min(far(1, ny ^ 1))
+        .min(far(2, nz ^ 1).min(L::splat(t_max)));
+    (L::bitmask(t_near.le(t_far)), t_near)
 }
 
 /// A ray's slab tests against a node's child boxes, at some lane width: which children the
@@ -210,15 +223,9 @@ impl SlabTest<2> for WideRayPre {
 
     #[inline(always)]
     fn hit(&self, node: &Node<2>, t_max: f32) -> (u32, [f32; MAX_WIDTH]) {
-        let [nx, ny, nz] = self.near;
-        let bound = |axis: usize, side: usize| F32x8::from_pair(&node.bounds[axis][side & 1]);
-        let near = |axis: usize, side: usize| (bound(axis, side) - self.origin[axis]) * self.inv_dir[axis];
-        let far = |axis: usize, side: usize| (bound(axis, side) - self.origin[axis]) * self.inv_dir_far[axis];
-        let t_near = near(0, nx).max(near(1, ny)).max(near(2, nz).max(F32x8::splat(0.0)));
-        let t_far = far(0, nx ^ 1)
-            .min(far(1, ny ^ 1))
-            .min(far(2, nz ^ 1).min(F32x8::splat(t_max)));
-        (F32x8::bitmask(t_near.le(t_far)), t_near.to_array())
+        let ray = (&self.origin, &self.inv_dir, &self.inv_dir_far, self.near);
+        let (mask, t_near) = slabs(|axis, side| F32x8::from_pair(&node.bounds[axis][side]), ray, t_max);
+        (mask, t_near.to_array())
     }
 }
 
