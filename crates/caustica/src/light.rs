@@ -377,6 +377,9 @@ pub struct LightSet {
     /// Light number of each shape and mesh (`u32::MAX` when it does not emit).
     shape_light: Vec<u32>,
     mesh_light: Vec<u32>,
+    /// Numbers of the lights outside the scene (environments and suns), the only ones a ray
+    /// that escapes can see.
+    sky: Vec<usize>,
     /// Where photons leave the lights.
     emitters: Emitters,
     /// The sphere around the scene, across which directional light enters.
@@ -428,7 +431,11 @@ impl LightSet {
         // in view, where caustics come from, half everywhere for the rest of the light.
         let far_aim = Aim::every(&camera_targets(scene), FAR_LIGHT_AIM_SHARE);
         let emitters = Emitters::new(&lights, (scene_center, scene_radius), None, far_aim);
+        let sky = (0..lights.len())
+            .filter(|&i| matches!(lights[i], Light::Environment(_) | Light::Sun { .. }))
+            .collect();
         LightSet {
+            sky,
             lights,
             emitters,
             probabilities,
@@ -612,7 +619,8 @@ impl LightSet {
         skip: impl Fn(usize) -> bool,
     ) -> Spectrum {
         let mut l = Spectrum::ZERO;
-        for (index, light) in self.lights.iter().enumerate() {
+        for &index in &self.sky {
+            let light = &self.lights[index];
             if skip(index) {
                 continue;
             }
@@ -648,9 +656,7 @@ impl LightSet {
     /// Whether light arrives from outside the scene (an environment or a sun): rays that escape
     /// carry radiance.
     pub fn has_sky(&self) -> bool {
-        self.lights
-            .iter()
-            .any(|l| matches!(l, Light::Environment(_) | Light::Sun { .. }))
+        !self.sky.is_empty()
     }
 
     /// Solid-angle pdf with which [`LightSet::sample_direct`] from `from` would sample the
