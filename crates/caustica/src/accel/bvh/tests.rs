@@ -646,3 +646,41 @@ fn walks_find_the_same_hits_at_every_width() {
         }
     }
 }
+
+/// A floor of two triangles (which the tree does not walk) answers as testing each triangle
+/// does for rays from on, above, below and beside it in every direction, zero components
+/// included: those that start outside its bounds and move away are passed over, and no other.
+#[test]
+fn a_floor_passes_over_only_the_rays_that_move_away() {
+    let (a, b, c, d) = (
+        Vec3::new(-5.0, 0.0, -5.0),
+        Vec3::new(5.0, 0.0, -5.0),
+        Vec3::new(5.0, 0.0, 5.0),
+        Vec3::new(-5.0, 0.0, 5.0),
+    );
+    let tris = [Triangle::new(a, c, b), Triangle::new(a, d, c)];
+    let mut rng = Rng(0x0f10_0a2e_d0c5_3a11);
+    for width in Width::on_host() {
+        let floor = TriangleBvh::new(&tris).with_width(width);
+        assert!(!floor.walks());
+        let (mut hits, mut away) = (0, 0);
+        for i in 0..20_000 {
+            let heights = [0.0, 1e-6, -1e-6, 0.5, -0.5, 3.0];
+            let mut origin = (rng.v() - 0.5) * 14.0;
+            origin.y = heights[i % heights.len()];
+            let ray = Ray::new(origin, rng.dir());
+            let t_max = if i % 3 == 0 {
+                1.0 + rng.f() * 10.0
+            } else {
+                f32::INFINITY
+            };
+            let expect = brute_closest(&tris, &ray, t_max);
+            let got = floor.closest_hit(&ray, t_max).map(|h| (h.t, h.prim));
+            assert!(same_hit(&tris, &ray, got, expect), "{ray:?}: {got:?} vs {expect:?}");
+            assert_eq!(floor.any_hit(&ray, t_max), expect.is_some(), "{ray:?}");
+            hits += usize::from(expect.is_some());
+            away += usize::from(floor.heads_away(&ray));
+        }
+        assert!(hits > 3_000 && away > 3_000, "{hits} hits, {away} rays moving away");
+    }
+}

@@ -9,8 +9,8 @@ use super::{Bvh, RayPre, SlabTest, StackSized, Traversal, Visit, END, LEAF};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::lanes::in_avx;
 use crate::accel::lanes::Width;
-use crate::geometry::triangle::{Triangle, TriangleHit, TriangleRay};
-use crate::geometry::triangle_packet::{self, TrianglePacket, LANES};
+use crate::geometry::triangle::{Triangle, TriangleRay};
+use crate::geometry::triangle_packet::{TrianglePacket, LANES};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::progress::{NoProgress, Progress};
 
@@ -167,7 +167,7 @@ impl TriangleBvh {
     /// along it, so it meets none: the rays leaving a floor, which would otherwise pay the
     /// packets' per-ray set-up and tests. Trees that walk test their root's boxes instead.
     #[inline(always)]
-    fn heads_away(&self, ray: &Ray) -> bool {
+    pub(super) fn heads_away(&self, ray: &Ray) -> bool {
         let Aabb { min, max } = self.bvh.bounds();
         let below = ray.origin.cmplt(min) & ray.dir.cmple(Vec3::ZERO);
         let above = ray.origin.cmpgt(max) & ray.dir.cmpge(Vec3::ZERO);
@@ -228,7 +228,16 @@ impl TriangleBvh {
     /// # Panics
     /// If `hits` and `rays` differ in length.
     pub fn closest_hits(&self, rays: &[Ray], t_max: f32, hits: &mut [Option<TriangleBvhHit>]) {
-        self.stream::<Closest>(rays, t_max, hits);
+        self.stream(
+            rays,
+            t_max,
+            hits,
+            |tri, first, t_max, best: &mut Option<LeafHit>| {
+                self.closest_in_leaf(tri, first, t_max, best);
+                false
+            },
+            |t, best| best.map(|b| self.hit(t, b)),
+        );
     }
 
     /// Whether each ray hits any triangle with `0 < t < t_max`, into `occluded` (one per ray):
@@ -238,51 +247,90 @@ impl TriangleBvh {
     /// # Panics
     /// If `occluded` and `rays` differ in length.
     pub fn any_hits(&self, rays: &[Ray], t_max: f32, occluded: &mut [bool]) {
-        self.stream::<AnyHit>(rays, t_max, occluded);
+        self.stream(
+            rays,
+            t_max,
+            occluded,
+            |tri, first, t_max, hit: &mut bool| {
+                *hit = self.any_in_leaf(tri, first, *t_max);
+                *hit
+            },
+            |_, hit| hit,
+        );
     }
 
-    /// Walks `rays` [`STREAM`] at a time, interleaved, for the query `Q`.
-    fn stream<Q: StreamQuery>(&self, rays: &[Ray], t_max: f32, out: &mut [Q::Answer]) {
+    /// Walks `rays` [`STREAM`] at a time, interleaved. Each ray's lane keeps a `F` (default at
+    /// the start); `leaf(ray, first, t_max, found)` tests the leaf starting at `first` and returns
+    /// whether the ray's answer is settled; `answer(t_max, found)` is what goes to `out`.
+    fn stream<F: Copy + Default, R: Default>(
+        &self,
+        rays: &[Ray],
+        t_max: f32,
+        out: &mut [R],
+        leaf: impl Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
+        answer: impl Fn(f32, F) -> R,
+    ) {
         /// The interleaved walks, generic over their stack size.
-        struct Stream<'a, 'b, Q: StreamQuery> {
+        struct Stream<'a, 'b, F, R, L, A> {
             bvh: &'a TriangleBvh,
             rays: &'a [Ray],
             t_max: f32,
-            out: &'b mut [Q::Answer],
+            out: &'b mut [R],
+            leaf: L,
+            answer: A,
+            found: std::marker::PhantomData<F>,
         }
-        impl<Q: StreamQuery> StackSized for Stream<'_, '_, Q> {
+        impl<F, R, L, A> StackSized for Stream<'_, '_, F, R, L, A>
+        where
+            F: Copy + Default,
+            L: Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
+            A: Fn(f32, F) -> R,
+        {
             type Output = ();
             fn run<const N: usize>(self) {
                 let bvh = self.bvh;
                 match bvh.width {
-                    Width::Four => bvh.stream_with::<N, Q, RayPre>(self.rays, self.t_max, self.out),
+                    Width::Four => {
+                        bvh.stream_with::<N, F, R, RayPre>(self.rays, self.t_max, self.out, &self.leaf, &self.answer)
+                    }
                     #[cfg(target_arch = "x86_64")]
                     Width::Eight(avx) => in_avx(avx, || {
-                        bvh.stream_with::<N, Q, WideRayPre>(self.rays, self.t_max, self.out)
+                        bvh.stream_with::<N, F, R, WideRayPre>(
+                            self.rays,
+                            self.t_max,
+                            self.out,
+                            &self.leaf,
+                            &self.answer,
+                        )
                     }),
                 }
             }
         }
         assert_eq!(rays.len(), out.len(), "one answer slot per ray");
-        out.iter_mut().for_each(|o| *o = Q::Answer::default());
+        out.iter_mut().for_each(|o| *o = R::default());
         if self.packets.is_empty() {
             return;
         }
-        self.bvh.with_stack(Stream::<Q> {
+        self.bvh.with_stack(Stream {
             bvh: self,
             rays,
             t_max,
             out,
+            leaf,
+            answer,
+            found: std::marker::PhantomData,
         });
     }
 
     /// [`TriangleBvh::stream`] with traversal stacks of `N` entries and boxes tested by `T`.
     #[inline(always)]
-    fn stream_with<const N: usize, Q: StreamQuery, T: SlabTest<2>>(
+    fn stream_with<const N: usize, F: Copy + Default, R, T: SlabTest<2>>(
         &self,
         rays: &[Ray],
         t_max: f32,
-        out: &mut [Q::Answer],
+        out: &mut [R],
+        leaf: &impl Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
+        answer: &impl Fn(f32, F) -> R,
     ) {
         /// One ray of the stream.
         struct Lane<const N: usize, F, T> {
@@ -294,7 +342,7 @@ impl TriangleBvh {
         let mut pending = rays.iter().enumerate();
         // A plain loop: an iterator adapter's closure, left out of line, would make the wide
         // test's lanes outside the AVX code.
-        let mut lanes: Vec<Lane<N, Q::Found, T>> = Vec::with_capacity(STREAM);
+        let mut lanes: Vec<Lane<N, F, T>> = Vec::with_capacity(STREAM);
         while lanes.len() < STREAM {
             let Some((index, ray)) = pending.next() else {
                 break;
@@ -304,7 +352,7 @@ impl TriangleBvh {
                     index,
                     walk,
                     tri: TriangleRay::new(ray),
-                    found: Q::Found::default(),
+                    found: F::default(),
                 });
             }
         }
@@ -315,8 +363,7 @@ impl TriangleBvh {
                 let done = match lane.walk.step::<2, false>(&self.bvh.nodes) {
                     Visit::Node => false,
                     Visit::Leaf(first) => {
-                        let (t_max, found) = (&mut lane.walk.t_max, &mut lane.found);
-                        Q::leaf(self, &lane.tri, first, t_max, found) || !lane.walk.pop()
+                        leaf(&lane.tri, first, &mut lane.walk.t_max, &mut lane.found) || !lane.walk.pop()
                     }
                     Visit::Done => true,
                 };
@@ -324,14 +371,14 @@ impl TriangleBvh {
                     slot += 1;
                     continue;
                 }
-                out[lane.index] = Q::answer(self, lane.walk.t_max, lane.found);
+                out[lane.index] = answer(lane.walk.t_max, lane.found);
                 // The next ray reuses the lane, stack storage included.
                 let next = pending.by_ref().find(|(_, ray)| lane.walk.restart(ray, t_max));
                 match next {
                     Some((index, ray)) => {
                         lane.index = index;
                         lane.tri = TriangleRay::new(ray);
-                        lane.found = Q::Found::default();
+                        lane.found = F::default();
                     }
                     None => {
                         lanes.swap_remove(slot);
@@ -342,75 +389,16 @@ impl TriangleBvh {
     }
 
     /// Tests the packets of the leaf starting at `first` for hits closer than `t_max`, shrinking
-    /// `t_max` and recording the closest in `best`; two at a time where the CPU has AVX.
+    /// `t_max` and recording the closest in `best`.
     #[inline(always)]
     fn closest_in_leaf(&self, tr: &TriangleRay, first: usize, t_max: &mut f32, best: &mut Option<LeafHit>) {
         let mut i = first;
         loop {
-            let two = self.pair_at(i);
-            let found = if two {
-                self.closest_in_pair(tr, i, *t_max)
-            } else {
-                self.packets[i].closest_hit(tr, *t_max)
-            };
-            if let Some((lane, h)) = found {
-                *t_max = h.t;
-                *best = Some(LeafHit {
-                    packet: i + lane / LANES,
-                    lane: lane % LANES,
-                    u: h.u,
-                    v: h.v,
-                });
-            }
-            let last = i + usize::from(two);
-            if self.bvh.order[last] & END != 0 {
+            self.closest_in_packet(tr, i, t_max, best);
+            if self.bvh.order[i] & END != 0 {
                 return;
             }
-            i = last + 1;
-        }
-    }
-
-    /// Whether packets `i` and `i + 1` are tested together: where the tree tests eight lanes
-    /// (the CPU has AVX) and both are of one leaf.
-    #[inline(always)]
-    fn pair_at(&self, i: usize) -> bool {
-        self.width != Width::Four && self.bvh.order[i] & END == 0
-    }
-
-    /// The closest hit of packets `i` and `i + 1` as one test of eight lanes (lanes 4–7 the
-    /// second's): the answer of testing one and then the other.
-    #[inline(always)]
-    fn closest_in_pair(&self, tr: &TriangleRay, i: usize, t_max: f32) -> Option<(usize, TriangleHit)> {
-        let pair = [&self.packets[i], &self.packets[i + 1]];
-        match self.width {
-            // Entered afresh: the walks' leaf closures may be out of line, compiled without AVX.
-            #[cfg(target_arch = "x86_64")]
-            Width::Eight(avx) => in_avx(avx, || triangle_packet::pair::closest_hit(pair, tr, t_max)),
-            Width::Four => {
-                let first = pair[0].closest_hit(tr, t_max);
-                let second = pair[1].closest_hit(tr, first.map_or(t_max, |(_, h)| h.t));
-                second.map(|(lane, h)| (lane + LANES, h)).or(first)
-            }
-        }
-    }
-
-    /// [`TrianglePacket::each_hit`] of packets `i` and `i + 1` as one test of eight lanes
-    /// (lanes 4–7 the second's).
-    #[inline(always)]
-    fn each_in_pair(
-        &self,
-        tr: &TriangleRay,
-        i: usize,
-        t_max: f32,
-        mut visit: impl FnMut(usize, TriangleHit) -> bool,
-    ) -> bool {
-        let pair = [&self.packets[i], &self.packets[i + 1]];
-        match self.width {
-            #[cfg(target_arch = "x86_64")]
-            Width::Eight(avx) => in_avx(avx, || triangle_packet::pair::each_hit(pair, tr, t_max, visit)),
-            Width::Four => {
-                pair[0].each_hit(tr, t_max, &mut visit) || pair[1].each_hit(tr, t_max, |lane, h| visit(lane + LANES, h))
-            }
+            i += 1;
         }
     }
 
@@ -429,26 +417,18 @@ impl TriangleBvh {
         }
     }
 
-    /// Whether a triangle of the leaf starting at `first` is hit with `0 < t < t_max`; two
-    /// packets at a time where the CPU has AVX.
+    /// Whether a triangle of the leaf starting at `first` is hit with `0 < t < t_max`.
     #[inline(always)]
     fn any_in_leaf(&self, tr: &TriangleRay, first: usize, t_max: f32) -> bool {
         let mut i = first;
         loop {
-            let two = self.pair_at(i);
-            let hit = if two {
-                self.each_in_pair(tr, i, t_max, |_, _| true)
-            } else {
-                self.packets[i].each_hit(tr, t_max, |_, _| true)
-            };
-            if hit {
+            if self.packets[i].each_hit(tr, t_max, |_, _| true) {
                 return true;
             }
-            let last = i + usize::from(two);
-            if self.bvh.order[last] & END != 0 {
+            if self.bvh.order[i] & END != 0 {
                 return false;
             }
-            i = last + 1;
+            i += 1;
         }
     }
 
@@ -476,32 +456,27 @@ impl TriangleBvh {
             return false;
         }
         let tr = TriangleRay::new(ray);
-        // Packet `i`, or with `two` packets `i` and `i + 1` as one test (lanes 4–7 the second's).
-        let mut packets = |i: usize, two: bool, t_max: f32| {
-            let hit = |lane: usize, h: TriangleHit| {
+        let mut packet = |i: usize, t_max: f32| {
+            let ids = &self.ids[i];
+            self.packets[i].each_hit(&tr, t_max, |lane, h| {
                 visit(TriangleBvhHit {
                     t: h.t,
-                    prim: self.ids[i + lane / LANES][lane % LANES],
+                    prim: ids[lane],
                     u: h.u,
                     v: h.v,
                 })
-            };
-            if two {
-                self.each_in_pair(&tr, i, t_max, hit)
-            } else {
-                self.packets[i].each_hit(&tr, t_max, hit)
-            }
+            })
         };
         if !self.walks() {
-            return super::walkable(ray) && (0..self.packets.len()).any(|i| packets(i, false, t_max));
+            return super::walkable(ray) && (0..self.packets.len()).any(|i| packet(i, t_max));
         }
-        self.each_walk(ray, t_max, packets)
+        self.each_walk(ray, t_max, packet)
     }
 
     /// [`TriangleBvh::each_hit`] by walking the tree, out of line as
     /// [`TriangleBvh::closest_walk`] is.
     #[inline(never)]
-    fn each_walk(&self, ray: &Ray, t_max: f32, packet: impl FnMut(usize, bool, f32) -> bool) -> bool {
+    fn each_walk(&self, ray: &Ray, t_max: f32, packet: impl FnMut(usize, f32) -> bool) -> bool {
         match self.width {
             Width::Four => self.each_walk_tested::<RayPre>(ray, t_max, packet),
             #[cfg(target_arch = "x86_64")]
@@ -515,21 +490,19 @@ impl TriangleBvh {
         &self,
         ray: &Ray,
         t_max: f32,
-        mut packet: impl FnMut(usize, bool, f32) -> bool,
+        mut packet: impl FnMut(usize, f32) -> bool,
     ) -> bool {
         let mut t = t_max;
         self.bvh.traverse_tested::<T, _>(ray, &mut t, |order, first, t_max| {
             let mut i = first;
             loop {
-                let two = self.pair_at(i);
-                if packet(i, two, *t_max) {
+                if packet(i, *t_max) {
                     return true;
                 }
-                let last = i + usize::from(two);
-                if order[last] & END != 0 {
+                if order[i] & END != 0 {
                     return false;
                 }
-                i = last + 1;
+                i += 1;
             }
         })
     }
@@ -543,53 +516,5 @@ impl TriangleBvh {
                 .take_while(|&&id| id != NO_TRIANGLE)
                 .any(|&id| visit(id))
         })
-    }
-}
-
-/// What a stream's walks look for ([`TriangleBvh::stream`]): what a ray keeps on the way, the
-/// test of a leaf, and the answer; a trait rather than closures, so the leaf test is inlined
-/// into the walk.
-trait StreamQuery {
-    /// What a ray's walk keeps (default at its start).
-    type Found: Copy + Default;
-    /// What goes to the output.
-    type Answer: Default;
-    /// Tests the leaf starting at `first`; whether the ray's answer is settled.
-    fn leaf(bvh: &TriangleBvh, ray: &TriangleRay, first: usize, t_max: &mut f32, found: &mut Self::Found) -> bool;
-    /// The answer of a walk that ended at `t_max` with `found`.
-    fn answer(bvh: &TriangleBvh, t_max: f32, found: Self::Found) -> Self::Answer;
-}
-
-/// The closest hit ([`TriangleBvh::closest_hits`]).
-struct Closest;
-
-impl StreamQuery for Closest {
-    type Found = Option<LeafHit>;
-    type Answer = Option<TriangleBvhHit>;
-    #[inline(always)]
-    fn leaf(bvh: &TriangleBvh, ray: &TriangleRay, first: usize, t_max: &mut f32, best: &mut Option<LeafHit>) -> bool {
-        bvh.closest_in_leaf(ray, first, t_max, best);
-        false
-    }
-    #[inline(always)]
-    fn answer(bvh: &TriangleBvh, t: f32, best: Option<LeafHit>) -> Option<TriangleBvhHit> {
-        best.map(|b| bvh.hit(t, b))
-    }
-}
-
-/// Any hit ([`TriangleBvh::any_hits`]).
-struct AnyHit;
-
-impl StreamQuery for AnyHit {
-    type Found = bool;
-    type Answer = bool;
-    #[inline(always)]
-    fn leaf(bvh: &TriangleBvh, ray: &TriangleRay, first: usize, t_max: &mut f32, hit: &mut bool) -> bool {
-        *hit = bvh.any_in_leaf(ray, first, *t_max);
-        *hit
-    }
-    #[inline(always)]
-    fn answer(_: &TriangleBvh, _: f32, hit: bool) -> bool {
-        hit
     }
 }
