@@ -732,6 +732,8 @@ impl Scene {
     #[inline]
     pub fn emission_towards(&self, hit: &SurfaceHit, wo: Vec3, wl: &Wavelengths) -> Spectrum {
         let id = match hit.material {
+            // Most surfaces a path meets do not glow: no emission to look up.
+            MaterialRef::One(id) if !self.materials[id as usize].is_emissive() => return Spectrum::ZERO,
             MaterialRef::One(id) => id,
             MaterialRef::Blend { ids, .. } => ids[0],
         };
