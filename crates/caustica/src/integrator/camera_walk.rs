@@ -206,14 +206,16 @@ impl CameraWalk {
         // Ended unless the bounce below carries on.
         self.ended = true;
         let wo = -self.ray.dir;
-        let (hit, sample) = match step {
+        // The hit by reference: moving it out of `step` copied it in 16-byte pieces, each
+        // waiting on the narrower stores that had just written it.
+        let (hit, sample) = match &step {
             Step::Escaped => {
                 visitor.escaped(self.ray.dir, self.throughput, length);
                 return;
             }
             Step::Medium(hit) => {
                 let at = MediumArrival {
-                    hit: &hit,
+                    hit,
                     phase: scene.medium(hit.media.back).phase,
                     wo: wo.normalize(),
                     throughput: self.throughput,
@@ -229,9 +231,9 @@ impl CameraWalk {
                 (hit, sample)
             }
             Step::Surface(hit) => {
-                let bsdf = Bsdf::at(scene, &hit, wo, wl);
+                let bsdf = Bsdf::at(scene, hit, wo, wl);
                 let at = CameraArrival {
-                    hit: &hit,
+                    hit,
                     bsdf: &bsdf,
                     wo,
                     t: hit.t,
@@ -252,7 +254,7 @@ impl CameraWalk {
         if !continue_camera(&sample, roulette, (&mut self.throughput, &mut self.dispersed), wl, rng) {
             return;
         }
-        self.passage.cross(scene, &hit, &sample);
+        self.passage.cross(scene, hit, &sample);
         self.ray = Ray::new(hit.ray_origin(sample.wi), sample.wi);
         if length < self.max_surfaces {
             self.length = length + 1;
