@@ -313,7 +313,7 @@ impl<const R: usize> Bvh<R> {
     ) -> Option<(f32, u32)> {
         let mut best = None;
         let mut t_max = t_max;
-        self.traverse_any_stack(ray, &mut t_max, |order, first, t_max| {
+        self.traverse_any_stack::<true, _>(ray, &mut t_max, |order, first, t_max| {
             let mut i = first;
             loop {
                 let p = order[i];
@@ -339,7 +339,7 @@ impl<const R: usize> Bvh<R> {
     #[inline]
     pub fn any_hit<F: FnMut(u32, f32) -> bool>(&self, ray: &Ray, t_max: f32, mut visit: F) -> bool {
         let mut t_max = t_max;
-        self.traverse_any_stack(ray, &mut t_max, |order, first, t_max| {
+        self.traverse_any_stack::<false, _>(ray, &mut t_max, |order, first, t_max| {
             let mut i = first;
             loop {
                 let p = order[i];
@@ -424,36 +424,38 @@ impl<const R: usize> Bvh<R> {
 
     /// [`Bvh::traverse`] with the stack size the tree needs, boxes tested by [`RayPre`].
     #[inline(always)]
-    fn traverse_any_stack<F: FnMut(&[u32], usize, &mut f32) -> bool>(
+    fn traverse_any_stack<const NEAR_FIRST: bool, F: FnMut(&[u32], usize, &mut f32) -> bool>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
         leaf: F,
     ) -> bool {
-        self.traverse_tested::<RayPre, F>(ray, t_max, leaf)
+        self.traverse_tested::<RayPre, NEAR_FIRST, F>(ray, t_max, leaf)
     }
 
     /// [`Bvh::traverse_any_stack`] with boxes tested by `T`.
     #[inline(always)]
-    fn traverse_tested<T: SlabTest<R>, F: FnMut(&[u32], usize, &mut f32) -> bool>(
+    fn traverse_tested<T: SlabTest<R>, const NEAR_FIRST: bool, F: FnMut(&[u32], usize, &mut f32) -> bool>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
         mut leaf: F,
     ) -> bool {
         /// One ray's traversal, generic over its stack size.
-        struct Walk<'a, const R: usize, T, F> {
+        struct Walk<'a, const R: usize, const NEAR_FIRST: bool, T, F> {
             bvh: &'a Bvh<R>,
             ray: &'a Ray,
             t_max: &'a mut f32,
             leaf: F,
             test: std::marker::PhantomData<T>,
         }
-        impl<const R: usize, T: SlabTest<R>, F: FnMut(&[u32], usize, &mut f32) -> bool> StackSized for Walk<'_, R, T, F> {
+        impl<const R: usize, const NEAR_FIRST: bool, T: SlabTest<R>, F: FnMut(&[u32], usize, &mut f32) -> bool>
+            StackSized for Walk<'_, R, NEAR_FIRST, T, F>
+        {
             type Output = bool;
             #[inline(always)]
             fn run<const N: usize>(self) -> bool {
-                self.bvh.traverse::<N, T>(self.ray, self.t_max, self.leaf)
+                self.bvh.traverse::<N, NEAR_FIRST, T>(self.ray, self.t_max, self.leaf)
             }
         }
         if self.nodes.is_empty() {
@@ -471,7 +473,7 @@ impl<const R: usize> Bvh<R> {
                     .any(|slot| leaf(&self.order, (root.child(slot) & !LEAF) as usize, t_max));
             }
         }
-        self.with_stack(Walk {
+        self.with_stack(Walk::<R, NEAR_FIRST, T, F> {
             bvh: self,
             ray,
             t_max,
@@ -480,10 +482,12 @@ impl<const R: usize> Bvh<R> {
         })
     }
 
-    /// Near-first traversal. `leaf(order, first, t_max)` handles the leaf starting at `first`
-    /// and may shrink `t_max`; returning `true` ends the traversal (and this returns `true`).
+    /// Traversal, near child first with `NEAR_FIRST` (else in slot order, for queries whose
+    /// answer does not depend on the order). `leaf(order, first, t_max)` handles the leaf
+    /// starting at `first` and may shrink `t_max`; returning `true` ends the traversal (and
+    /// this returns `true`).
     #[inline(always)]
-    fn traverse<const N: usize, T: SlabTest<R>>(
+    fn traverse<const N: usize, const NEAR_FIRST: bool, T: SlabTest<R>>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
@@ -496,9 +500,10 @@ impl<const R: usize> Bvh<R> {
                 let stack = scratch
                     .first_chunk_mut::<N>()
                     .expect("no tier exceeds the scratch stack");
-                Traversal::<N, _, T>::new(ray, *t_max, stack).is_some_and(|walk| self.walk(walk, t_max, &mut leaf))
+                Traversal::<N, _, T>::new(ray, *t_max, stack)
+                    .is_some_and(|walk| self.walk::<N, NEAR_FIRST, _, T>(walk, t_max, &mut leaf))
             }
-            Err(_) => self.traverse_nested::<N, T>(ray, t_max, &mut leaf),
+            Err(_) => self.traverse_nested::<N, NEAR_FIRST, T>(ray, t_max, &mut leaf),
         })
     }
 
@@ -506,7 +511,7 @@ impl<const R: usize> Bvh<R> {
     /// Kept out of line: inlined, its stack array grows every query's frame past a page.
     #[cold]
     #[inline(never)]
-    fn traverse_nested<const N: usize, T: SlabTest<R>>(
+    fn traverse_nested<const N: usize, const NEAR_FIRST: bool, T: SlabTest<R>>(
         &self,
         ray: &Ray,
         t_max: &mut f32,
@@ -514,19 +519,20 @@ impl<const R: usize> Bvh<R> {
     ) -> bool {
         // Out of line, this is compiled for the baseline CPU: a wide test's lanes call their
         // AVX intrinsics here (correct, the CPU has AVX; slower, and rare).
-        Traversal::<N, _, T>::new(ray, *t_max, [(0, 0.0); N]).is_some_and(|walk| self.walk(walk, t_max, leaf))
+        Traversal::<N, _, T>::new(ray, *t_max, [(0, 0.0); N])
+            .is_some_and(|walk| self.walk::<N, NEAR_FIRST, _, T>(walk, t_max, leaf))
     }
 
     /// Runs `walk` to its end, handing leaves to `leaf` (see [`Bvh::traverse`]).
     #[inline(always)]
-    fn walk<const N: usize, S: BorrowMut<[(u32, f32); N]>, T: SlabTest<R>>(
+    fn walk<const N: usize, const NEAR_FIRST: bool, S: BorrowMut<[(u32, f32); N]>, T: SlabTest<R>>(
         &self,
         mut walk: Traversal<N, S, T>,
         t_max: &mut f32,
         leaf: &mut impl FnMut(&[u32], usize, &mut f32) -> bool,
     ) -> bool {
         let found = loop {
-            match walk.step::<R, true>(&self.nodes) {
+            match walk.step::<R, true, NEAR_FIRST>(&self.nodes) {
                 Visit::Node => {}
                 Visit::Leaf(first) => {
                     if leaf(&self.order, first, &mut walk.t_max) {
@@ -646,7 +652,7 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>, T> Traversal<N, S, T> {
     /// `FETCH`, children put off are prefetched ([`fetch`]): a single walk gains, while
     /// interleaved walks already overlap their misses and only pay the extra instructions.
     #[inline(always)]
-    fn step<const R: usize, const FETCH: bool>(&mut self, nodes: &[Node<R>]) -> Visit
+    fn step<const R: usize, const FETCH: bool, const NEAR_FIRST: bool>(&mut self, nodes: &[Node<R>]) -> Visit
     where
         T: SlabTest<R>,
     {
@@ -667,6 +673,22 @@ impl<const N: usize, S: BorrowMut<[(u32, f32); N]>, T> Traversal<N, S, T> {
             return Visit::Node;
         }
         let t = |slot: usize| t_near[slot % MAX_WIDTH];
+        if !NEAR_FIRST {
+            // Any order finds the same answer: the first child next, the rest pushed unsorted.
+            let mut m = rest;
+            while m != 0 {
+                let slot = m.trailing_zeros() as usize % width;
+                m &= m - 1;
+                let child = node.child(slot);
+                if FETCH {
+                    fetch(nodes, child);
+                }
+                self.stack.borrow_mut()[self.sp % N] = (child, t(slot));
+                self.sp += 1;
+            }
+            self.cur = node.child(first);
+            return Visit::Node;
+        }
         if rest & (rest - 1) == 0 {
             let second = rest.trailing_zeros() as usize % width;
             let (c0, c1) = (node.child(first), node.child(second));

@@ -214,7 +214,7 @@ impl TriangleBvh {
     #[inline(always)]
     fn closest_walk_tested<T: SlabTest<2>>(&self, ray: &Ray, tr: &TriangleRay, t_max: f32) -> Option<TriangleBvhHit> {
         let (mut t, mut best) = (t_max, None);
-        self.bvh.traverse_tested::<T, _>(ray, &mut t, |_, first, t_max| {
+        self.bvh.traverse_tested::<T, true, _>(ray, &mut t, |_, first, t_max| {
             self.closest_in_leaf(tr, first, t_max, &mut best);
             false
         });
@@ -228,7 +228,7 @@ impl TriangleBvh {
     /// # Panics
     /// If `hits` and `rays` differ in length.
     pub fn closest_hits(&self, rays: &[Ray], t_max: f32, hits: &mut [Option<TriangleBvhHit>]) {
-        self.stream(
+        self.stream::<true, _, _>(
             rays,
             t_max,
             hits,
@@ -247,7 +247,7 @@ impl TriangleBvh {
     /// # Panics
     /// If `occluded` and `rays` differ in length.
     pub fn any_hits(&self, rays: &[Ray], t_max: f32, occluded: &mut [bool]) {
-        self.stream(
+        self.stream::<false, _, _>(
             rays,
             t_max,
             occluded,
@@ -259,10 +259,11 @@ impl TriangleBvh {
         );
     }
 
-    /// Walks `rays` [`STREAM`] at a time, interleaved. Each ray's lane keeps a `F` (default at
+    /// Walks `rays` [`STREAM`] at a time, interleaved, near child first with `NEAR_FIRST` (else in
+    /// slot order, for any-hit queries). Each ray's lane keeps a `F` (default at
     /// the start); `leaf(ray, first, t_max, found)` tests the leaf starting at `first` and returns
     /// whether the ray's answer is settled; `answer(t_max, found)` is what goes to `out`.
-    fn stream<F: Copy + Default, R: Default>(
+    fn stream<const NEAR_FIRST: bool, F: Copy + Default, R: Default>(
         &self,
         rays: &[Ray],
         t_max: f32,
@@ -271,7 +272,7 @@ impl TriangleBvh {
         answer: impl Fn(f32, F) -> R,
     ) {
         /// The interleaved walks, generic over their stack size.
-        struct Stream<'a, 'b, F, R, L, A> {
+        struct Stream<'a, 'b, const NEAR_FIRST: bool, F, R, L, A> {
             bvh: &'a TriangleBvh,
             rays: &'a [Ray],
             t_max: f32,
@@ -280,7 +281,7 @@ impl TriangleBvh {
             answer: A,
             found: std::marker::PhantomData<F>,
         }
-        impl<F, R, L, A> StackSized for Stream<'_, '_, F, R, L, A>
+        impl<const NEAR_FIRST: bool, F, R, L, A> StackSized for Stream<'_, '_, NEAR_FIRST, F, R, L, A>
         where
             F: Copy + Default,
             L: Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
@@ -290,12 +291,16 @@ impl TriangleBvh {
             fn run<const N: usize>(self) {
                 let bvh = self.bvh;
                 match bvh.width {
-                    Width::Four => {
-                        bvh.stream_with::<N, F, R, RayPre>(self.rays, self.t_max, self.out, &self.leaf, &self.answer)
-                    }
+                    Width::Four => bvh.stream_with::<N, NEAR_FIRST, F, R, RayPre>(
+                        self.rays,
+                        self.t_max,
+                        self.out,
+                        &self.leaf,
+                        &self.answer,
+                    ),
                     #[cfg(target_arch = "x86_64")]
                     Width::Eight(avx) => in_avx(avx, || {
-                        bvh.stream_with::<N, F, R, WideRayPre>(
+                        bvh.stream_with::<N, NEAR_FIRST, F, R, WideRayPre>(
                             self.rays,
                             self.t_max,
                             self.out,
@@ -311,7 +316,7 @@ impl TriangleBvh {
         if self.packets.is_empty() {
             return;
         }
-        self.bvh.with_stack(Stream {
+        self.bvh.with_stack(Stream::<NEAR_FIRST, _, _, _, _> {
             bvh: self,
             rays,
             t_max,
@@ -324,7 +329,7 @@ impl TriangleBvh {
 
     /// [`TriangleBvh::stream`] with traversal stacks of `N` entries and boxes tested by `T`.
     #[inline(always)]
-    fn stream_with<const N: usize, F: Copy + Default, R, T: SlabTest<2>>(
+    fn stream_with<const N: usize, const NEAR_FIRST: bool, F: Copy + Default, R, T: SlabTest<2>>(
         &self,
         rays: &[Ray],
         t_max: f32,
@@ -360,7 +365,7 @@ impl TriangleBvh {
             let mut slot = 0;
             while slot < lanes.len() {
                 let lane = &mut lanes[slot];
-                let done = match lane.walk.step::<2, false>(&self.bvh.nodes) {
+                let done = match lane.walk.step::<2, false, NEAR_FIRST>(&self.bvh.nodes) {
                     Visit::Node => false,
                     Visit::Leaf(first) => {
                         leaf(&lane.tri, first, &mut lane.walk.t_max, &mut lane.found) || !lane.walk.pop()
@@ -493,18 +498,19 @@ impl TriangleBvh {
         mut packet: impl FnMut(usize, f32) -> bool,
     ) -> bool {
         let mut t = t_max;
-        self.bvh.traverse_tested::<T, _>(ray, &mut t, |order, first, t_max| {
-            let mut i = first;
-            loop {
-                if packet(i, *t_max) {
-                    return true;
+        self.bvh
+            .traverse_tested::<T, false, _>(ray, &mut t, |order, first, t_max| {
+                let mut i = first;
+                loop {
+                    if packet(i, *t_max) {
+                        return true;
+                    }
+                    if order[i] & END != 0 {
+                        return false;
+                    }
+                    i += 1;
                 }
-                if order[i] & END != 0 {
-                    return false;
-                }
-                i += 1;
-            }
-        })
+            })
     }
 
     /// Calls `visit(triangle)` for triangles in leaves whose boxes overlap `query`, until it
