@@ -323,11 +323,16 @@ translate(0, 0, -2, scale(20, square {{ material = {{ diffuse = (0.8, 0.8, 0.8);
             &NoProgress,
         );
         assert!(matches!(bad_syntax, Err(Error::Scene { path, .. }) if path == Path::new("a.ray")));
-        // Textures are read while building.
-        let no_texture = "SBT-raytracer 1.0\nsphere { material = { diffuse = map(\"missing.png\"); } }\n";
+        // Textures are read while building: one that is there but is no image is refused then.
+        let garbage = std::env::temp_dir().join(format!("caustica-loader-garbage-{}.png", std::process::id()));
+        std::fs::write(&garbage, b"not an image").unwrap();
+        let no_texture = format!(
+            "SBT-raytracer 1.0\nsphere {{ material = {{ diffuse = map(\"{}\"); }} }}\n",
+            garbage.display()
+        );
         let parsed = format::read_text(
             Path::new("b.ray"),
-            no_texture.into(),
+            no_texture.clone(),
             Path::new("."),
             &settings.read,
             &NoProgress,

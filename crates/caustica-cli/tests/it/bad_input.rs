@@ -159,12 +159,14 @@ fn catalogue() -> Vec<Case> {
         )
         .at("5:15"),
         // Textures.
+        // A missing image is a located warning, and the render goes on with mid grey.
         case(
             "missing_texture",
             staged("sphere { material = { diffuse = map(\"nope.png\"); } }\n"),
-            &["cannot read the texture", "nope.png"],
+            &["warning: ", ":4:33: the image `", "nope.png` is missing: the texture reads mid grey"],
         )
-        .at("4:33"),
+        .run(Run::RenderLoud)
+        .succeeds(),
         case(
             "corrupt_texture",
             staged("sphere { material = { diffuse = map(\"garbage.png\"); } }\n"),

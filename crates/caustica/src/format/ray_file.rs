@@ -28,6 +28,24 @@ use crate::progress::{NoProgress, Progress};
 use crate::ParseError;
 use std::path::Path;
 
+/// `param` as read, unless it maps an image file that does not exist: then mid grey, with a
+/// located warning, as a missing image reads in the other formats. An image that exists but
+/// cannot be decoded is still refused when the scene is built.
+fn present_or_grey(param: ast::Param, warnings: &mut Vec<(String, ast::Span)>) -> ast::Param {
+    if let ast::Param::Texture(map) = &param {
+        if let crate::description::ImageSource::File(path) = &map.source {
+            if !path.is_file() {
+                warnings.push((
+                    format!("the image `{}` is missing: the texture reads mid grey", path.display()),
+                    map.span.clone(),
+                ));
+                return ast::Param::grey(0.5);
+            }
+        }
+    }
+    param
+}
+
 /// Options for reading a scene file.
 #[derive(Clone, Debug, Default)]
 pub struct ParseOptions {

@@ -574,7 +574,7 @@ impl<'a> Reader<'a> {
                     self.scene.warnings.push((message, self.tree[value].span.clone()));
                 }
                 _ if COLOUR_FIELDS.contains(&word) || word == "shininess" || word == "index" => {
-                    let mut param = self.param(value, word)?;
+                    let mut param = super::present_or_grey(self.param(value, word)?, &mut self.scene.warnings);
                     if word == "shininess" {
                         if let Param::Constant(c) = &mut param {
                             *c *= 128.0;
@@ -585,7 +585,10 @@ impl<'a> Reader<'a> {
                 }
                 // An HKUST fork's image texture: the diffuse colour read from a file.
                 "texture" if self.hkust => match self.tree[value].kind {
-                    Kind::Str => material.diffuse = self.texture(value, self.tree[value].span.clone()),
+                    Kind::Str => {
+                        let map = self.texture(value, self.tree[value].span.clone());
+                        material.diffuse = super::present_or_grey(map, &mut self.scene.warnings);
+                    }
                     _ => return Err(self.expected("a file name in quotes for `texture`", value)),
                 },
                 _ => self.ignore_key(&key, "material")?,

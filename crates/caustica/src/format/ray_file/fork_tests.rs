@@ -9,7 +9,7 @@ use crate::error::line_col;
 use crate::format::SourceFiles;
 use crate::ParseError;
 use glam::Vec3;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 const HEADER: &str = "SBT-raytracer 1.0\n";
 
@@ -97,15 +97,22 @@ fn hkust_point_lights_do_not_fall_off_unless_told() {
 #[test]
 fn hkust_texture_is_the_diffuse_map() {
     let body = "sphere { material = { diffuse = (1,1,1); texture = \"earth.bmp\"; }; }";
-    let scene = read(body);
+    let dir = std::env::temp_dir().join(format!("caustica-hkust-texture-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("earth.bmp"), b"").unwrap();
+    let scene = parse(&format!("{HEADER}{body}"), &dir, &ParseOptions::default()).unwrap();
     assert_eq!(scene.dialect, Dialect::Hkust, "`texture = \"…\"` marks an HKUST file");
     match &scene.objects[0].material.diffuse {
-        Param::Texture(map) => assert_eq!(
-            map.source,
-            crate::description::ImageSource::File(PathBuf::from("scenes/earth.bmp"))
-        ),
+        Param::Texture(map) => assert_eq!(map.source, crate::description::ImageSource::File(dir.join("earth.bmp"))),
         other => panic!("{other:?}"),
     }
+    // Without the image: mid grey, warned.
+    let missing = read(body);
+    assert_eq!(missing.objects[0].material.diffuse, Param::grey(0.5));
+    assert!(missing
+        .warnings
+        .iter()
+        .any(|(w, _)| w.contains("earth.bmp` is missing")));
     let plain = read_as(body, Some(Dialect::Dictionary)).unwrap();
     assert_eq!(plain.objects[0].material.diffuse, Param::grey(1.0));
     assert!(plain.warnings[0].0.contains("`texture`"));

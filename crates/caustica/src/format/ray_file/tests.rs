@@ -18,6 +18,22 @@ fn read(body: &str) -> RayScene {
     }
 }
 
+/// [`read`] in a folder of its own holding (empty) files named `images`, so maps of them exist.
+fn read_with_images(body: &str, images: &[&str]) -> (RayScene, PathBuf) {
+    let dir = std::env::temp_dir().join(format!(
+        "caustica-ray-images-{}-{}",
+        std::process::id(),
+        images.join("-")
+    ));
+    std::fs::create_dir_all(&dir).unwrap();
+    for image in images {
+        std::fs::write(dir.join(image), b"").unwrap();
+    }
+    let text = format!("{HEADER}{body}");
+    let scene = parse(&text, &dir, &ParseOptions::default()).unwrap_or_else(|e| panic!("parse failed: {}", e.message));
+    (scene, dir)
+}
+
 fn read_as(body: &str, dialect: Dialect) -> Result<RayScene, ParseError> {
     let text = format!("{HEADER}{body}");
     let options = ParseOptions { dialect: Some(dialect) };
@@ -263,13 +279,14 @@ fn degenerate_mesh_is_dropped_with_warnings() {
 
 #[test]
 fn materials_inherit_from_the_current_default() {
-    let scene = read(
+    let (scene, dir) = read_with_images(
         "sphere {}\n\
          material = { diffuse = (1, 0, 0); shininess = 25.6; };\n\
          sphere {}\n\
          sphere { material = { specular = (0, 1, 0); index = 1.5; transmissive = map(\"glass.png\"); } }\n\
          material = { reflective = (0.5, 0.5, 0.5) }\n\
          box {}",
+        &["glass.png"],
     );
     let m: Vec<&MaterialDesc> = scene.objects.iter().map(|o| &o.material).collect();
     assert_eq!(*m[0], MaterialDesc::default());
@@ -280,7 +297,7 @@ fn materials_inherit_from_the_current_default() {
     assert_eq!(m[2].index, Param::grey(1.5));
     match &m[2].transmissive {
         Param::Texture(map) => {
-            let course = crate::description::ImageMap::course(PathBuf::from("scenes/glass.png"), map.span.clone());
+            let course = crate::description::ImageMap::course(dir.join("glass.png"), map.span.clone());
             assert_eq!(**map, course, "read as stored, clamped, bilinear");
             assert_eq!(map.span.end - map.span.start, "map(\"glass.png\")".len());
         }
@@ -291,6 +308,38 @@ fn materials_inherit_from_the_current_default() {
     assert_eq!(m[3].specular, Param::grey(0.0));
     assert_eq!(m[3].reflective, Param::grey(0.5));
     assert_eq!(m[3].index, Param::grey(1.0));
+}
+
+/// A map of an image that is not there reads mid grey, with a warning at the map, in both
+/// dialects; the render goes on.
+#[test]
+fn a_missing_image_reads_mid_grey_with_a_located_warning() {
+    let (scene, dir) = read_with_images(
+        "sphere { material = { diffuse = map(\"here.png\"); specular = map(\"gone.png\"); } }",
+        &["here.png"],
+    );
+    let m = &scene.objects[0].material;
+    assert!(
+        matches!(&m.diffuse, Param::Texture(map) if map.source == crate::description::ImageSource::File(dir.join("here.png")))
+    );
+    assert_eq!(m.specular, Param::grey(0.5));
+    assert_eq!(scene.warnings.len(), 1, "{:?}", scene.warnings);
+    let (message, span) = &scene.warnings[0];
+    assert!(
+        message.contains("gone.png` is missing: the texture reads mid grey"),
+        "{message}"
+    );
+    let text =
+        format!("{HEADER}sphere {{ material = {{ diffuse = map(\"here.png\"); specular = map(\"gone.png\"); }} }}");
+    assert_eq!(&text[span.clone()], "map(\"gone.png\")");
+    for dialect in [Dialect::Tokenizer, Dialect::Dictionary] {
+        let scene = read_as("sphere { material = { diffuse = map(\"gone.png\"); } }", dialect).unwrap();
+        assert_eq!(scene.objects[0].material.diffuse, Param::grey(0.5), "{dialect:?}");
+        assert!(
+            scene.warnings.iter().any(|(w, _)| w.contains("is missing")),
+            "{dialect:?}"
+        );
+    }
 }
 
 #[test]
@@ -603,7 +652,7 @@ const DIALECT_O: &str = "camera { position = (0, 0, 5); viewdir = (0, 0, -2); up
 #[test]
 fn dialect_o_reads_its_own_rules() {
     // Detected dialect-O files are read with the HKUST skeleton's defaults.
-    let scene = read(DIALECT_O);
+    let (scene, dir) = read_with_images(DIALECT_O, &["brick.bmp"]);
     assert_eq!(scene.dialect, Dialect::Hkust);
     let camera = scene.camera.as_ref().expect("camera");
     assert_eq!(camera.basis, CameraBasis::Normalized);
@@ -629,7 +678,7 @@ fn dialect_o_reads_its_own_rules() {
     assert_eq!(inline.reflective, Param::Constant(Vec3::Z));
     assert_eq!(inline.specular, Param::grey(0.0));
     assert!(
-        matches!(&inline.diffuse, Param::Texture(map) if map.source == crate::description::ImageSource::File(PathBuf::from("scenes/brick.bmp")))
+        matches!(&inline.diffuse, Param::Texture(map) if map.source == crate::description::ImageSource::File(dir.join("brick.bmp")))
     );
     let ShapeDesc::Trimesh(mesh) = &scene.objects[2].shape else {
         panic!("mesh")

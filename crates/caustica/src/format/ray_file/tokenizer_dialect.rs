@@ -1130,10 +1130,11 @@ impl<'a> Parser<'a> {
         self.cur.expect(Tok::LParen, "after `map`")?;
         let (file, _) = self.identifier("(the image file) in `map(…)`")?;
         self.cur.expect(Tok::RParen, "to close `map(…)`")?;
-        Ok(Param::Texture(Box::new(crate::description::ImageMap::course(
+        let map = Param::Texture(Box::new(crate::description::ImageMap::course(
             self.scene_dir.join(file),
             start..self.cur.prev_end(),
-        ))))
+        )));
+        Ok(super::present_or_grey(map, &mut self.scene.warnings))
     }
 
     fn push_object(&mut self, shape: ShapeDesc, material: MaterialDesc, span: Span) {
