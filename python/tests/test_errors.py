@@ -36,12 +36,20 @@ def test_a_malformed_scene_names_file_line_and_column(tmp_path):
 
 
 def test_errors_found_while_building_point_into_the_file(tmp_path):
+    (tmp_path / "broken.png").write_bytes(b"not an image")
     path = tmp_path / "texture.ray"
-    path.write_text('SBT-raytracer 1.0\n\nsphere { material = { diffuse = map("nowhere.png"); } }\n')
+    path.write_text('SBT-raytracer 1.0\n\nsphere { material = { diffuse = map("broken.png"); } }\n')
     with pytest.raises(caustica.SceneError) as info:
         caustica.Scene(path)
     assert str(info.value).startswith(f"{path}:3:")
-    assert "nowhere.png" in str(info.value)
+    assert "broken.png" in str(info.value)
+
+
+def test_a_missing_image_is_a_warning_and_the_scene_loads(tmp_path):
+    path = tmp_path / "texture.ray"
+    path.write_text('SBT-raytracer 1.0\n\nsphere { material = { diffuse = map("nowhere.png"); } }\n')
+    scene = caustica.Scene(path)
+    assert any("nowhere.png` is missing: the texture reads mid grey" in w for w in scene.warnings), scene.warnings
 
 
 def test_a_misspelt_keyword_gets_help(tmp_path):
