@@ -289,6 +289,12 @@ pub fn read_file(path: &Path, options: &ReadOptions, progress: &dyn Progress) ->
 /// The warning for text read with bytes that are not UTF-8.
 pub(crate) const NOT_UTF8: &str = "the file is not valid UTF-8 text: bytes that are not were read as \u{FFFD}";
 
+/// The warning for an image a texture names that is not there; the texture reads mid grey, in
+/// every format that reads images by name.
+pub(crate) fn missing_image(path: &std::path::Path) -> String {
+    format!("the image `{}` is missing: the texture reads mid grey", path.display())
+}
+
 /// Text from bytes, those that are not UTF-8 read as U+FFFD; the offset of the first of them.
 fn decode_text(bytes: Vec<u8>) -> (String, Option<usize>) {
     match String::from_utf8(bytes) {

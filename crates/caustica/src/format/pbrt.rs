@@ -1497,10 +1497,7 @@ impl<'f> Reader<'f> {
                 };
                 let image = self.dir.join(file);
                 if !image.is_file() {
-                    self.warn(
-                        format!("the image `{}` is missing: the texture reads mid grey", image.display()),
-                        span.clone(),
-                    );
+                    self.warn(super::missing_image(&image), span.clone());
                     self.textures.insert(name.text, TextureValue::Param(Param::grey(0.5)));
                     return Ok(());
                 }

@@ -35,10 +35,7 @@ fn present_or_grey(param: ast::Param, warnings: &mut Vec<(String, ast::Span)>) -
     if let ast::Param::Texture(map) = &param {
         if let crate::description::ImageSource::File(path) = &map.source {
             if !path.is_file() {
-                warnings.push((
-                    format!("the image `{}` is missing: the texture reads mid grey", path.display()),
-                    map.span.clone(),
-                ));
+                warnings.push((super::missing_image(path), map.span.clone()));
                 return ast::Param::grey(0.5);
             }
         }

@@ -97,10 +97,7 @@ fn hkust_point_lights_do_not_fall_off_unless_told() {
 #[test]
 fn hkust_texture_is_the_diffuse_map() {
     let body = "sphere { material = { diffuse = (1,1,1); texture = \"earth.bmp\"; }; }";
-    let dir = std::env::temp_dir().join(format!("caustica-hkust-texture-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(dir.join("earth.bmp"), b"").unwrap();
-    let scene = parse(&format!("{HEADER}{body}"), &dir, &ParseOptions::default()).unwrap();
+    let (scene, dir) = super::tests::read_with_images(body, &["earth.bmp"]);
     assert_eq!(scene.dialect, Dialect::Hkust, "`texture = \"…\"` marks an HKUST file");
     match &scene.objects[0].material.diffuse {
         Param::Texture(map) => assert_eq!(map.source, crate::description::ImageSource::File(dir.join("earth.bmp"))),

@@ -19,7 +19,7 @@ fn read(body: &str) -> RayScene {
 }
 
 /// [`read`] in a folder of its own holding (empty) files named `images`, so maps of them exist.
-fn read_with_images(body: &str, images: &[&str]) -> (RayScene, PathBuf) {
+pub(super) fn read_with_images(body: &str, images: &[&str]) -> (RayScene, PathBuf) {
     let dir = std::env::temp_dir().join(format!(
         "caustica-ray-images-{}-{}",
         std::process::id(),
