@@ -536,7 +536,8 @@ fn build_reports_every_primitive_once() {
 }
 
 /// The interleaved streams give each ray exactly its single-ray answers, whatever the tree's
-/// stack tier, ray order and number of rays (fewer, as many as, or more than the stream's lanes).
+/// stack tier, ray order and number of rays (fewer, as many as, or more than the stream's lanes),
+/// loading ahead or not.
 #[test]
 fn stream_matches_single_rays() {
     let mut rng = Rng(0x5eed);
@@ -549,11 +550,12 @@ fn stream_matches_single_rays() {
         exponential_steps(),
     ];
     let nasty = [0.0, f32::NAN, f32::INFINITY, 1e-40, 5.0];
-    for (tris, width) in meshes
-        .iter()
-        .flat_map(|m| Width::on_host().into_iter().map(move |w| (m, w)))
-    {
-        let tbvh = TriangleBvh::new(tris).with_width(width);
+    for (tris, width, fetch_ahead) in meshes.iter().flat_map(|m| {
+        Width::on_host()
+            .into_iter()
+            .flat_map(move |w| [false, true].map(|f| (m, w, f)))
+    }) {
+        let tbvh = TriangleBvh::new(tris).with_width(width).fetching_ahead(fetch_ahead);
         let mut rays: Vec<Ray> = (0..2000)
             .map(|i| match (i % 7, tris.is_empty()) {
                 (0, _) | (_, true) => Ray::new(rng.v() * 4.0 - 1.0, rng.dir()),
@@ -580,6 +582,14 @@ fn stream_matches_single_rays() {
             }
         }
     }
+}
+
+/// Only trees beyond the caches load ahead: a sphere of 12,800 triangles does not, one of
+/// 128,000 (about 5.7 MB) does.
+#[test]
+fn only_large_trees_load_ahead() {
+    assert!(!TriangleBvh::new(&sphere(80, 80)).fetches_ahead());
+    assert!(TriangleBvh::new(&sphere(400, 160)).fetches_ahead());
 }
 
 #[test]
