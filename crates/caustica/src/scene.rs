@@ -1141,9 +1141,9 @@ impl Scene {
     /// for a wave of hits shaded one after another: it changes no result.
     #[inline]
     pub(crate) fn prefetch_reference(&self, hit: &Intersection) {
-        if let Some(tri_ref) = self.hit_triangle_ref(hit) {
+        let index = self.hit_triangle_index(hit);
+        if let Some(tri_ref) = self.triangle_refs.get(index) {
             crate::accel::lanes::prefetch(tri_ref);
-            let index = hit.prim.wrapping_sub(self.shapes.len() as u32) as usize;
             // Its first and last bytes: a triangle may straddle two cache lines.
             let triangle = self.triangles.as_ptr().wrapping_add(index).cast::<u8>();
             crate::accel::lanes::prefetch(triangle);
@@ -1164,8 +1164,13 @@ impl Scene {
     /// The mesh reference of a triangle `hit` (`None` for a shape's).
     #[inline]
     fn hit_triangle_ref(&self, hit: &Intersection) -> Option<&TriangleRef> {
-        self.triangle_refs
-            .get(hit.prim.wrapping_sub(self.shapes.len() as u32) as usize)
+        self.triangle_refs.get(self.hit_triangle_index(hit))
+    }
+
+    /// The triangle number of `hit` (out of range for a shape's).
+    #[inline]
+    fn hit_triangle_index(&self, hit: &Intersection) -> usize {
+        hit.prim.wrapping_sub(self.shapes.len() as u32) as usize
     }
 
     /// Full shading data for an intersection found along `ray`.
