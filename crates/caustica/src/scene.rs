@@ -939,6 +939,12 @@ impl Scene {
         self.closest_of(ray, t_max, self.triangle_bvh.closest_hit(ray, t_max))
     }
 
+    /// Whether rays traced together ([`Scene::intersect_stream`]) are faster than one by one:
+    /// the triangles' tree is larger than the caches, so the stream overlaps its misses.
+    pub fn streams_pay(&self) -> bool {
+        self.triangle_bvh.walks() && self.triangle_bvh.fetches_ahead()
+    }
+
     /// The closest hit in `(0, ∞)` of each ray, into `hits` (one per ray): [`Scene::intersect`]
     /// ray by ray, with the same answers, the triangles' tree walked for several rays at once
     /// when it is large ([`TriangleBvh::closest_hits`]), so their cache misses overlap.

@@ -9,7 +9,7 @@
 
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
-use crate::photon::light_walk::{MediumArrival, Passage, Step};
+use crate::photon::light_walk::{in_waves, MediumArrival, Passage, Step, Wave};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -263,10 +263,6 @@ impl CameraWalk {
     }
 }
 
-/// How many walks ahead of the one taking its step [`walk_cameras`] fetches a hit's vertex
-/// indices.
-const PREFETCH_AHEAD: usize = 4;
-
 /// One of the camera paths [`walk_cameras`] takes together: its walk, wavelengths, random
 /// stream and visitor.
 pub struct CameraPath<V> {
@@ -280,41 +276,26 @@ pub struct CameraPath<V> {
     pub visitor: V,
 }
 
-/// Takes every path's walk to its end, as [`walk_camera`] would one by one and with the same
-/// results, in waves: the pending rays of all live walks are traced together
-/// ([`Scene::intersect_stream`]), then each walk takes its step. In scenes with media (where a
-/// segment's end depends on the path's random numbers) the walks go one at a time.
-pub fn walk_cameras<V: CameraVisitor>(scene: &Scene, paths: &mut [CameraPath<V>]) {
-    if scene.has_media() {
-        for p in paths {
-            walk_to_end(scene, &mut p.walk, &p.wl, &mut p.rng, &mut p.visitor);
-        }
-        return;
+impl<V: CameraVisitor> Wave for CameraPath<V> {
+    fn pending_ray(&self) -> Option<&Ray> {
+        self.walk.pending()
     }
-    let mut live: Vec<usize> = (0..paths.len())
-        .filter(|&i| paths[i].walk.pending().is_some())
-        .collect();
-    let (mut rays, mut hits) = (Vec::with_capacity(live.len()), Vec::with_capacity(live.len()));
-    while !live.is_empty() {
-        rays.clear();
-        rays.extend(live.iter().map(|&i| paths[i].walk.ray));
-        hits.resize(live.len(), None);
-        scene.intersect_stream(&rays, &mut hits);
-        // A large mesh's hits miss the cache twice before shading (the triangle's reference,
-        // then its vertex indices): both are fetched ahead of the walks that read them.
-        hits.iter().flatten().for_each(|hit| scene.prefetch_reference(hit));
-        let mut wave = rays.iter().zip(&hits);
-        let mut ahead = hits.iter().skip(PREFETCH_AHEAD);
-        live.retain(|&i| {
-            if let Some(Some(hit)) = ahead.next() {
-                scene.prefetch_indices(hit);
-            }
-            let (ray, &hit) = wave.next().expect("one ray per live walk");
-            let p = &mut paths[i];
-            let step = Step::without_media(scene, ray, hit);
-            p.walk.arrive(scene, step, &p.wl, &mut p.rng, &mut p.visitor);
-            p.walk.pending().is_some()
-        });
+
+    fn take_step(&mut self, scene: &Scene, step: Step) {
+        self.walk
+            .arrive(scene, step, &self.wl, &mut self.rng, &mut self.visitor);
+    }
+}
+
+/// Takes every path's walk to its end, as [`walk_camera`] would one by one and with the same
+/// results: in waves ([`in_waves`]), or one at a time in scenes with media (where a segment's
+/// end depends on the path's random numbers).
+pub fn walk_cameras<V: CameraVisitor>(scene: &Scene, paths: &mut [CameraPath<V>]) {
+    if !scene.has_media() {
+        return in_waves(scene, paths);
+    }
+    for p in paths {
+        walk_to_end(scene, &mut p.walk, &p.wl, &mut p.rng, &mut p.visitor);
     }
 }
 
@@ -347,7 +328,7 @@ pub fn continue_camera(
 mod tests {
     use super::*;
     use crate::medium::VACUUM;
-    use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor};
+    use crate::photon::light_walk::{walk_light, walk_lights, LightArrival, LightPath, LightVisitor, LightWalk};
     use crate::scene::build::test_scene;
 
     /// Every arrival's length and throughput, and the escapes.
@@ -376,12 +357,13 @@ mod tests {
             self.arrivals.push((at.length, at.throughput.x));
             true
         }
-        fn visit_medium(&mut self, _at: &MediumArrival) -> bool {
-            unreachable!("no media here")
+        fn visit_medium(&mut self, at: &MediumArrival) -> bool {
+            self.arrivals.push((at.length, at.throughput.x));
+            true
         }
     }
 
-    /// Camera walks taken together, a wave of rays per bounce, make the same arrivals in the
+    /// Camera walks and light walks taken together, a wave of rays per bounce, make the same arrivals in the
     /// same order with the same numbers as each walk alone: in a closed room around a bumpy
     /// mesh that walks its tree, with Russian roulette, and in the same room filled with fog
     /// (where the walks go one at a time).
@@ -425,6 +407,32 @@ mod tests {
                 surfaces += alone.arrivals.len();
             }
             assert!(surfaces > 400, "{surfaces} surfaces");
+
+            // Light walks the same way, from the same rays, with their own roulette.
+            let carried = (wl.grey(2.0), scene.camera_medium());
+            let mut paths: Vec<LightPath<Record>> = (0..200)
+                .map(|i| {
+                    let (ray, rng) = start(i);
+                    LightPath {
+                        walk: LightWalk::new(&scene, ray, carried, 12),
+                        wl,
+                        rng,
+                        visitor: Record::default(),
+                    }
+                })
+                .collect();
+            walk_lights(&scene, &mut paths);
+            let mut surfaces = 0;
+            for (i, together) in paths.iter_mut().enumerate() {
+                let (ray, mut rng) = start(i as u64);
+                let mut alone = Record::default();
+                let rays = walk_light(&scene, ray, carried, &wl, 12, &mut rng, &mut alone);
+                assert_eq!(together.visitor.arrivals, alone.arrivals, "light path {i}");
+                assert_eq!(together.walk.rays(), rays);
+                assert_eq!(together.rng.uniform(), rng.uniform(), "the same numbers drawn");
+                surfaces += alone.arrivals.len();
+            }
+            assert!(surfaces > 400, "{surfaces} light surfaces");
         }
     }
 

@@ -17,7 +17,9 @@ use crate::bsdf::{Bsdf, Transport};
 use crate::camera::Camera;
 use crate::light::emission::EmissionPoint;
 use crate::math::{offset_origin, Ray, Vec3};
-use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor, MediumArrival};
+use crate::photon::light_walk::{
+    light_waves, walk_lights, LightArrival, LightPath, LightVisitor, LightWalk, MediumArrival,
+};
 use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
@@ -198,19 +200,24 @@ impl<'a> LightTracer<'a> {
         }
     }
 
-    /// Follows photon `index` of pass `pass` and records what each smooth surface it meets
-    /// sends to the eye, in film units (already divided by the pass's photon count).
-    fn trace(&self, pass: u64, index: u64, wl: &Wavelengths, out: &mut Vec<(u32, Vec3)>) {
+    /// Starts photon `index` of pass `pass`: records what the light's own point sends to the
+    /// eye into `out`, and returns its walk, which records what each smooth surface it meets
+    /// sends there, in film units (already divided by the pass's photon count).
+    #[inline]
+    fn start<'t>(
+        &'t self,
+        (pass, index): (u64, u64),
+        wl: &'t Wavelengths,
+        out: &'t mut Vec<(u32, Vec3)>,
+    ) -> Option<LightPath<Splats<'t, 'a>>> {
         let scene = self.scene;
         let mut rng = Rng::new(self.seed ^ PHOTON_SEED, (pass << 40) ^ index);
-        let Some(emitted) = scene.lights().emit(scene, wl, &mut rng) else {
-            return;
-        };
+        let emitted = scene.lights().emit(scene, wl, &mut rng)?;
         let share = 1.0 / self.settings.photons_per_pass as f32;
         // Shadow rays to the eye draw from a stream of their own (transmittance through a grid).
         let mut eye_rng = Rng::new(self.seed ^ EYE_SEED, (pass << 40) ^ index);
+        let medium = scene.light_medium(emitted.light);
         if let Some(origin) = &emitted.origin {
-            let medium = scene.light_medium(emitted.light);
             if let Some((pixel, value)) = self.connect_light(origin, medium, share, wl, &mut eye_rng) {
                 let rgb = wl.to_rgb(value);
                 if rgb.is_finite() {
@@ -219,22 +226,43 @@ impl<'a> LightTracer<'a> {
             }
         }
         // The walk's photons carry flux, as the photon tracer's do.
-        let mut splats = Splats {
-            tracer: self,
-            wl,
-            out,
-            rng: eye_rng,
-        };
         let surfaces = self.settings.max_depth.saturating_add(1);
-        walk_light(
-            scene,
-            emitted.ray,
-            (emitted.throughput * share, scene.light_medium(emitted.light)),
-            wl,
-            surfaces,
-            &mut rng,
-            &mut splats,
-        );
+        Some(LightPath {
+            walk: LightWalk::new(scene, emitted.ray, (emitted.throughput * share, medium), surfaces),
+            wl: *wl,
+            rng,
+            visitor: Splats {
+                tracer: self,
+                wl,
+                out,
+                rng: eye_rng,
+            },
+        })
+    }
+
+    /// Follows the photons `indices` of pass `pass`, a wave at a time, and returns what they
+    /// add to the film, in photon order.
+    fn trace(&self, pass: u64, indices: std::ops::Range<u64>, wl: &Wavelengths) -> Vec<(u32, Vec3)> {
+        let mut out = Vec::new();
+        let mut own: Vec<Vec<(u32, Vec3)>> = Vec::new();
+        for wave in light_waves(self.scene, indices) {
+            if wave.end - wave.start == 1 {
+                // One path a wave: straight into the batch's list.
+                // Walked where it was made: moving it out of the `Option` copied it.
+                let mut path = self.start((pass, wave.start), wl, &mut out);
+                walk_lights(self.scene, path.as_mut_slice());
+                continue;
+            }
+            // Each path splats into its own list, appended in photon order.
+            own.resize_with(wave.clone().count(), Vec::new);
+            let mut paths: Vec<_> = wave
+                .zip(&mut own)
+                .filter_map(|(i, path_out)| self.start((pass, i), wl, path_out))
+                .collect();
+            walk_lights(self.scene, &mut paths);
+            own.iter_mut().for_each(|path_out| out.append(path_out));
+        }
+        out
     }
 
     /// The pixel a photon of flux `power` arriving at `hit` from `wo` lights, and by how much:
@@ -377,11 +405,7 @@ impl Progressive for LightTracer<'_> {
                     if control.cancelled() {
                         return None;
                     }
-                    let mut out = Vec::new();
-                    for i in b * BATCH..((b + 1) * BATCH).min(count) {
-                        self.trace(pass, i, &wl, &mut out);
-                    }
-                    Some(out)
+                    Some(self.trace(pass, b * BATCH..((b + 1) * BATCH).min(count), &wl))
                 })
                 .collect();
             // In batch order: the sums do not depend on which thread traced what.

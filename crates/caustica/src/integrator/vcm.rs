@@ -54,7 +54,7 @@ use crate::light::aim::{caustic_targets, Aim};
 use crate::light::emission::{Emission, Emitters};
 use crate::math::{Ray, Vec3};
 use crate::photon::kd_tree::{KdPoint, KdTree};
-use crate::photon::light_walk::{walk_light, LightArrival, LightVisitor, Roulette};
+use crate::photon::light_walk::{LightArrival, LightVisitor, Roulette};
 use crate::progress::Control;
 use crate::sampling::{power_heuristic, Rng};
 use crate::scene::{Scene, SurfaceHit};
@@ -170,7 +170,9 @@ impl LightPaths {
 /// come back without the page faults and regrowth of new vectors.
 #[derive(Default)]
 struct Scratch {
-    batches: Vec<LightPaths>,
+    /// Each batch's subpaths, and the lists its wave's paths store into before they are
+    /// appended in order.
+    batches: Vec<(LightPaths, Vec<LightPaths>)>,
     paths: LightPaths,
     grid: HashGrid,
     merge_vertices: Vec<MergeVertex>,

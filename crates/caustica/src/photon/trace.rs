@@ -12,14 +12,17 @@
 //! - [`PhysicalPhotons`]: photons scatter by the same BSDF the camera paths use and are stored
 //!   wherever they meet a smooth (diffuse or glossy) surface, their history in their flags;
 //!   Russian roulette keeps each photon's flux nearly constant. They walk the light side's one
-//!   walk ([`walk_light`]), as the light tracer's paths and vcm's light subpaths do.
+//!   walk, a wave of photons at a time ([`walk_lights`]), as the light tracer's paths and vcm's
+//!   light subpaths do.
 //!
 //! Two drivers emit: [`super::budget::trace_photons`] stores a budget of caustic photons shared
 //! between the lights (course), [`trace_count`] emits a fixed number from lights chosen by power
 //! (physical). Both are deterministic whatever the thread count: photon `i` draws from its own
 //! random stream and batches are concatenated in order.
 
-use super::light_walk::{walk_light, LightArrival, LightVisitor, MediumArrival, Roulette};
+use super::light_walk::{
+    light_waves, walk_lights, LightArrival, LightPath, LightVisitor, LightWalk, MediumArrival, Roulette,
+};
 use super::{Photon, DIFFUSE, DISPERSED, MAX_BOUNCES_LEFT, REFLECTED, REFRACTED};
 use crate::bsdf::{BsdfSample, Transport};
 use crate::light::{distance_attenuation, Light};
@@ -62,7 +65,13 @@ pub fn trace_count_in_media(
     if lights.is_empty() || count == 0 {
         return (Vec::new(), Vec::new());
     }
-    let scale = 1.0 / count as f32;
+    let emitter = PhotonEmitter {
+        scene,
+        stream: (seed, stream),
+        scale: 1.0 / count as f32,
+        max_bounces,
+        wl,
+    };
     let parts: Vec<(Vec<Photon>, Vec<Photon>)> = (0..count.div_ceil(BATCH))
         .into_par_iter()
         .map(|b| {
@@ -70,20 +79,25 @@ pub fn trace_count_in_media(
             if control.cancelled() {
                 return (out, volume);
             }
-            let first = b * BATCH;
-            for i in first..(first + BATCH).min(count) {
-                let mut rng = Rng::new(seed, (stream << 40) ^ i);
-                if let Some(emitted) = lights.emit(scene, wl, &mut rng) {
-                    let flux = emitted.throughput * scale;
-                    let mut photons = PhysicalPhotons {
-                        max_bounces,
-                        flags: 0,
-                        out: &mut out,
-                        volume: Some(&mut volume),
-                    };
-                    let surfaces = max_bounces.saturating_add(1);
-                    let medium = scene.light_medium(emitted.light);
-                    walk_light(scene, emitted.ray, (flux, medium), wl, surfaces, &mut rng, &mut photons);
+            let mut own: Vec<(Vec<Photon>, Vec<Photon>)> = Vec::new();
+            for wave in light_waves(scene, b * BATCH..((b + 1) * BATCH).min(count)) {
+                if wave.end - wave.start == 1 {
+                    // One path a wave: straight into the batch's lists.
+                    // Walked where it was made: moving it out of the `Option` copied it.
+                    let mut path = emitter.start(wave.start, (&mut out, &mut volume));
+                    walk_lights(scene, path.as_mut_slice());
+                    continue;
+                }
+                // Each path stores into its own lists, appended in photon order.
+                own.resize_with(wave.clone().count(), Default::default);
+                let mut paths: Vec<_> = wave
+                    .zip(&mut own)
+                    .filter_map(|(i, (out, volume))| emitter.start(i, (out, volume)))
+                    .collect();
+                walk_lights(scene, &mut paths);
+                for (path_out, path_volume) in &mut own {
+                    out.append(path_out);
+                    volume.append(path_volume);
                 }
             }
             (out, volume)
@@ -91,6 +105,45 @@ pub fn trace_count_in_media(
         .collect();
     let (surface, volume): (Vec<_>, Vec<_>) = parts.into_iter().unzip();
     (surface.concat(), volume.concat())
+}
+
+/// What starts [`trace_count_in_media`]'s photons.
+struct PhotonEmitter<'s> {
+    scene: &'s Scene,
+    /// Seed and stream.
+    stream: (u64, u64),
+    /// Each photon's share of the lights' flux.
+    scale: f32,
+    max_bounces: u32,
+    wl: &'s Wavelengths,
+}
+
+impl PhotonEmitter<'_> {
+    /// Photon `i`'s walk from a light chosen by power, storing into `(out, volume)`.
+    #[inline]
+    fn start<'o>(
+        &self,
+        i: u64,
+        (out, volume): (&'o mut Vec<Photon>, &'o mut Vec<Photon>),
+    ) -> Option<LightPath<PhysicalPhotons<'o>>> {
+        let (scene, (seed, stream)) = (self.scene, self.stream);
+        let mut rng = Rng::new(seed, (stream << 40) ^ i);
+        let emitted = scene.lights().emit(scene, self.wl, &mut rng)?;
+        let flux = emitted.throughput * self.scale;
+        let medium = scene.light_medium(emitted.light);
+        let surfaces = self.max_bounces.saturating_add(1);
+        Some(LightPath {
+            walk: LightWalk::new(scene, emitted.ray, (flux, medium), surfaces),
+            wl: *self.wl,
+            rng,
+            visitor: PhysicalPhotons {
+                max_bounces: self.max_bounces,
+                flags: 0,
+                out,
+                volume: Some(volume),
+            },
+        })
+    }
 }
 
 /// Runs `photon(i, out)` for each photon index of a batch; returns what they stored and, for

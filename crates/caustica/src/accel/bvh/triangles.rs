@@ -160,9 +160,9 @@ impl TriangleBvh {
         TriangleBvh { fetch_ahead, ..self }
     }
 
-    /// Whether this tree's streams load ahead.
-    #[cfg(test)]
-    pub(super) fn fetches_ahead(&self) -> bool {
+    /// Whether this tree's streams load ahead: it is larger than the caches, and rays walked
+    /// together overlap their misses.
+    pub fn fetches_ahead(&self) -> bool {
         self.fetch_ahead
     }
 

@@ -3,46 +3,84 @@
 //! off Lambertian surfaces aimed at the mirrors and glass.
 
 use super::*;
-use crate::photon::light_walk::MediumArrival;
+use crate::photon::light_walk::{light_waves, walk_lights, LightPath, LightWalk, MediumArrival};
 
 /// Mixed into the seed of the streams joins to the eye draw from.
 const EYE_SEED: u64 = 0x6579_6573_7663_6d21;
 
 impl<'a> Vcm<'a> {
-    /// Traces light subpath `index` of pass `pass`: stores its smooth vertices and joins each
-    /// to the eye.
-    /// (The pilot run, `to_eye` false, only stores.)
-    fn trace_light(&self, pass: u64, index: u64, f: &Factors, wl: &Wavelengths, to_eye: bool, out: &mut LightPaths) {
+    /// Starts light subpath `index` of pass `pass`: its walk stores its smooth vertices into
+    /// `out` and joins each to the eye (the pilot run, `to_eye` false, only stores).
+    #[inline]
+    fn start_light<'v>(
+        &'v self,
+        (pass, index): (u64, u64),
+        (f, wl): (&'v Factors, &'v Wavelengths),
+        to_eye: bool,
+        out: &'v mut LightPaths,
+    ) -> Option<LightPath<Subpath<'v, 'a>>> {
         let scene = self.scene;
         let mut rng = Rng::new(self.seed ^ LIGHT_SEED, (pass << 40) ^ index);
-        let Some(emission) = self.emitters.emit(scene, wl, &mut rng) else {
-            return;
-        };
-        let mut subpath = Subpath {
-            vcm: self,
-            f,
-            wl,
-            emission: &emission,
-            to_eye,
-            connected: self.settings.connections && index < self.pixels() as u64,
-            out,
-            partial: Partial::default(),
-            previous: emission.ray.origin,
-            start: emission.throughput.max_element(),
-            all_specular: true,
-            eye_rng: Rng::new(self.seed ^ EYE_SEED, (pass << 40) ^ index),
-        };
+        let emission = self.emitters.emit(scene, wl, &mut rng)?;
         let surfaces = self.max_length.saturating_sub(1);
-        let rays = walk_light(
-            scene,
-            emission.ray,
-            (emission.throughput, scene.light_medium(emission.light)),
-            wl,
-            surfaces,
-            &mut rng,
-            &mut subpath,
-        );
-        out.rays += rays;
+        let carried = (emission.throughput, scene.light_medium(emission.light));
+        Some(LightPath {
+            walk: LightWalk::new(scene, emission.ray, carried, surfaces),
+            wl: *wl,
+            rng,
+            visitor: Subpath {
+                vcm: self,
+                f,
+                wl,
+                start: emission.throughput.max_element(),
+                previous: emission.ray.origin,
+                emission,
+                to_eye,
+                connected: self.settings.connections && index < self.pixels() as u64,
+                out,
+                partial: Partial::default(),
+                all_specular: true,
+                eye_rng: Rng::new(self.seed ^ EYE_SEED, (pass << 40) ^ index),
+            },
+        })
+    }
+
+    /// Traces the light subpaths `indices` of pass `pass` into `out`, in index order, a wave at
+    /// a time; in waves of more than one path each into its own of `own` first.
+    fn trace_lights(
+        &self,
+        (pass, indices): (u64, std::ops::Range<u64>),
+        fw: (&Factors, &Wavelengths),
+        to_eye: bool,
+        (out, own): (&mut LightPaths, &mut Vec<LightPaths>),
+    ) {
+        for wave in light_waves(self.scene, indices) {
+            if wave.end - wave.start == 1 {
+                // One path a wave: straight into the batch's lists.
+                // Walked where it was made: moving it out of the `Option` copied it.
+                let mut path = self.start_light((pass, wave.start), fw, to_eye, out);
+                walk_lights(self.scene, path.as_mut_slice());
+                if let Some(path) = path.as_mut() {
+                    path.visitor.out.rays += path.walk.rays();
+                }
+                out.ends.push(out.vertices.len() as u32);
+                continue;
+            }
+            own.resize_with(wave.clone().count(), LightPaths::default);
+            let mut paths: Vec<_> = wave
+                .zip(own.iter_mut())
+                .filter_map(|(i, path_out)| self.start_light((pass, i), fw, to_eye, path_out))
+                .collect();
+            walk_lights(self.scene, &mut paths);
+            for path in paths {
+                path.visitor.out.rays += path.walk.rays();
+            }
+            for path_out in own.iter_mut() {
+                path_out.ends.push(path_out.vertices.len() as u32);
+                out.append(path_out);
+                path_out.clear();
+            }
+        }
     }
 
     /// Light tracing: the light vertex seen by the eye, splatted onto its pixel.
@@ -122,26 +160,27 @@ impl<'a> Vcm<'a> {
     ) -> Option<()> {
         let batch_count = count.div_ceil(BATCH) as usize;
         let batches = &mut scratch.batches;
-        batches.resize_with(batches.len().max(batch_count), LightPaths::default);
-        let complete = batches[..batch_count].par_iter_mut().enumerate().all(|(b, out)| {
-            if cancel.load(Ordering::Relaxed) {
-                return false;
-            }
-            out.clear();
-            let b = b as u64;
-            for i in b * BATCH..((b + 1) * BATCH).min(count) {
-                self.trace_light(pass, i, f, wl, to_eye, out);
-                out.ends.push(out.vertices.len() as u32);
-            }
-            true
-        });
+        batches.resize_with(batches.len().max(batch_count), Default::default);
+        let complete = batches[..batch_count]
+            .par_iter_mut()
+            .enumerate()
+            .all(|(b, (out, own))| {
+                if cancel.load(Ordering::Relaxed) {
+                    return false;
+                }
+                out.clear();
+                let b = b as u64;
+                let indices = b * BATCH..((b + 1) * BATCH).min(count);
+                self.trace_lights((pass, indices), (f, wl), to_eye, (out, own));
+                true
+            });
         if !complete {
             return None;
         }
         let all = &mut scratch.paths;
         all.clear();
         all.ends.push(0);
-        for batch in &batches[..batch_count] {
+        for (batch, _) in &batches[..batch_count] {
             all.append(batch);
         }
         Some(())
@@ -163,7 +202,7 @@ struct Subpath<'v, 'a> {
     vcm: &'v Vcm<'a>,
     f: &'v Factors,
     wl: &'v Wavelengths,
-    emission: &'v Emission,
+    emission: Emission,
     /// Joined to the eye (light tracing): not in the pilot that only stores.
     to_eye: bool,
     /// Its vertices are kept for a pixel's connections.
@@ -194,7 +233,7 @@ impl LightVisitor for Subpath<'_, '_> {
     }
 
     fn visit(&mut self, at: &LightArrival) -> bool {
-        let (vcm, f, emission) = (self.vcm, self.f, self.emission);
+        let (vcm, f, emission) = (self.vcm, self.f, &self.emission);
         let (hit, wo, bsdf, length) = (*at.hit, at.wo, at.bsdf, at.length);
         if length == 1 {
             // Next-event estimation's density of the light point depends on where it is
