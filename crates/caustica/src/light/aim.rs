@@ -149,68 +149,108 @@ impl Aim {
         }
     }
 
-    /// An aimed start on a sphere lamp (centre, radius) from a point drawn uniformly on it
-    /// (`normal`, its unit normal): a target by its solid angle from the centre, the point
-    /// mirrored onto the half of the lamp facing that target, then a direction in the
-    /// target's cone from it. Drawn anywhere on the lamp, half the aimed starts would face
-    /// away from their target. Returns the start's normal and direction.
-    pub(crate) fn sample_from_sphere(
-        &self,
-        center: Vec3,
-        radius: f32,
-        normal: Vec3,
-        u_pick: f32,
-        u: Vec2,
-    ) -> Option<(Vec3, Vec3)> {
-        let target = self.pick(center, u_pick)?;
-        let facing = target.cone_from(center).0;
-        let along = normal.dot(facing);
+    /// The targets as a sphere lamp (centre, radius) aims at them ([`LampAim`]).
+    pub(crate) fn seen_from_lamp(&self, center: Vec3, radius: f32) -> LampAim {
+        let cones: Vec<(Target, Vec3, f32)> = self
+            .targets
+            .iter()
+            .map(|t| {
+                let (facing, cos) = t.cone_from(center);
+                (*t, facing, 1.0 - cos)
+            })
+            .collect();
+        LampAim {
+            center,
+            radius,
+            total: cones.iter().map(|c| c.2).sum(),
+            cones,
+        }
+    }
+}
+
+/// An aim's targets seen from a sphere lamp's centre, worked out once per lamp: each aimed start
+/// and each density of one reads them (they took a third of a sphere lamp's emission).
+#[derive(Clone, Debug)]
+pub(crate) struct LampAim {
+    center: Vec3,
+    radius: f32,
+    /// Each target, the axis towards it from the centre and its weight: the solid angle it
+    /// subtends there over 2π.
+    cones: Vec<(Target, Vec3, f32)>,
+    /// The weights' sum.
+    total: f32,
+}
+
+impl LampAim {
+    /// Whether some target subtends a solid angle from the lamp.
+    fn aims(&self) -> bool {
+        !self.total.is_nan() && self.total > 0.0
+    }
+
+    /// An aimed start from a point drawn uniformly on the lamp (`normal`, its unit normal): a
+    /// target by its solid angle from the centre, the point mirrored onto the half of the lamp
+    /// facing that target, then a direction in the target's cone from it. Drawn anywhere on
+    /// the lamp, half the aimed starts would face away from their target. Returns the start's
+    /// normal and direction.
+    pub(crate) fn sample(&self, normal: Vec3, u_pick: f32, u: Vec2) -> Option<(Vec3, Vec3)> {
+        if !self.aims() {
+            return None;
+        }
+        let mut x = u_pick * self.total;
+        let last = self.cones.len() - 1;
+        let (target, facing, _) = self
+            .cones
+            .iter()
+            .enumerate()
+            .find(|&(i, &(_, _, w))| {
+                let found = x < w || i == last;
+                x -= w;
+                found
+            })?
+            .1;
+        let along = normal.dot(*facing);
         let normal = if along < 0.0 {
-            normal - 2.0 * along * facing
+            normal - 2.0 * along * *facing
         } else {
             normal
         };
-        let (axis, cos_max) = target.cone_from(center + normal * radius);
+        let (axis, cos_max) = target.cone_from(self.center + normal * self.radius);
         Some((normal, sample_uniform_cone(u, axis, cos_max)))
     }
 
-    /// The density (area × solid angle) of [`Aim::sample_from_sphere`]'s start at the lamp's
-    /// point `point`, leaving in `dir`.
-    pub(crate) fn sphere_pdf(&self, center: Vec3, radius: f32, point: Vec3, dir: Vec3) -> f32 {
-        let total: f32 = self.targets.iter().map(|t| 1.0 - t.cone_from(center).1).sum();
-        if total.is_nan() || total <= 0.0 {
+    /// The density (area × solid angle) of [`LampAim::sample`]'s start at the lamp's point
+    /// `point`, leaving in `dir`.
+    pub(crate) fn pdf(&self, point: Vec3, dir: Vec3) -> f32 {
+        if !self.aims() {
             return 0.0;
         }
         // From the point, not a caller's normal (which may face either way).
-        let normal = point - center;
-        let half_area = 2.0 * PI * radius * radius;
+        let normal = point - self.center;
+        let half_area = 2.0 * PI * self.radius * self.radius;
         let mut pdf = 0.0;
-        for t in &self.targets {
-            let (facing, cos_center) = t.cone_from(center);
-            if normal.dot(facing) < 0.0 {
+        for (t, facing, weight) in &self.cones {
+            if normal.dot(*facing) < 0.0 {
                 continue;
             }
             let (axis, cos_max) = t.cone_from(point);
             if dir.dot(axis) >= cos_max {
-                pdf += (1.0 - cos_center) / total * uniform_cone_pdf(cos_max) / half_area;
+                pdf += weight / self.total * uniform_cone_pdf(cos_max) / half_area;
             }
         }
         pdf
     }
 
-    /// The area density over the lamp of [`Aim::sample_from_sphere`]'s start point `point`:
-    /// each target's share on the half of the lamp that faces it.
-    pub(crate) fn sphere_point_pdf(&self, center: Vec3, radius: f32, point: Vec3) -> f32 {
-        let total: f32 = self.targets.iter().map(|t| 1.0 - t.cone_from(center).1).sum();
-        if total.is_nan() || total <= 0.0 {
+    /// The area density over the lamp of [`LampAim::sample`]'s start point `point`: each
+    /// target's share on the half of the lamp that faces it.
+    pub(crate) fn point_pdf(&self, point: Vec3) -> f32 {
+        if !self.aims() {
             return 0.0;
         }
-        let half_area = 2.0 * PI * radius * radius;
-        self.targets
+        let half_area = 2.0 * PI * self.radius * self.radius;
+        self.cones
             .iter()
-            .map(|t| t.cone_from(center))
-            .filter(|&(facing, _)| (point - center).dot(facing) >= 0.0)
-            .map(|(_, cos_center)| (1.0 - cos_center) / total / half_area)
+            .filter(|(_, facing, _)| (point - self.center).dot(*facing) >= 0.0)
+            .map(|(_, _, weight)| weight / self.total / half_area)
             .sum()
     }
 }
@@ -333,9 +373,9 @@ mod tests {
     }
 
     /// A sphere lamp of radius 0.5 at the origin and two targets in different directions.
-    fn lamp_aim() -> (Aim, f32) {
+    fn lamp_aim() -> (LampAim, f32) {
         let aim = Aim::new(&[Target::at(0.0, -3.0, 0.0, 1.0), Target::at(2.5, -2.0, 0.5, 0.8)], 1.0).unwrap();
-        (aim, 0.5)
+        (aim.seen_from_lamp(Vec3::ZERO, 0.5), 0.5)
     }
 
     #[test]
@@ -348,7 +388,7 @@ mod tests {
         let mean: f64 = (0..n)
             .map(|_| {
                 let point = sample_uniform_sphere(rng.uniform2()) * radius;
-                aim.sphere_pdf(Vec3::ZERO, radius, point, sample_uniform_sphere(rng.uniform2())) as f64
+                aim.pdf(point, sample_uniform_sphere(rng.uniform2())) as f64
             })
             .sum::<f64>()
             / n as f64;
@@ -371,11 +411,9 @@ mod tests {
         let (mut sum, mut inwards) = (0.0f64, 0);
         for _ in 0..n {
             let uniform = sample_uniform_sphere(rng.uniform2());
-            let (normal, dir) = aim
-                .sample_from_sphere(Vec3::ZERO, radius, uniform, rng.uniform(), rng.uniform2())
-                .unwrap();
+            let (normal, dir) = aim.sample(uniform, rng.uniform(), rng.uniform2()).unwrap();
             inwards += (dir.dot(normal) <= 0.0) as usize;
-            let pdf = aim.sphere_pdf(Vec3::ZERO, radius, normal * radius, dir);
+            let pdf = aim.pdf(normal * radius, dir);
             assert!(pdf > 0.0, "a start the density says cannot be drawn");
             sum += (q / pdf) as f64;
         }
@@ -384,7 +422,7 @@ mod tests {
         let reachable = (0..m)
             .filter(|_| {
                 let point = sample_uniform_sphere(rng.uniform2()) * radius;
-                aim.sphere_pdf(Vec3::ZERO, radius, point, sample_uniform_sphere(rng.uniform2())) > 0.0
+                aim.pdf(point, sample_uniform_sphere(rng.uniform2())) > 0.0
             })
             .count() as f64
             / m as f64;

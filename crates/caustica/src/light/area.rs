@@ -551,15 +551,14 @@ impl Emitters {
                 let mut sample = light.sample(scene, rng.uniform(), u)?;
                 let (dir, normal) = match self.aimed_lobe(rng) {
                     Some((aim, u_pick, u_aim)) => {
-                        let dir = match light.sphere() {
-                            Some((center, radius)) => {
-                                let (normal, dir) =
-                                    aim.sample_from_sphere(center, radius, sample.normal, u_pick, u_aim)?;
+                        let dir = match (self.lamp(number), light.sphere()) {
+                            (Some(lamp), Some((center, radius))) => {
+                                let (normal, dir) = lamp.sample(sample.normal, u_pick, u_aim)?;
                                 sample.normal = normal;
                                 sample.point = center + normal * radius;
                                 dir
                             }
-                            None => aim.sample(sample.point, u_pick, u_aim)?,
+                            _ => aim.sample(sample.point, u_pick, u_aim)?,
                         };
                         // Leaves by the face it points out of, if that face emits.
                         let side = if dir.dot(sample.normal) >= 0.0 { 1.0 } else { -1.0 };
@@ -582,8 +581,8 @@ impl Emitters {
                 let le = area_radiance(light, scene, &sample, wl);
                 let cos = dir.dot(normal);
                 let plain = cos / (PI * light.faces.count());
-                let pdf = pick * self.start_pdf(light, sample.point, sample.normal, dir, plain);
-                let point_pdf = pick * self.point_pdf(light, &sample);
+                let pdf = pick * self.start_pdf((number, light), sample.point, sample.normal, dir, plain);
+                let point_pdf = pick * self.point_pdf((number, light), &sample);
                 (cos > 0.0 && pdf > 0.0).then(|| Emission {
                     ray: Ray::new(offset_origin(sample.point, sample.normal, dir), dir),
                     throughput: le * (cos / pdf),

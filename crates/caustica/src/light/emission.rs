@@ -20,7 +20,7 @@
 //! aims the far lights at the mirrors and glass in view ([`LightSet::emit`]); the course model
 //! aims all its light at the caustics' sources; vcm chooses its shares ([`crate::integrator::vcm`]).
 
-use super::aim::Aim;
+use super::aim::{Aim, LampAim};
 use super::area::{AreaLight, AreaSample};
 use super::beam::Beam;
 use super::{DirectSample, Light, LightSet};
@@ -62,6 +62,9 @@ pub struct Emitters {
     choice: Option<Distribution1D>,
     /// Where points, spots, emissive objects and lights with a size aim a share of their light.
     pub(super) near: Option<Aim>,
+    /// Each sphere lamp's view of `near`'s targets (by light number; `None`: not a sphere lamp,
+    /// or nothing aimed at).
+    lamps: Vec<Option<LampAim>>,
     /// Where directional lights, suns and the sky aim a share of theirs.
     pub(super) far: Option<Aim>,
     /// Each light's beam, for the directional lights and suns.
@@ -155,10 +158,20 @@ impl Emitters {
             .collect();
         let weights: Vec<f32> = numbers.iter().map(|&i| powers[i]).collect();
         let choice = (total > 0.0 && total.is_finite()).then(|| Distribution1D::new(&weights));
+        let lamps = lights
+            .iter()
+            .map(|light| match (light, &near) {
+                (Light::Area(area), Some(aim)) => {
+                    area.sphere().map(|(center, radius)| aim.seen_from_lamp(center, radius))
+                }
+                _ => None,
+            })
+            .collect();
         Emitters {
             probability,
             numbers,
             choice,
+            lamps,
             near,
             far,
             beams,
@@ -188,27 +201,38 @@ impl Emitters {
         self.aimed_lobe(rng).map(|(aim, u_pick, u)| aim.sample(from, u_pick, u))
     }
 
-    /// Density (area × solid angle) of leaving emissive object `light` at `point`, of unit
-    /// normal `normal`, in `dir`, whose direction density without aiming is `plain`.
-    pub(super) fn start_pdf(&self, light: &AreaLight, point: Vec3, normal: Vec3, dir: Vec3, plain: f32) -> f32 {
+    /// How sphere lamp `number` aims its share of light (`None`: it is not one, or nothing is
+    /// aimed at).
+    pub(super) fn lamp(&self, number: usize) -> Option<&LampAim> {
+        self.lamps.get(number)?.as_ref()
+    }
+
+    /// Density (area × solid angle) of leaving emissive object `light` (number `number`) at
+    /// `point`, of unit normal `normal`, in `dir`, whose direction density without aiming is
+    /// `plain`.
+    pub(super) fn start_pdf(
+        &self,
+        (number, light): (usize, &AreaLight),
+        point: Vec3,
+        normal: Vec3,
+        dir: Vec3,
+        plain: f32,
+    ) -> f32 {
         let area = light.pdf_area(normal);
-        match (&self.near, light.sphere()) {
+        match (&self.near, self.lamp(number)) {
             (None, _) => area * plain,
-            (Some(aim), Some((center, radius))) => {
-                (1.0 - aim.share()) * area * plain + aim.share() * aim.sphere_pdf(center, radius, point, dir)
-            }
+            (Some(aim), Some(lamp)) => (1.0 - aim.share()) * area * plain + aim.share() * lamp.pdf(point, dir),
             (Some(_), None) => area * self.direction_pdf(point, dir, plain),
         }
     }
 
-    /// Area density of the start point `sample` on emissive object `light` (before the
-    /// choice of light): a sphere lamp's aimed starts lie on the halves facing their targets.
-    pub(super) fn point_pdf(&self, light: &AreaLight, sample: &AreaSample) -> f32 {
+    /// Area density of the start point `sample` on emissive object `light` (number `number`;
+    /// before the choice of light): a sphere lamp's aimed starts lie on the halves facing their
+    /// targets.
+    pub(super) fn point_pdf(&self, (number, light): (usize, &AreaLight), sample: &AreaSample) -> f32 {
         let area = light.pdf_area(sample.normal);
-        match (&self.near, light.sphere()) {
-            (Some(aim), Some((center, radius))) => {
-                (1.0 - aim.share()) * area + aim.share() * aim.sphere_point_pdf(center, radius, sample.point)
-            }
+        match (&self.near, self.lamp(number)) {
+            (Some(aim), Some(lamp)) => (1.0 - aim.share()) * area + aim.share() * lamp.point_pdf(sample.point),
             _ => area,
         }
     }
@@ -225,7 +249,12 @@ impl Emitters {
 
     /// The start of a light subpath from a light chosen by power, at the wavelengths `wl`.
     pub fn emit(&self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng) -> Option<Emission> {
-        let (_, slot, _) = self.choice.as_ref()?.sample(rng.uniform());
+        let (choice, u) = (self.choice.as_ref()?, rng.uniform());
+        // One light needs no search (a tenth of a sphere lamp's emission).
+        let slot = match self.numbers.len() {
+            1 => 0,
+            _ => choice.sample(u).1,
+        };
         let number = self.numbers[slot];
         self.emit_light(scene, number, self.probability[number], wl, rng)
     }
@@ -321,7 +350,7 @@ impl Emitters {
             return 0.0;
         }
         let plain = normal.dot(dir).abs() / (PI * light.faces.count());
-        self.probability[number] * self.start_pdf(light, point, normal, dir, plain)
+        self.probability[number] * self.start_pdf((number, light), point, normal, dir, plain)
     }
 
     /// Emission's density (point × direction, choice included) of the start that next-event
