@@ -289,9 +289,9 @@ impl<V: CameraVisitor> Wave for CameraPath<V> {
 
 /// Takes every path's walk to its end, as [`walk_camera`] would one by one and with the same
 /// results: in waves ([`in_waves`]), or one at a time in scenes with media (where a segment's
-/// end depends on the path's random numbers).
+/// end depends on the path's random numbers) or if there is one.
 pub fn walk_cameras<V: CameraVisitor>(scene: &Scene, paths: &mut [CameraPath<V>]) {
-    if !scene.has_media() {
+    if !scene.has_media() && paths.len() > 1 {
         return in_waves(scene, paths);
     }
     for p in paths {

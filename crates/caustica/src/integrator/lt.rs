@@ -245,7 +245,7 @@ impl<'a> LightTracer<'a> {
     fn trace(&self, pass: u64, indices: std::ops::Range<u64>, wl: &Wavelengths) -> Vec<(u32, Vec3)> {
         let mut out = Vec::new();
         let mut own: Vec<Vec<(u32, Vec3)>> = Vec::new();
-        for wave in light_waves(self.scene, indices) {
+        for wave in light_waves(self.scene.streams_pay(), indices) {
             if wave.end - wave.start == 1 {
                 // One path a wave: straight into the batch's list.
                 // Walked where it was made: moving it out of the `Option` copied it.

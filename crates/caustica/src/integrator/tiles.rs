@@ -81,7 +81,7 @@ where
 
 /// [`shade_tiles`] a tile at a time: `tile((x0, y0), (x1, y1))` returns the pixels of the
 /// rectangle from `(x0, y0)` to `(x1, y1)` (exclusive), row by row.
-fn shade_tile_blocks<F>(
+pub(crate) fn shade_tile_blocks<F>(
     width: usize,
     height: usize,
     control: Control,

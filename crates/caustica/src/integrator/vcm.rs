@@ -43,11 +43,13 @@ pub mod mis;
 mod pilots;
 mod settings;
 
-use super::camera_walk::{bounce_as_surface, visit_as_surface, walk_camera, CameraArrival, CameraVisitor};
+use super::camera_walk::{
+    bounce_as_surface, visit_as_surface, walk_cameras, CameraArrival, CameraPath, CameraVisitor, CameraWalk,
+};
 use super::lt::Sensor;
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{radius_factor, InitialRadius};
-use super::tiles::shade_tiles;
+use super::tiles::{shade_tile_blocks, shade_tiles};
 use super::Progressive;
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::light::aim::{caustic_targets, Aim};
@@ -66,7 +68,7 @@ use mis::{ConnectionPdfs, DirectPdfs, Factors, Partial};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use camera_paths::both_dispersed;
+use camera_paths::{both_dispersed, camera_radiance};
 use pilots::PILOT_TO_PASS_COST;
 pub use settings::*;
 
@@ -170,9 +172,7 @@ impl LightPaths {
 /// come back without the page faults and regrowth of new vectors.
 #[derive(Default)]
 struct Scratch {
-    /// Each batch's subpaths, and the lists its wave's paths store into before they are
-    /// appended in order.
-    batches: Vec<(LightPaths, Vec<LightPaths>)>,
+    batches: Vec<LightPaths>,
     paths: LightPaths,
     grid: HashGrid,
     merge_vertices: Vec<MergeVertex>,
@@ -271,6 +271,9 @@ pub struct Vcm<'a> {
     /// The pixels that see a focused cell, from rays through their centres (empty until
     /// prepared).
     focus_pixels: Vec<bool>,
+    /// Light subpaths and a tile's camera subpaths walk together, a wave of rays per bounce
+    /// (where streams pay, [`Scene::streams_pay`]), or one at a time: the same image.
+    waves: bool,
     /// The last pass's memory, reused by the next.
     scratch: std::sync::Mutex<Scratch>,
     /// Seconds a pilot light subpath took, for sizing a first pass to a time limit.
@@ -348,6 +351,7 @@ impl<'a> Vcm<'a> {
             seed,
             focus: CausticFocus::default(),
             focus_pixels: Vec::new(),
+            waves: scene.streams_pay(),
             scratch: std::sync::Mutex::default(),
             pilot_seconds: None,
             timing: std::sync::Mutex::new(None),
@@ -448,7 +452,101 @@ impl Progressive for Vcm<'_> {
     }
 }
 
+/// A pixel's camera samples in a pass: its random stream, the light subpath it connects to,
+/// the samples still to take and what they have added.
+struct CameraPixel {
+    rng: Rng,
+    own: usize,
+    samples: usize,
+    left: usize,
+    sum: Vec3,
+    work: CameraWork,
+}
+
+impl CameraPixel {
+    /// Its next sample's camera ray through pixel `(x, y)`, jittered.
+    fn next_ray(&mut self, vcm: &Vcm, (x, y): (usize, usize)) -> Ray {
+        self.left -= 1;
+        let (jx, jy) = (self.rng.uniform(), self.rng.uniform());
+        let (w, h) = (vcm.width as f32, vcm.height as f32);
+        vcm.camera.generate_ray((x as f32 + jx) / w, 1.0 - (y as f32 + jy) / h)
+    }
+
+    /// Adds a sample's value (left out if not finite).
+    fn add(&mut self, v: Vec3) {
+        if v.is_finite() {
+            self.sum += v;
+        }
+    }
+
+    /// The mean of its samples.
+    fn value(&self) -> Vec3 {
+        self.sum / self.samples as f32
+    }
+}
+
 impl Vcm<'_> {
+    /// Pixel `(x, y)`'s camera samples in pass `pass` of `count` light subpaths: focus pixels
+    /// take several.
+    fn camera_pixel(&self, (x, y): (usize, usize), (pass, count): (u64, u64)) -> CameraPixel {
+        let pixel = y * self.width + x;
+        let samples = if self.focus_pixels[pixel] {
+            self.settings.focus_samples.max(1)
+        } else {
+            1
+        };
+        CameraPixel {
+            rng: Rng::new(self.seed, (pass << 32) ^ pixel as u64),
+            own: pixel % count as usize,
+            samples,
+            left: samples,
+            sum: Vec3::ZERO,
+            work: CameraWork::default(),
+        }
+    }
+
+    /// The pixels of the tile from `from` to `to` (exclusive), row by row: each round of
+    /// samples walks together (a focus pixel's next sample starts where its stream left off).
+    fn camera_tile(
+        &self,
+        (from, to): ((usize, usize), (usize, usize)),
+        pass: (u64, u64),
+        pass_data: &PassData,
+        wl: &Wavelengths,
+    ) -> Vec<Vec3> {
+        let tw = to.0 - from.0;
+        let at = |i: usize| (from.0 + i % tw, from.1 + i / tw);
+        let mut pixels: Vec<CameraPixel> = (0..tw * (to.1 - from.1))
+            .map(|i| self.camera_pixel(at(i), pass))
+            .collect();
+        let mut values = Vec::new();
+        while pixels.iter().any(|p| p.left > 0) {
+            let (mut paths, mut walking) = (Vec::new(), Vec::new());
+            for (i, p) in pixels.iter_mut().enumerate().filter(|(_, p)| p.left > 0) {
+                let ray = p.next_ray(self, at(i));
+                match self.camera_subpath(ray, (pass_data, p.own), wl, p.rng.clone(), &mut p.work) {
+                    Some(path) => {
+                        paths.push(path);
+                        walking.push(i);
+                    }
+                    None => values.push((i, None, Vec3::ZERO)),
+                }
+            }
+            walk_cameras(self.scene, &mut paths);
+            let walked = paths
+                .into_iter()
+                .map(|path| (Some(path.rng.clone()), wl.to_rgb(camera_radiance(path))));
+            values.extend(walking.iter().zip(walked).map(|(&i, (rng, v))| (i, rng, v)));
+            for (i, rng, v) in values.drain(..) {
+                if let Some(rng) = rng {
+                    pixels[i].rng = rng;
+                }
+                pixels[i].add(v);
+            }
+        }
+        pixels.iter().map(CameraPixel::value).collect()
+    }
+
     /// Pass `pass` with `count` light subpaths.
     fn render_light_paths(&self, pass: u64, count: u64, control: Control) -> Option<Vec<Vec3>> {
         let wl = pass_wavelengths(self.spectral, self.seed, pass);
@@ -479,30 +577,21 @@ impl Vcm<'_> {
             f,
             radius,
         );
-        let camera = &self.camera;
-        let (w, h) = (self.width, self.height);
-        let focus_pixels = &self.focus_pixels;
-        let (mut film, complete) = shade_tiles(w, h, control, false, |x, y| {
-            let pixel = y * w + x;
-            let mut rng = Rng::new(self.seed, (pass << 32) ^ pixel as u64);
-            let own = pixel % count as usize;
-            let samples = if focus_pixels[pixel] {
-                self.settings.focus_samples.max(1)
-            } else {
-                1
-            };
-            let mut sum = Vec3::ZERO;
-            let mut work = CameraWork::default();
-            for _ in 0..samples {
-                let (jx, jy) = (rng.uniform(), rng.uniform());
-                let ray = camera.generate_ray((x as f32 + jx) / w as f32, 1.0 - (y as f32 + jy) / h as f32);
-                let v = wl.to_rgb(self.camera_path(ray, &pass_data, own, &wl, &mut rng, &mut work));
-                if v.is_finite() {
-                    sum += v;
+        let (mut film, complete) = if self.waves {
+            shade_tile_blocks(self.width, self.height, control, false, |from, to| {
+                self.camera_tile((from, to), (pass, count), &pass_data, &wl)
+            })
+        } else {
+            shade_tiles(self.width, self.height, control, false, |x, y| {
+                let mut pixel = self.camera_pixel((x, y), (pass, count));
+                while pixel.left > 0 {
+                    let ray = pixel.next_ray(self, (x, y));
+                    let v = self.camera_path(ray, &pass_data, pixel.own, &wl, &mut pixel.rng, &mut pixel.work);
+                    pixel.add(wl.to_rgb(v));
                 }
-            }
-            sum / samples as f32
-        });
+                pixel.value()
+            })
+        };
         if !complete {
             return None;
         }

@@ -482,13 +482,13 @@ impl LightWalk {
 }
 
 /// The waves a caller of [`walk_lights`] splits the light paths `indices` into, in order:
-/// where streams pay ([`Scene::streams_pay`]), 256 paths a wave, enough for the stream's loads
-/// to overlap, as a tile's camera paths; else one path a wave, whose walk keeps its own state
-/// and output in the cache (waves of 256 there made `vcm` 11–17% and `lt` 6–9% slower on the
-/// Cornell box and the glass ball, where inside a million-triangle mesh they made `ppm`, `lt`
-/// and `vcm` 1.3–1.7× faster).
-pub fn light_waves(scene: &Scene, indices: Range<u64>) -> impl Iterator<Item = Range<u64>> {
-    let wave = if scene.streams_pay() { 256 } else { 1 };
+/// `together` (where streams pay, [`Scene::streams_pay`]), 256 paths a wave, enough for the
+/// stream's loads to overlap, as a tile's camera paths; else one path a wave, whose walk keeps
+/// its own state and output in the cache (waves of 256 there made `vcm` 11–17% and `lt` 6–9%
+/// slower on the Cornell box and the glass ball, where inside a million-triangle mesh they made
+/// `ppm`, `lt` and `vcm` 1.3–1.7× faster).
+pub fn light_waves(together: bool, indices: Range<u64>) -> impl Iterator<Item = Range<u64>> {
+    let wave = if together { 256 } else { 1 };
     let end = indices.end;
     indices
         .step_by(wave)

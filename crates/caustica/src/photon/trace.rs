@@ -80,7 +80,7 @@ pub fn trace_count_in_media(
                 return (out, volume);
             }
             let mut own: Vec<(Vec<Photon>, Vec<Photon>)> = Vec::new();
-            for wave in light_waves(scene, b * BATCH..((b + 1) * BATCH).min(count)) {
+            for wave in light_waves(scene.streams_pay(), b * BATCH..((b + 1) * BATCH).min(count)) {
                 if wave.end - wave.start == 1 {
                     // One path a wave: straight into the batch's lists.
                     // Walked where it was made: moving it out of the `Option` copied it.

@@ -7,7 +7,7 @@ use crate::photon::light_walk::{MediumArrival, Passage};
 
 /// One camera subpath on its walk: its MIS sums, the variants merging at the first vertex
 /// needs, and the radiance gathered.
-struct CameraSubpath<'v, 'a> {
+pub(super) struct CameraSubpath<'v, 'a> {
     vcm: &'v Vcm<'a>,
     pass: &'v PassData,
     /// The light subpath this pixel connects to.
@@ -188,6 +188,17 @@ impl CameraVisitor for CameraSubpath<'_, '_> {
     }
 }
 
+/// What a walked camera subpath gathered (black if not finite); its rays counted in its work.
+pub(super) fn camera_radiance(path: CameraPath<CameraSubpath>) -> Spectrum {
+    let l = path.visitor.l;
+    path.visitor.work.rays += path.walk.rays();
+    if l.is_finite() {
+        l
+    } else {
+        Spectrum::ZERO
+    }
+}
+
 impl CameraSubpath<'_, '_> {
     /// Whether the path's segments gather light by beam queries: before its first smooth vertex.
     fn gathers_beams(&self) -> bool {
@@ -207,11 +218,29 @@ impl<'a> Vcm<'a> {
         rng: &mut Rng,
         work: &mut CameraWork,
     ) -> Spectrum {
+        let Some(mut path) = self.camera_subpath(ray, (pass, own), wl, rng.clone(), work) else {
+            return Spectrum::ZERO;
+        };
+        walk_cameras(self.scene, std::slice::from_mut(&mut path));
+        *rng = path.rng.clone();
+        camera_radiance(path)
+    }
+
+    /// The camera subpath along `ray` (`None`: the camera sees nothing that way), joined to the
+    /// light subpaths of `pass` (`own`: the one its pixel connects to), drawing from `rng`.
+    pub(super) fn camera_subpath<'v>(
+        &'v self,
+        ray: Ray,
+        (pass, own): (&'v PassData, usize),
+        wl: &'v Wavelengths,
+        rng: Rng,
+        work: &'v mut CameraWork,
+    ) -> Option<CameraPath<CameraSubpath<'v, 'a>>> {
         let camera_pdf = self.sensor.importance(ray.dir);
         if camera_pdf <= 0.0 {
-            return Spectrum::ZERO;
+            return None;
         }
-        let mut subpath = CameraSubpath {
+        let visitor = CameraSubpath {
             vcm: self,
             pass,
             own,
@@ -227,21 +256,12 @@ impl<'a> Vcm<'a> {
             smooth_before: false,
             first_focused: false,
         };
-        let rays = walk_camera(
-            self.scene,
-            ray,
-            wl,
-            (self.max_length, ROULETTE_DEPTH),
+        Some(CameraPath {
+            walk: CameraWalk::new(self.scene, ray, wl, (self.max_length, ROULETTE_DEPTH)),
+            wl: *wl,
             rng,
-            &mut subpath,
-        );
-        let l = subpath.l;
-        work.rays += rays;
-        if l.is_finite() {
-            l
-        } else {
-            Spectrum::ZERO
-        }
+            visitor,
+        })
     }
 
     /// What a camera path leaving `from` in `dir` after `length` segments sees of the sky and
@@ -477,5 +497,78 @@ pub(super) fn both_dispersed(a: bool, b: bool) -> f32 {
         1.0 / SAMPLES as f32
     } else {
         1.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::progress::{Control, NoProgress};
+
+    /// Light subpaths walked together, and a tile's camera subpaths, make the image each walked
+    /// alone makes, bit for bit, every subpath's vertices kept in order (for connections) and
+    /// focus pixels' further samples included: a spot light through a glass ball onto a floor,
+    /// its caustic in view.
+    #[test]
+    fn waves_make_the_image_single_walks_make() {
+        let text = "SBT-raytracer 1.0
+camera { position = (-2.5, 2.5, 0); viewdir = (1, -1.1, 0); updir = (0, 1, 0); fov = 40; }
+spot_light { position = (1.2, 2, 0); direction = (-1.2, -1.5, 0); color = (3, 3, 3); size = 50; blend = 0.3;
+  constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
+translate(0, 0.5, 0, scale(0.5, sphere { material = { transmissive = (1, 1, 1); index = 1.5; } }))
+rotate(1, 0, 0, -1.5707963, scale(40, square { material = { diffuse = (0.6, 0.6, 0.6); } }))";
+        let scene = crate::loader::from_text(text, std::path::Path::new("."), &Default::default()).unwrap();
+        let cancel = std::sync::atomic::AtomicBool::new(false);
+        let control = || Control {
+            progress: &NoProgress,
+            cancel: &cancel,
+        };
+        let settings = VcmSettings {
+            focus_samples: 3,
+            connections: true,
+            ..VcmSettings::default()
+        };
+        let mut vcm = Vcm::new(&scene, settings, 40, 40, 5);
+        assert!(vcm.prepare(control()));
+        let focused = vcm.focus_pixels.iter().filter(|&&f| f).count();
+        assert!(focused > 5, "{focused} focus pixels");
+        // Each subpath's vertices, where camera paths find them (by `ends`), in index order.
+        let wl = Wavelengths::Rgb;
+        let count = vcm.pixels() as u64 * 2;
+        let lists = [true, false].map(|waves| {
+            vcm.waves = waves;
+            let mut scratch = Scratch::default();
+            let f = Factors::new(0.05, count as f32);
+            vcm.light_paths((1, count), &f, &wl, true, &cancel, &mut scratch)
+                .expect("not cancelled");
+            let paths = scratch.paths;
+            let subpaths: Vec<Vec<Vec3>> = paths
+                .ends
+                .windows(2)
+                .map(|w| {
+                    paths.vertices[w[0] as usize..w[1] as usize]
+                        .iter()
+                        .map(|v| v.hit.point)
+                        .collect()
+                })
+                .collect();
+            (subpaths, paths.merge_points, paths.splats, paths.rays)
+        });
+        assert_eq!(lists[0].0.len(), count as usize);
+        assert!(
+            lists[0].0.iter().filter(|v| !v.is_empty()).count() > 100,
+            "subpaths with vertices"
+        );
+        assert!(
+            lists[0].1.len() > 100 && lists[0].2.len() > 100,
+            "merge points and splats"
+        );
+        assert_eq!(lists[0], lists[1]);
+        let films = [true, false].map(|waves| {
+            vcm.waves = waves;
+            vcm.render_pass(1, control()).expect("not cancelled")
+        });
+        assert!(films[0].iter().any(|p| p.x > 0.0), "a lit image");
+        assert_eq!(films[0], films[1]);
     }
 }

@@ -46,15 +46,18 @@ impl<'a> Vcm<'a> {
     }
 
     /// Traces the light subpaths `indices` of pass `pass` into `out`, in index order, a wave at
-    /// a time; in waves of more than one path each into its own of `own` first.
+    /// a time; in waves of more than one path each into its own lists first.
     fn trace_lights(
         &self,
         (pass, indices): (u64, std::ops::Range<u64>),
         fw: (&Factors, &Wavelengths),
         to_eye: bool,
-        (out, own): (&mut LightPaths, &mut Vec<LightPaths>),
+        out: &mut LightPaths,
     ) {
-        for wave in light_waves(self.scene, indices) {
+        // The lists of a wave's paths, reused by the batch's waves (kept only for the batch:
+        // kept for the pass, every batch's added half again to vcm's memory).
+        let mut own: Vec<LightPaths> = Vec::new();
+        for wave in light_waves(self.waves, indices) {
             if wave.end - wave.start == 1 {
                 // One path a wave: straight into the batch's lists.
                 // Walked where it was made: moving it out of the `Option` copied it.
@@ -160,27 +163,24 @@ impl<'a> Vcm<'a> {
     ) -> Option<()> {
         let batch_count = count.div_ceil(BATCH) as usize;
         let batches = &mut scratch.batches;
-        batches.resize_with(batches.len().max(batch_count), Default::default);
-        let complete = batches[..batch_count]
-            .par_iter_mut()
-            .enumerate()
-            .all(|(b, (out, own))| {
-                if cancel.load(Ordering::Relaxed) {
-                    return false;
-                }
-                out.clear();
-                let b = b as u64;
-                let indices = b * BATCH..((b + 1) * BATCH).min(count);
-                self.trace_lights((pass, indices), (f, wl), to_eye, (out, own));
-                true
-            });
+        batches.resize_with(batches.len().max(batch_count), LightPaths::default);
+        let complete = batches[..batch_count].par_iter_mut().enumerate().all(|(b, out)| {
+            if cancel.load(Ordering::Relaxed) {
+                return false;
+            }
+            out.clear();
+            let b = b as u64;
+            let indices = b * BATCH..((b + 1) * BATCH).min(count);
+            self.trace_lights((pass, indices), (f, wl), to_eye, out);
+            true
+        });
         if !complete {
             return None;
         }
         let all = &mut scratch.paths;
         all.clear();
         all.ends.push(0);
-        for (batch, _) in &batches[..batch_count] {
+        for batch in &batches[..batch_count] {
             all.append(batch);
         }
         Some(())
