@@ -5,7 +5,7 @@
 use super::build::LeafCost;
 #[cfg(target_arch = "x86_64")]
 use super::WideRayPre;
-use super::{Bvh, RayPre, SlabTest, StackSized, Traversal, Visit, END, LEAF};
+use super::{Bvh, RayPre, SlabTest, StackSized, Traversal, Visit, END, LARGE_STACK, LEAF};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::lanes::in_avx;
 use crate::accel::lanes::Width;
@@ -13,6 +13,7 @@ use crate::geometry::triangle::{Triangle, TriangleRay};
 use crate::geometry::triangle_packet::{TrianglePacket, LANES};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::progress::{NoProgress, Progress};
+use std::cell::RefCell;
 
 /// Packet leaves: a packet test costs about one binary node visit (measured with the `bvh`
 /// bench: 1.0 to 2.0 change incoherent throughput by under 5%), and a leaf holds at most two.
@@ -25,6 +26,16 @@ const PACKET_LEAVES: LeafCost = LeafCost {
 /// Rays walked together by [`TriangleBvh::closest_hits`]: enough independent node reads in
 /// flight to overlap cache misses, few enough that their state stays in the L1 cache.
 const STREAM: usize = 8;
+
+/// The traversal stacks of a stream's lanes, each as large as any tree needs.
+type LaneStacks = [[(u32, f32); LARGE_STACK]; STREAM];
+
+thread_local! {
+    /// The lane stacks each stream on the thread borrows: lanes that owned theirs had them
+    /// cleared and moved when made, 4 KB each on a million triangles (`memmove` took 3% of a
+    /// vcm render there).
+    static STREAM_STACKS: RefCell<LaneStacks> = const { RefCell::new([[(0, 0.0); LARGE_STACK]; STREAM]) };
+}
 
 /// Cache lines of a leaf's packets loaded ahead by a stream's walk: a whole packet.
 const FETCH_LINES: usize = 3;
@@ -306,6 +317,7 @@ impl TriangleBvh {
             rays: &'a [Ray],
             t_max: f32,
             out: &'b mut [R],
+            stacks: &'b mut LaneStacks,
             leaf: L,
             answer: A,
             found: std::marker::PhantomData<F>,
@@ -323,7 +335,7 @@ impl TriangleBvh {
                     Width::Four => bvh.stream_with::<N, NEAR_FIRST, F, R, RayPre>(
                         self.rays,
                         self.t_max,
-                        self.out,
+                        (self.out, self.stacks),
                         &self.leaf,
                         &self.answer,
                     ),
@@ -332,7 +344,7 @@ impl TriangleBvh {
                         bvh.stream_with::<N, NEAR_FIRST, F, R, WideRayPre>(
                             self.rays,
                             self.t_max,
-                            self.out,
+                            (self.out, self.stacks),
                             &self.leaf,
                             &self.answer,
                         )
@@ -345,14 +357,27 @@ impl TriangleBvh {
         if self.packets.is_empty() {
             return;
         }
-        self.bvh.with_stack(Stream::<NEAR_FIRST, _, _, _, _> {
-            bvh: self,
-            rays,
-            t_max,
-            out,
-            leaf,
-            answer,
-            found: std::marker::PhantomData,
+        // The thread's lane stacks, or (within another stream on this thread) new ones.
+        STREAM_STACKS.with(|cell| {
+            let mut lent = cell.try_borrow_mut();
+            let mut own;
+            let stacks = match lent.as_deref_mut() {
+                Ok(stacks) => stacks,
+                Err(_) => {
+                    own = Box::new([[(0, 0.0); LARGE_STACK]; STREAM]);
+                    &mut *own
+                }
+            };
+            self.bvh.with_stack(Stream::<NEAR_FIRST, _, _, _, _> {
+                bvh: self,
+                rays,
+                t_max,
+                out,
+                stacks,
+                leaf,
+                answer,
+                found: std::marker::PhantomData,
+            });
         });
     }
 
@@ -362,18 +387,19 @@ impl TriangleBvh {
         &self,
         rays: &[Ray],
         t_max: f32,
-        out: &mut [R],
+        (out, stacks): (&mut [R], &mut LaneStacks),
         leaf: &impl Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
         answer: &impl Fn(f32, F) -> R,
     ) {
-        /// One ray of the stream.
-        struct Lane<const N: usize, F, T> {
+        /// One ray of the stream, walking with a stack it borrows.
+        struct Lane<'s, const N: usize, F, T> {
             index: usize,
-            walk: Traversal<N, [(u32, f32); N], T>,
+            walk: Traversal<N, &'s mut [(u32, f32); N], T>,
             tri: TriangleRay,
             found: F,
         }
         let mut pending = rays.iter().enumerate();
+        let mut free = stacks.iter_mut();
         // A plain loop: an iterator adapter's closure, left out of line, would make the wide
         // test's lanes outside the AVX code.
         let mut lanes: Vec<Lane<N, F, T>> = Vec::with_capacity(STREAM);
@@ -381,7 +407,13 @@ impl TriangleBvh {
             let Some((index, ray)) = pending.next() else {
                 break;
             };
-            if let Some(walk) = Traversal::new(ray, t_max, [(0, 0.0); N]) {
+            // A ray that cannot be walked keeps its default answer and takes no stack.
+            if !super::walkable(ray) {
+                continue;
+            }
+            let stack = free.next().expect("a stack for each lane");
+            let stack: &mut [(u32, f32); N] = (&mut stack[..N]).try_into().expect("N entries at most LARGE_STACK");
+            if let Some(walk) = Traversal::new(ray, t_max, stack) {
                 lanes.push(Lane {
                     index,
                     walk,
