@@ -9,7 +9,7 @@
 
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
-use crate::photon::light_walk::{in_waves, MediumArrival, Passage, Step, Wave};
+use crate::photon::light_walk::{MediumArrival, Passage, Step, Walk, Walker};
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -136,11 +136,11 @@ fn walk_to_end(
 ) {
     while walk.pending().is_some() {
         let step = walk.trace(scene, wl, rng, visitor);
-        walk.arrive(scene, step, wl, rng, visitor);
+        walk.arrive(scene, &step, wl, rng, visitor);
     }
 }
 
-/// A camera walk between its rays: [`walk_camera`] takes one to its end; [`walk_cameras`]
+/// A camera walk between its rays: [`walk_camera`] takes one to its end; [`walk_together`](crate::photon::light_walk::walk_together)
 /// takes many a ray at a time, tracing each wave of rays together.
 #[derive(Clone, Debug)]
 pub struct CameraWalk {
@@ -200,7 +200,14 @@ impl CameraWalk {
 
     /// Takes the pending ray's `step`: hands the vertex to `visitor`, lets it bounce, and sets
     /// up the next ray, or ends the walk.
-    fn arrive(&mut self, scene: &Scene, step: Step, wl: &Wavelengths, rng: &mut Rng, visitor: &mut impl CameraVisitor) {
+    fn arrive(
+        &mut self,
+        scene: &Scene,
+        step: &Step,
+        wl: &Wavelengths,
+        rng: &mut Rng,
+        visitor: &mut impl CameraVisitor,
+    ) {
         self.rays += 1;
         let length = self.length;
         // Ended unless the bounce below carries on.
@@ -208,7 +215,7 @@ impl CameraWalk {
         let wo = -self.ray.dir;
         // The hit by reference: moving it out of `step` copied it in 16-byte pieces, each
         // waiting on the narrower stores that had just written it.
-        let (hit, sample) = match &step {
+        let (hit, sample) = match step {
             Step::Escaped => {
                 visitor.escaped(self.ray.dir, self.throughput, length);
                 return;
@@ -263,39 +270,20 @@ impl CameraWalk {
     }
 }
 
-/// One of the camera paths [`walk_cameras`] takes together: its walk, wavelengths, random
-/// stream and visitor.
-pub struct CameraPath<V> {
-    /// The walk.
-    pub walk: CameraWalk,
-    /// Its wavelengths.
-    pub wl: Wavelengths,
-    /// Its random stream.
-    pub rng: Rng,
-    /// What it does at each vertex.
-    pub visitor: V,
-}
+/// A camera path [`walk_together`](crate::photon::light_walk::walk_together) takes with others.
+pub type CameraPath<V> = Walker<CameraWalk, V>;
 
-impl<V: CameraVisitor> Wave for CameraPath<V> {
-    fn pending_ray(&self) -> Option<&Ray> {
-        self.walk.pending()
+impl<V: CameraVisitor> Walk<V> for CameraWalk {
+    fn next_ray(&self) -> Option<&Ray> {
+        self.pending()
     }
 
-    fn take_step(&mut self, scene: &Scene, step: Step) {
-        self.walk
-            .arrive(scene, step, &self.wl, &mut self.rng, &mut self.visitor);
+    fn take_step(&mut self, scene: &Scene, step: &Step, wl: &Wavelengths, rng: &mut Rng, visitor: &mut V) {
+        self.arrive(scene, step, wl, rng, visitor);
     }
-}
 
-/// Takes every path's walk to its end, as [`walk_camera`] would one by one and with the same
-/// results: in waves ([`in_waves`]), or one at a time in scenes with media (where a segment's
-/// end depends on the path's random numbers) or if there is one.
-pub fn walk_cameras<V: CameraVisitor>(scene: &Scene, paths: &mut [CameraPath<V>]) {
-    if !scene.has_media() && paths.len() > 1 {
-        return in_waves(scene, paths);
-    }
-    for p in paths {
-        walk_to_end(scene, &mut p.walk, &p.wl, &mut p.rng, &mut p.visitor);
+    fn walk_to_end(&mut self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng, visitor: &mut V) {
+        walk_to_end(scene, self, wl, rng, visitor);
     }
 }
 
@@ -328,7 +316,7 @@ pub fn continue_camera(
 mod tests {
     use super::*;
     use crate::medium::VACUUM;
-    use crate::photon::light_walk::{walk_light, walk_lights, LightArrival, LightPath, LightVisitor, LightWalk};
+    use crate::photon::light_walk::{walk_light, walk_together, LightArrival, LightPath, LightVisitor, LightWalk};
     use crate::scene::build::test_scene;
 
     /// Every arrival's length and throughput, and the escapes.
@@ -394,7 +382,7 @@ mod tests {
                     }
                 })
                 .collect();
-            walk_cameras(&scene, &mut paths);
+            walk_together(&scene, &mut paths);
             let mut surfaces = 0;
             for (i, together) in paths.iter_mut().enumerate() {
                 let (ray, mut rng) = start(i as u64);
@@ -421,7 +409,7 @@ mod tests {
                     }
                 })
                 .collect();
-            walk_lights(&scene, &mut paths);
+            walk_together(&scene, &mut paths);
             let mut surfaces = 0;
             for (i, together) in paths.iter_mut().enumerate() {
                 let (ray, mut rng) = start(i as u64);

@@ -18,7 +18,7 @@ use crate::camera::Camera;
 use crate::light::emission::EmissionPoint;
 use crate::math::{offset_origin, Ray, Vec3};
 use crate::photon::light_walk::{
-    light_waves, walk_lights, LightArrival, LightPath, LightVisitor, LightWalk, MediumArrival,
+    light_waves, walk_together, LightArrival, LightPath, LightVisitor, LightWalk, MediumArrival, Walker,
 };
 use crate::progress::Control;
 use crate::sampling::Rng;
@@ -227,7 +227,7 @@ impl<'a> LightTracer<'a> {
         }
         // The walk's photons carry flux, as the photon tracer's do.
         let surfaces = self.settings.max_depth.saturating_add(1);
-        Some(LightPath {
+        Some(Walker {
             walk: LightWalk::new(scene, emitted.ray, (emitted.throughput * share, medium), surfaces),
             wl: *wl,
             rng,
@@ -250,7 +250,7 @@ impl<'a> LightTracer<'a> {
                 // One path a wave: straight into the batch's list.
                 // Walked where it was made: moving it out of the `Option` copied it.
                 let mut path = self.start((pass, wave.start), wl, &mut out);
-                walk_lights(self.scene, path.as_mut_slice());
+                walk_together(self.scene, path.as_mut_slice());
                 continue;
             }
             // Each path splats into its own list, appended in photon order.
@@ -259,7 +259,7 @@ impl<'a> LightTracer<'a> {
                 .zip(&mut own)
                 .filter_map(|(i, path_out)| self.start((pass, i), wl, path_out))
                 .collect();
-            walk_lights(self.scene, &mut paths);
+            walk_together(self.scene, &mut paths);
             own.iter_mut().for_each(|path_out| out.append(path_out));
         }
         out

@@ -4,12 +4,12 @@
 //! It cannot see caustics of point or directional lights (a path can never hit a delta light
 //! after a mirror or through glass); that is what photon mapping is for.
 
-use super::camera_walk::{walk_camera, walk_cameras, CameraArrival, CameraPath, CameraVisitor, CameraWalk};
+use super::camera_walk::{walk_camera, CameraArrival, CameraPath, CameraVisitor, CameraWalk};
 use super::direct::{direct_in_medium, direct_light, emitted, power_heuristic};
 use super::tiles::PixelSample;
 use crate::bsdf::{BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
-use crate::photon::light_walk::MediumArrival;
+use crate::photon::light_walk::{walk_together, MediumArrival, Walker};
 use crate::sampling::Rng;
 use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -201,7 +201,7 @@ impl super::Progressive for PathTracer<'_> {
                         };
                         let ray = camera.generate_ray(sx, sy);
                         let visitor = PathRadiance::new(self.scene, &self.settings, &ray, wl);
-                        CameraPath {
+                        Walker {
                             walk: CameraWalk::new(self.scene, ray, &wl, visitor.limits()),
                             wl,
                             rng,
@@ -210,7 +210,7 @@ impl super::Progressive for PathTracer<'_> {
                     },
                 )
                 .collect();
-            walk_cameras(self.scene, &mut paths);
+            walk_together(self.scene, &mut paths);
             paths.iter().map(|p| p.wl.to_rgb(p.visitor.radiance())).collect()
         })
     }

@@ -43,9 +43,7 @@ pub mod mis;
 mod pilots;
 mod settings;
 
-use super::camera_walk::{
-    bounce_as_surface, visit_as_surface, walk_cameras, CameraArrival, CameraPath, CameraVisitor, CameraWalk,
-};
+use super::camera_walk::{bounce_as_surface, visit_as_surface, CameraArrival, CameraPath, CameraVisitor, CameraWalk};
 use super::lt::Sensor;
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{radius_factor, InitialRadius};
@@ -56,7 +54,7 @@ use crate::light::aim::{caustic_targets, Aim};
 use crate::light::emission::{Emission, Emitters};
 use crate::math::{Ray, Vec3};
 use crate::photon::kd_tree::{KdPoint, KdTree};
-use crate::photon::light_walk::{LightArrival, LightVisitor, Roulette};
+use crate::photon::light_walk::{walk_together, LightArrival, LightVisitor, Roulette};
 use crate::progress::Control;
 use crate::sampling::{power_heuristic, Rng};
 use crate::scene::{Scene, SurfaceHit};
@@ -532,7 +530,7 @@ impl Vcm<'_> {
                     None => values.push((i, None, Vec3::ZERO)),
                 }
             }
-            walk_cameras(self.scene, &mut paths);
+            walk_together(self.scene, &mut paths);
             let walked = paths
                 .into_iter()
                 .map(|path| (Some(path.rng.clone()), wl.to_rgb(camera_radiance(path))));

@@ -5,8 +5,8 @@
 //! or vcm's mixture aimed at mirrors and glass), and carries the throughput on through
 //! [`continue_light`]: Veach's correction for interpolated normals, Russian roulette, the
 //! spectral hero's termination at a dispersive surface, absorption inside glass and the depth,
-//! written once. Over a large mesh [`walk_lights`] takes many walks together, a wave of rays
-//! per bounce ([`in_waves`], which the camera side's walks share). (The course
+//! written once. Over a large mesh [`walk_together`] takes many walks together, a wave of rays
+//! per bounce, the camera side's as the light side's. (The course
 //! model's caustic photons follow the course's own Phong rules, not a BSDF: their loop is
 //! [`super::trace::trace_path`].)
 
@@ -370,7 +370,7 @@ pub fn walk_light(
     walk.rays
 }
 
-/// A light walk between its rays: [`walk_light`] takes one to its end; [`walk_lights`] takes
+/// A light walk between its rays: [`walk_light`] takes one to its end; [`walk_together`] takes
 /// many a ray at a time, tracing each wave of rays together.
 #[derive(Clone, Debug)]
 pub struct LightWalk {
@@ -481,7 +481,7 @@ impl LightWalk {
     }
 }
 
-/// The waves a caller of [`walk_lights`] splits the light paths `indices` into, in order:
+/// The waves a caller of [`walk_together`] splits the light paths `indices` into, in order:
 /// `together` (where streams pay, [`Scene::streams_pay`]), 256 paths a wave, enough for the
 /// stream's loads to overlap, as a tile's camera paths; else one path a wave, whose walk keeps
 /// its own state and output in the cache (waves of 256 there made `vcm` 11–17% and `lt` 6–9%
@@ -495,11 +495,40 @@ pub fn light_waves(together: bool, indices: Range<u64>) -> impl Iterator<Item = 
         .map(move |first| first..(first + wave as u64).min(end))
 }
 
-/// One of the light paths [`walk_lights`] takes together: its walk, wavelengths, random stream
-/// and visitor.
-pub struct LightPath<V> {
+/// A light path [`walk_together`] takes with others.
+pub type LightPath<V> = Walker<LightWalk, V>;
+
+impl<V: LightVisitor> Walk<V> for LightWalk {
+    fn next_ray(&self) -> Option<&Ray> {
+        self.pending()
+    }
+
+    fn take_step(&mut self, scene: &Scene, step: &Step, wl: &Wavelengths, rng: &mut Rng, visitor: &mut V) {
+        self.arrive(scene, step, wl, rng, visitor);
+    }
+
+    fn walk_to_end(&mut self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng, visitor: &mut V) {
+        self.finish(scene, wl, rng, visitor);
+    }
+}
+
+/// A walk between its rays whose vertices a visitor `V` takes: the camera side's
+/// [`CameraWalk`](crate::integrator::camera_walk::CameraWalk) or the light side's [`LightWalk`].
+pub trait Walk<V> {
+    /// The ray it follows next; `None` once it has ended.
+    fn next_ray(&self) -> Option<&Ray>;
+
+    /// Takes the pending ray's `step` (where its segment ends).
+    fn take_step(&mut self, scene: &Scene, step: &Step, wl: &Wavelengths, rng: &mut Rng, visitor: &mut V);
+
+    /// Takes it to its end a ray at a time, media sampled on the way.
+    fn walk_to_end(&mut self, scene: &Scene, wl: &Wavelengths, rng: &mut Rng, visitor: &mut V);
+}
+
+/// One of the paths [`walk_together`] takes: its walk, wavelengths, random stream and visitor.
+pub struct Walker<W, V> {
     /// The walk.
-    pub walk: LightWalk,
+    pub walk: W,
     /// Its wavelengths.
     pub wl: Wavelengths,
     /// Its random stream.
@@ -508,52 +537,28 @@ pub struct LightPath<V> {
     pub visitor: V,
 }
 
-impl<V: LightVisitor> Wave for LightPath<V> {
-    fn pending_ray(&self) -> Option<&Ray> {
-        self.walk.pending()
-    }
-
-    fn take_step(&mut self, scene: &Scene, step: Step) {
-        self.walk
-            .arrive(scene, &step, &self.wl, &mut self.rng, &mut self.visitor);
-    }
-}
-
-/// Takes every path's walk to its end, as [`walk_light`] would one by one and with the same
-/// results: in waves ([`in_waves`]), or one at a time in scenes with media (or if there is one).
-#[inline]
-pub fn walk_lights<V: LightVisitor>(scene: &Scene, paths: &mut [LightPath<V>]) {
-    if !scene.has_media() && paths.len() > 1 {
-        return in_waves(scene, paths);
-    }
-    for p in paths {
-        p.walk.finish(scene, &p.wl, &mut p.rng, &mut p.visitor);
-    }
-}
-
-/// How many walks ahead of the one taking its step [`in_waves`] fetches a hit's vertex indices.
+/// How many walks ahead of the one taking its step [`walk_together`] fetches a hit's vertex
+/// indices.
 const PREFETCH_AHEAD: usize = 4;
 
-/// A walk that [`in_waves`] steps alongside others: a camera path or a light path.
-pub trait Wave {
-    /// The ray it follows next; `None` once it has ended.
-    fn pending_ray(&self) -> Option<&Ray>;
-
-    /// Takes the pending ray's `step` (where its segment ends).
-    fn take_step(&mut self, scene: &Scene, step: Step);
-}
-
-/// Takes every walk to its end a ray at a time, in waves: the pending rays of all live walks
-/// are traced together ([`Scene::intersect_stream`]), then each walk takes its step. Each walk
-/// takes the same steps as alone only where a segment ends at its closest hit: in scenes
-/// without media (the callers' check).
-pub fn in_waves<W: Wave>(scene: &Scene, walks: &mut [W]) {
-    debug_assert!(!scene.has_media(), "a segment through a medium draws its end");
-    let mut live: Vec<usize> = (0..walks.len()).filter(|&i| walks[i].pending_ray().is_some()).collect();
+/// Takes every walker's walk to its end, as each alone would and with the same results, in
+/// waves: the pending rays of all live walks are traced together ([`Scene::intersect_stream`]),
+/// then each walk takes its step. In scenes with media (where a segment's end depends on the
+/// path's random numbers), or for one walker, the walks go one at a time.
+pub fn walk_together<W: Walk<V>, V>(scene: &Scene, walkers: &mut [Walker<W, V>]) {
+    if scene.has_media() || walkers.len() < 2 {
+        for w in walkers {
+            w.walk.walk_to_end(scene, &w.wl, &mut w.rng, &mut w.visitor);
+        }
+        return;
+    }
+    let mut live: Vec<usize> = (0..walkers.len())
+        .filter(|&i| walkers[i].walk.next_ray().is_some())
+        .collect();
     let (mut rays, mut hits) = (Vec::with_capacity(live.len()), Vec::with_capacity(live.len()));
     while !live.is_empty() {
         rays.clear();
-        rays.extend(live.iter().map(|&i| *walks[i].pending_ray().expect("a live walk")));
+        rays.extend(live.iter().map(|&i| *walkers[i].walk.next_ray().expect("a live walk")));
         hits.resize(live.len(), None);
         scene.intersect_stream(&rays, &mut hits);
         // A large mesh's hits miss the cache twice before shading (the triangle's reference,
@@ -566,9 +571,10 @@ pub fn in_waves<W: Wave>(scene: &Scene, walks: &mut [W]) {
                 scene.prefetch_indices(hit);
             }
             let (ray, &hit) = wave.next().expect("one ray per live walk");
-            let walk = &mut walks[i];
-            walk.take_step(scene, Step::without_media(scene, ray, hit));
-            walk.pending_ray().is_some()
+            let w = &mut walkers[i];
+            let step = Step::without_media(scene, ray, hit);
+            w.walk.take_step(scene, &step, &w.wl, &mut w.rng, &mut w.visitor);
+            w.walk.next_ray().is_some()
         });
     }
 }

@@ -12,7 +12,7 @@
 //! - [`PhysicalPhotons`]: photons scatter by the same BSDF the camera paths use and are stored
 //!   wherever they meet a smooth (diffuse or glossy) surface, their history in their flags;
 //!   Russian roulette keeps each photon's flux nearly constant. They walk the light side's one
-//!   walk, a wave of photons at a time ([`walk_lights`]), as the light tracer's paths and vcm's
+//!   walk, a wave of photons at a time ([`walk_together`]), as the light tracer's paths and vcm's
 //!   light subpaths do.
 //!
 //! Two drivers emit: [`super::budget::trace_photons`] stores a budget of caustic photons shared
@@ -21,7 +21,7 @@
 //! random stream and batches are concatenated in order.
 
 use super::light_walk::{
-    light_waves, walk_lights, LightArrival, LightPath, LightVisitor, LightWalk, MediumArrival, Roulette,
+    light_waves, walk_together, LightArrival, LightPath, LightVisitor, LightWalk, MediumArrival, Roulette, Walker,
 };
 use super::{Photon, DIFFUSE, DISPERSED, MAX_BOUNCES_LEFT, REFLECTED, REFRACTED};
 use crate::bsdf::{BsdfSample, Transport};
@@ -85,7 +85,7 @@ pub fn trace_count_in_media(
                     // One path a wave: straight into the batch's lists.
                     // Walked where it was made: moving it out of the `Option` copied it.
                     let mut path = emitter.start(wave.start, (&mut out, &mut volume));
-                    walk_lights(scene, path.as_mut_slice());
+                    walk_together(scene, path.as_mut_slice());
                     continue;
                 }
                 // Each path stores into its own lists, appended in photon order.
@@ -94,7 +94,7 @@ pub fn trace_count_in_media(
                     .zip(&mut own)
                     .filter_map(|(i, (out, volume))| emitter.start(i, (out, volume)))
                     .collect();
-                walk_lights(scene, &mut paths);
+                walk_together(scene, &mut paths);
                 for (path_out, path_volume) in &mut own {
                     out.append(path_out);
                     volume.append(path_volume);
@@ -132,7 +132,7 @@ impl PhotonEmitter<'_> {
         let flux = emitted.throughput * self.scale;
         let medium = scene.light_medium(emitted.light);
         let surfaces = self.max_bounces.saturating_add(1);
-        Some(LightPath {
+        Some(Walker {
             walk: LightWalk::new(scene, emitted.ray, (flux, medium), surfaces),
             wl: *self.wl,
             rng,

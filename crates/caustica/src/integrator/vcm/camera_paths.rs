@@ -3,7 +3,7 @@
 //! ([`super::merging`]), every strategy weighted by [`mis`].
 
 use super::*;
-use crate::photon::light_walk::{MediumArrival, Passage};
+use crate::photon::light_walk::{walk_together, MediumArrival, Passage, Walker};
 
 /// One camera subpath on its walk: its MIS sums, the variants merging at the first vertex
 /// needs, and the radiance gathered.
@@ -221,7 +221,7 @@ impl<'a> Vcm<'a> {
         let Some(mut path) = self.camera_subpath(ray, (pass, own), wl, rng.clone(), work) else {
             return Spectrum::ZERO;
         };
-        walk_cameras(self.scene, std::slice::from_mut(&mut path));
+        walk_together(self.scene, std::slice::from_mut(&mut path));
         *rng = path.rng.clone();
         camera_radiance(path)
     }
@@ -256,7 +256,7 @@ impl<'a> Vcm<'a> {
             smooth_before: false,
             first_focused: false,
         };
-        Some(CameraPath {
+        Some(Walker {
             walk: CameraWalk::new(self.scene, ray, wl, (self.max_length, ROULETTE_DEPTH)),
             wl: *wl,
             rng,

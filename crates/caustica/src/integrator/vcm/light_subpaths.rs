@@ -3,7 +3,7 @@
 //! off Lambertian surfaces aimed at the mirrors and glass.
 
 use super::*;
-use crate::photon::light_walk::{light_waves, walk_lights, LightPath, LightWalk, MediumArrival};
+use crate::photon::light_walk::{light_waves, walk_together, LightPath, LightWalk, MediumArrival, Walker};
 
 /// Mixed into the seed of the streams joins to the eye draw from.
 const EYE_SEED: u64 = 0x6579_6573_7663_6d21;
@@ -24,7 +24,7 @@ impl<'a> Vcm<'a> {
         let emission = self.emitters.emit(scene, wl, &mut rng)?;
         let surfaces = self.max_length.saturating_sub(1);
         let carried = (emission.throughput, scene.light_medium(emission.light));
-        Some(LightPath {
+        Some(Walker {
             walk: LightWalk::new(scene, emission.ray, carried, surfaces),
             wl: *wl,
             rng,
@@ -62,7 +62,7 @@ impl<'a> Vcm<'a> {
                 // One path a wave: straight into the batch's lists.
                 // Walked where it was made: moving it out of the `Option` copied it.
                 let mut path = self.start_light((pass, wave.start), fw, to_eye, out);
-                walk_lights(self.scene, path.as_mut_slice());
+                walk_together(self.scene, path.as_mut_slice());
                 if let Some(path) = path.as_mut() {
                     path.visitor.out.rays += path.walk.rays();
                 }
@@ -74,7 +74,7 @@ impl<'a> Vcm<'a> {
                 .zip(own.iter_mut())
                 .filter_map(|(i, path_out)| self.start_light((pass, i), fw, to_eye, path_out))
                 .collect();
-            walk_lights(self.scene, &mut paths);
+            walk_together(self.scene, &mut paths);
             for path in paths {
                 path.visitor.out.rays += path.walk.rays();
             }
