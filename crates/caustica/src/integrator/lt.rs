@@ -248,7 +248,6 @@ impl<'a> LightTracer<'a> {
         for wave in light_waves(self.scene.streams_pay(), indices) {
             if wave.end - wave.start == 1 {
                 // One path a wave: straight into the batch's list.
-                // Walked where it was made: moving it out of the `Option` copied it.
                 let mut path = self.start((pass, wave.start), wl, &mut out);
                 walk_together(self.scene, path.as_mut_slice());
                 continue;

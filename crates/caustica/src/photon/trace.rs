@@ -83,7 +83,6 @@ pub fn trace_count_in_media(
             for wave in light_waves(scene.streams_pay(), b * BATCH..((b + 1) * BATCH).min(count)) {
                 if wave.end - wave.start == 1 {
                     // One path a wave: straight into the batch's lists.
-                    // Walked where it was made: moving it out of the `Option` copied it.
                     let mut path = emitter.start(wave.start, (&mut out, &mut volume));
                     walk_together(scene, path.as_mut_slice());
                     continue;

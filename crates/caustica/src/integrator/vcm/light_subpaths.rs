@@ -60,7 +60,6 @@ impl<'a> Vcm<'a> {
         for wave in light_waves(self.waves, indices) {
             if wave.end - wave.start == 1 {
                 // One path a wave: straight into the batch's lists.
-                // Walked where it was made: moving it out of the `Option` copied it.
                 let mut path = self.start_light((pass, wave.start), fw, to_eye, out);
                 walk_together(self.scene, path.as_mut_slice());
                 if let Some(path) = path.as_mut() {
