@@ -316,7 +316,7 @@ pub fn continue_camera(
 mod tests {
     use super::*;
     use crate::medium::VACUUM;
-    use crate::photon::light_walk::{walk_light, walk_together, LightArrival, LightPath, LightVisitor, LightWalk};
+    use crate::photon::light_walk::{walk_light, walk_together, LightArrival, LightVisitor, LightWalk};
     use crate::scene::build::test_scene;
 
     /// Every arrival's length and throughput, and the escapes.
@@ -351,6 +351,26 @@ mod tests {
         }
     }
 
+    /// 200 walkers of `walk(ray)` from `start`'s rays and random streams, each recording its
+    /// arrivals.
+    fn walkers<W>(
+        start: &impl Fn(u64) -> (Ray, Rng),
+        wl: Wavelengths,
+        walk: impl Fn(Ray) -> W,
+    ) -> Vec<Walker<W, Record>> {
+        (0..200)
+            .map(|i| {
+                let (ray, rng) = start(i);
+                Walker {
+                    walk: walk(ray),
+                    wl,
+                    rng,
+                    visitor: Record::default(),
+                }
+            })
+            .collect()
+    }
+
     /// Camera walks and light walks taken together, a wave of rays per bounce, make the same arrivals in the
     /// same order with the same numbers as each walk alone: in a closed room around a bumpy
     /// mesh that walks its tree, with Russian roulette, and in the same room filled with fog
@@ -371,17 +391,7 @@ mod tests {
                 (Ray::new(Vec3::new(0.0, 0.0, 2.5), dir), rng)
             };
             let limits = (12, 2);
-            let mut paths: Vec<CameraPath<Record>> = (0..200)
-                .map(|i| {
-                    let (ray, rng) = start(i);
-                    CameraPath {
-                        walk: CameraWalk::new(&scene, ray, &wl, limits),
-                        wl,
-                        rng,
-                        visitor: Record::default(),
-                    }
-                })
-                .collect();
+            let mut paths = walkers(&start, wl, |ray| CameraWalk::new(&scene, ray, &wl, limits));
             walk_together(&scene, &mut paths);
             let mut surfaces = 0;
             for (i, together) in paths.iter_mut().enumerate() {
@@ -398,17 +408,7 @@ mod tests {
 
             // Light walks the same way, from the same rays, with their own roulette.
             let carried = (wl.grey(2.0), scene.camera_medium());
-            let mut paths: Vec<LightPath<Record>> = (0..200)
-                .map(|i| {
-                    let (ray, rng) = start(i);
-                    LightPath {
-                        walk: LightWalk::new(&scene, ray, carried, 12),
-                        wl,
-                        rng,
-                        visitor: Record::default(),
-                    }
-                })
-                .collect();
+            let mut paths = walkers(&start, wl, |ray| LightWalk::new(&scene, ray, carried, 12));
             walk_together(&scene, &mut paths);
             let mut surfaces = 0;
             for (i, together) in paths.iter_mut().enumerate() {
