@@ -34,7 +34,7 @@ mod rough_dielectric;
 
 use crate::description::{ClearCoat, Coating};
 use crate::material::{Lobes, MaterialRef, MaterialSpectra, PhysicalMaterial, SurfaceParams};
-use crate::math::{reflect, Frame, Vec3, Vec4};
+use crate::math::{reflect, sin_cos_turns, Frame, Vec3, Vec4};
 use crate::medium::{henyey_greenstein, Phase};
 use crate::sampling::sample_cosine_hemisphere;
 use crate::scene::{Scene, SurfaceHit};
@@ -736,8 +736,8 @@ impl Bsdf {
                 let r = reflect(-wo, n);
                 let cos_a = u.x.powf(1.0 / (self.exponent + 1.0));
                 let sin_a = (1.0 - cos_a * cos_a).max(0.0).sqrt();
-                let phi = 2.0 * PI * u.y;
-                Frame::from_normal(r).to_world(Vec3::new(sin_a * phi.cos(), sin_a * phi.sin(), cos_a))
+                let (sin, cos) = sin_cos_turns(u.y);
+                Frame::from_normal(r).to_world(Vec3::new(sin_a * cos, sin_a * sin, cos_a))
             };
             return self.smooth_sample(wo, wi);
         }
@@ -1097,8 +1097,8 @@ impl Microfacet {
         let tan2 = a2 * x / (1.0 - x);
         let cos_h = 1.0 / (1.0 + tan2).sqrt();
         let sin_h = (1.0 - cos_h * cos_h).max(0.0).sqrt();
-        let phi = 2.0 * PI * u.y;
-        let h = frame.to_world(Vec3::new(sin_h * phi.cos(), sin_h * phi.sin(), cos_h));
+        let (sin, cos) = sin_cos_turns(u.y);
+        let h = frame.to_world(Vec3::new(sin_h * cos, sin_h * sin, cos_h));
         let wo_h = wo.dot(h);
         (wo_h > 0.0).then(|| 2.0 * wo_h * h - wo)
     }

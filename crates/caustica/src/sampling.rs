@@ -3,7 +3,7 @@
 //! Every pixel and every photon draws from its own stream, derived from (seed, index), so images
 //! and photon maps do not depend on the number of threads.
 
-use crate::math::{Frame, Vec2, Vec3};
+use crate::math::{sin_cos_turns, Frame, Vec2, Vec3};
 use std::f32::consts::PI;
 
 /// A small, fast generator (PCG-XSH-RR 64/32) with an independent stream per index.
@@ -64,8 +64,8 @@ pub fn mix64(mut z: u64) -> u64 {
 pub fn sample_uniform_sphere(u: Vec2) -> Vec3 {
     let z = 1.0 - 2.0 * u.x;
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin, cos) = sin_cos_turns(u.y);
+    Vec3::new(r * cos, r * sin, z)
 }
 
 /// Solid-angle pdf of [`sample_uniform_sphere`].
@@ -77,10 +77,16 @@ pub fn uniform_sphere_pdf() -> f32 {
 /// A direction in the cone of half-angle `acos(cos_max)` around `axis`, uniform in solid angle.
 #[inline]
 pub fn sample_uniform_cone(u: Vec2, axis: Vec3, cos_max: f32) -> Vec3 {
+    Frame::from_normal(axis).to_world(sample_uniform_cone_local(u, cos_max))
+}
+
+/// [`sample_uniform_cone`] about +z.
+#[inline]
+pub fn sample_uniform_cone_local(u: Vec2, cos_max: f32) -> Vec3 {
     let cos_theta = 1.0 - u.x * (1.0 - cos_max);
     let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let phi = 2.0 * PI * u.y;
-    Frame::from_normal(axis).to_world(Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta))
+    let (sin, cos) = sin_cos_turns(u.y);
+    Vec3::new(sin_theta * cos, sin_theta * sin, cos_theta)
 }
 
 /// Solid-angle pdf of [`sample_uniform_cone`] inside the cone.
@@ -96,19 +102,25 @@ pub fn sample_uniform_disc(u: Vec2) -> Vec2 {
     if a.x == 0.0 && a.y == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, theta) = if a.x.abs() > a.y.abs() {
-        (a.x, PI / 4.0 * (a.y / a.x))
+    // The angle in turns: π/4·(y/x) is an eighth of a turn times y/x.
+    let (r, turns) = if a.x.abs() > a.y.abs() {
+        (a.x, 0.125 * (a.y / a.x))
     } else {
-        (a.y, PI / 2.0 - PI / 4.0 * (a.x / a.y))
+        (a.y, 0.25 - 0.125 * (a.x / a.y))
     };
-    Vec2::new(r * theta.cos(), r * theta.sin())
+    let (sin, cos) = sin_cos_turns(turns);
+    Vec2::new(r * cos, r * sin)
 }
 
 /// A cosine-weighted direction about +z.
 #[inline]
 pub fn sample_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = sample_uniform_disc(u);
-    Vec3::new(d.x, d.y, (1.0 - d.length_squared()).max(0.0).sqrt())
+    // A point of the unit disc by radius √u.x and angle (not the concentric map, whose
+    // coin-flip branch and division cost more than its stratification gives random numbers),
+    // lifted onto the hemisphere.
+    let r = u.x.sqrt();
+    let (sin, cos) = sin_cos_turns(u.y);
+    Vec3::new(r * cos, r * sin, (1.0 - u.x).max(0.0).sqrt())
 }
 
 /// Solid-angle pdf of [`sample_cosine_hemisphere`] for a direction with `cos_theta` to +z.

@@ -8,8 +8,7 @@
 //! refracts one into the other.
 
 use super::{fresnel_dielectric, Fresnel, Microfacet, Transport};
-use crate::math::{refract, Vec3};
-use std::f32::consts::PI;
+use crate::math::{refract, sin_cos_turns, Vec3};
 
 /// One side's view of a rough dielectric interface.
 #[derive(Clone, Copy, Debug)]
@@ -120,11 +119,11 @@ impl Microfacet {
         };
         let t2 = v.cross(t1);
         let r = u.x.sqrt();
-        let phi = 2.0 * PI * u.y;
-        let p1 = r * phi.cos();
+        let (sin, cos) = sin_cos_turns(u.y);
+        let p1 = r * cos;
         // The half of the disc hidden behind `wo` is squeezed onto the seen half.
         let s = 0.5 * (1.0 + v.z);
-        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
+        let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * sin;
         let pz = (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
         let n = p1 * t1 + p2 * t2 + pz * v;
         Vec3::new(a * n.x, a * n.y, n.z.max(1e-6)).normalize()

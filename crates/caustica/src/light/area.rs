@@ -18,7 +18,7 @@ use crate::geometry::ShapeKind;
 use crate::math::{offset_origin, Frame, Ray};
 use crate::math::{Mat3, Vec2, Vec3};
 use crate::sampling::{sample_cosine_hemisphere, Rng};
-use crate::sampling::{sample_uniform_cone, sample_uniform_disc, sample_uniform_sphere, uniform_cone_pdf};
+use crate::sampling::{sample_uniform_cone_local, sample_uniform_disc, sample_uniform_sphere, uniform_cone_pdf};
 use crate::scene::{ObjectRef, Scene};
 use std::f32::consts::PI;
 
@@ -279,9 +279,18 @@ impl AreaLight {
             let to = center - from;
             let d2 = to.length_squared();
             if let Some(cos_max) = cone_cosine_at(d2, radius) {
-                let axis = to * d2.sqrt().recip();
-                let dir = sample_uniform_cone(u, axis, cos_max);
-                let t = ray_sphere(from, dir, center, radius)?;
+                let d = d2.sqrt();
+                let local = sample_uniform_cone_local(u, cos_max);
+                let dir = Frame::from_normal(to * d.recip()).to_world(local);
+                // The nearest hit from the cone's angle θ, not by testing the ray, so that it
+                // does not wait for `dir`: the ray passes closest to the centre d·cosθ along it,
+                // (r² − d²·sin²θ)^½ after the sphere's near side (clamped: a direction at the
+                // cone's rim can graze past it by rounding).
+                let sin2 = (1.0 - local.z * local.z).max(0.0);
+                let t = d * local.z - (radius * radius - d2 * sin2).max(0.0).sqrt();
+                if t.is_nan() || t <= 0.0 {
+                    return None;
+                }
                 let point = from + dir * t;
                 let Sampler::Shape { prim, .. } = &self.sampler else {
                     return None;
@@ -353,17 +362,6 @@ fn cone_cosine_at(d2: f32, radius: f32) -> Option<f32> {
         return None;
     }
     Some((1.0 - sin2).sqrt())
-}
-
-/// The nearest positive hit of a unit ray on a sphere.
-fn ray_sphere(origin: Vec3, dir: Vec3, center: Vec3, radius: f32) -> Option<f32> {
-    let oc = origin - center;
-    let b = oc.dot(dir);
-    let c = oc.length_squared() - radius * radius;
-    // A direction inside the cone can graze past the rim by rounding: clamp to the tangent.
-    let disc = (b * b - c).max(0.0);
-    let t = -b - disc.sqrt();
-    (t > 0.0).then_some(t)
 }
 
 /// An area density at `point` (normal `normal`) seen from `from`, in solid angle.

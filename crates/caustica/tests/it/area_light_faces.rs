@@ -99,12 +99,13 @@ fn one_sided_lights_emit_from_their_front_in_every_integrator() {
     let (down, up) = (disk_scene(true), disk_scene(false));
     assert!(down.warnings().is_empty(), "{:?}", down.warnings());
     // (integrator, passes, photons or light paths a pass, bound on the floor's worst block).
-    // The bounds are about twice the errors measured at these seeds and budgets.
+    // The bounds are about twice the errors measured at these seeds and budgets (lt's: 1.0%
+    // since 2026-12-07's change of the warps' angles).
     let cases: [(&str, u64, usize, f32); 5] = [
         ("path", 128, 0, 0.03),
         ("ppm", 64, 20_000, 0.04),
         ("gi", 64, 20_000, 0.04),
-        ("lt", 64, 50_000, 0.01),
+        ("lt", 64, 50_000, 0.02),
         ("vcm", 96, 20_000, 0.03),
     ];
     let mut failures = Vec::new();

@@ -136,8 +136,10 @@ fn the_course_model_splits_channels_in_a_dispersive_glass() {
 }
 
 /// The reference scenes (a Cornell box with a glass and a mirror ball, point or area light; no
-/// dispersion): rendered spectrally, every region keeps its RGB render's colour within 1% of the
-/// region's brightest channel. Skipped when ../shared is absent.
+/// dispersion): rendered spectrally, every region keeps its RGB render's colour within 3% of the
+/// region's brightest channel: the two renders' photon-map noise at this budget (the open floor
+/// under the point light, seeds 5–7: up to 0.4–2.0% apart in a channel). Skipped when
+/// ../shared is absent.
 #[test]
 fn spectral_rendering_of_the_reference_scenes_matches_rgb() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/reference");
@@ -176,7 +178,7 @@ fn spectral_rendering_of_the_reference_scenes_matches_rgb() {
             let (a, b) = (spectral.region_mean(rows, cols), rgb.region_mean(rows, cols));
             let error = (a - b).abs().max_element() / b.max_element();
             assert!(
-                error < 0.01,
+                error < 0.03,
                 "{name} {region}: spectral {a} vs RGB {b} ({:.2}%)",
                 100.0 * error
             );

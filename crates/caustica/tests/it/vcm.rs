@@ -125,9 +125,13 @@ fn path_quadrants(s: &caustica::scene::Scene, depth: u32, passes: u64) -> [f32; 
 
 /// On a purely diffuse scene (with many bounces of light between coloured walls) `vcm`, with
 /// and without inner connections, agrees with the path tracer, and light tracing with both
-/// wherever it sees the same thing (the quadrants below the lamp): each quadrant within 2%.
+/// wherever it sees the same thing (the quadrants below the lamp): each quadrant within 2%, the
+/// lower left's vcm within 3% (merging darkens the box's corners there: 1.6% at 512 passes,
+/// measured before and after 2026-12-07's change of the warps' angles, with lt and the path
+/// tracer agreeing within 0.3%).
 #[test]
 fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
+    const VCM_QUADRANT_BOUNDS: [f32; 4] = [0.02, 0.02, 0.03, 0.02];
     let s = scene(DIFFUSE_BOX);
     let depth = 6;
     let reference = path_quadrants(&s, depth, 2048);
@@ -143,7 +147,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
         for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
             eprintln!("connections {connections}, quadrant {i}: vcm {g:.4} path {r:.4}");
             assert!(
-                rel(*g, *r) < 0.02,
+                rel(*g, *r) < VCM_QUADRANT_BOUNDS[i],
                 "connections {connections}, quadrant {i}: vcm {g} against path {r}"
             );
         }
@@ -165,7 +169,7 @@ fn lt_path_and_vcm_agree_on_a_diffuse_scene() {
     for (i, (g, r)) in got.iter().zip(&reference).enumerate() {
         eprintln!("resized passes, quadrant {i}: vcm {g:.4} path {r:.4}");
         assert!(
-            rel(*g, *r) < 0.02,
+            rel(*g, *r) < VCM_QUADRANT_BOUNDS[i],
             "resized passes, quadrant {i}: vcm {g} against path {r}"
         );
     }
@@ -273,13 +277,17 @@ fn vcm_pilots_are_a_cancellable_step_before_the_passes() {
 fn vcm_passes_weigh_their_light_subpaths() {
     let s = scene(DIFFUSE_BOX);
     let vcm = prepared(&s, VcmSettings::default(), 32, 32, 7);
+    // Half as many, rounded up: the pilots may choose an odd count.
+    let full = vcm.chosen_paths_per_pass().expect("the pilots ran");
+    let half = full.div_ceil(2) as f64 / full as f64;
+    assert!((half - 0.5).abs() <= 0.5 / full as f64);
     assert_eq!(
         (vcm.pass_weight(0), vcm.pass_weight(1), vcm.pass_weight(2)),
-        (0.5, 0.5, 1.0)
+        (half, half, 1.0)
     );
-    assert_eq!(vcm.pass_cost(1), 0.5);
+    assert_eq!(vcm.pass_cost(1), half);
     let own = vcm.render_pass(0, control()).unwrap();
-    assert_eq!(vcm.render_share(0, 0.5, control()).unwrap(), own);
+    assert_eq!(vcm.render_share(0, half, control()).unwrap(), own);
     assert_ne!(vcm.render_share(0, 0.75, control()).unwrap(), own);
     assert_deterministic_and_merges(&vcm, 32, 32);
 }
@@ -288,9 +296,11 @@ fn vcm_passes_weigh_their_light_subpaths() {
 /// reference, a particle tracer's image, is black there; vcm sees through them). The caustic's
 /// line is its part left of the glass sphere's silhouette.
 const CAUSTIC: Region = ("glass caustic", (137, 138), (42, 44));
-const REGIONS: [Region; 6] = [
+/// The glass ball's shadow: dim, so its noise at [`PASSES`] is about 1.2% (under the point
+/// light, six seeds before and after 2026-12-07's change of the warps' angles: 0.3–2.5% off).
+const SHADOW: Region = ("shadow", (150, 156), (112, 132));
+const REGIONS: [Region; 5] = [
     ("lit floor", (150, 158), (60, 90)),
-    ("shadow", (150, 156), (112, 132)),
     ("back wall", (40, 70), (60, 100)),
     ("left wall", (60, 100), (5, 20)),
     ("right wall", (60, 100), (140, 155)),
@@ -301,9 +311,10 @@ const REGIONS: [Region; 6] = [
 const REFERENCE_DEPTH: u32 = 8;
 
 /// On the Cornell box with a glass and a mirror ball, under the point light and under the
-/// small area light, every region within 2% of the independent reference, and the caustic's
-/// line within 3% (light tracing keeps it whole, no kernel blurs it; its six pixels carry about
-/// 1.4% noise at this count of light paths; measured 1.39% and 0.64% off, the worst region 0.86%).
+/// small area light, every region within 2% of the independent reference, the shadow within 4%,
+/// and the caustic's line within 3% (light tracing keeps it whole, no kernel blurs it; its six
+/// pixels carry about 1.4% noise at this count of light paths; measured 1.39% and 0.64% off,
+/// the worst region 0.86%).
 #[test]
 #[cfg_attr(not(caustica_reference), ignore = "../shared/reference is absent")]
 fn vcm_converges_to_the_cornell_references() {
@@ -319,14 +330,16 @@ fn vcm_converges_to_the_cornell_references() {
         let film = render_passes(&vcm, w, h, 0, PASSES).film();
         let (worst, text) = report(&film, &reference, &REGIONS);
         let caustic = region_error(&film, &reference, CAUSTIC);
-        eprintln!(
-            "vcm, {light} light, {PASSES} passes:\n{text}  glass caustic: {:.2}%",
+        let shadow = region_error(&film, &reference, SHADOW);
+        let text = format!(
+            "{text}  shadow: {:.2}%\n  glass caustic: {:.2}%",
+            100.0 * shadow,
             100.0 * caustic
         );
+        eprintln!("vcm, {light} light, {PASSES} passes:\n{text}");
         assert!(
-            worst < 0.02 && caustic < 0.03,
-            "{light} light:\n{text}  glass caustic: {:.2}%",
-            100.0 * caustic
+            worst < 0.02 && shadow < 0.04 && caustic < 0.03,
+            "{light} light:\n{text}"
         );
     }
 }
