@@ -220,9 +220,9 @@ pub fn luminance(c: Vec3) -> f32 {
 }
 
 /// `(sin, cos)` of `turns` whole turns (the angle 2π·`turns`), to within 2·10⁻⁷ for |`turns`| up
-/// to 2²². The sample warps' angles: inlined, without branches and without the C library's call,
-/// which made every caller spill its vector registers; plain arithmetic, so the same bits on
-/// every host.
+/// to 2²². The sample warps' angles: inlined and without branches, where the C library's
+/// `sincosf` was a call around which the caller kept its vector registers on the stack; plain
+/// arithmetic, so the same bits on every host.
 #[inline]
 pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
     // The nearest quarter turn, and the rest as an angle in [-π/4, π/4].
