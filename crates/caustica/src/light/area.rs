@@ -234,7 +234,7 @@ impl AreaLight {
                     return Some(AreaSample {
                         point: center + normal * radius,
                         normal,
-                        pdf_area: 1.0 / (4.0 * PI * radius * radius),
+                        pdf_area: sphere_area_pdf(radius),
                         prim: *prim,
                     });
                 }
@@ -302,7 +302,7 @@ impl AreaLight {
                         // square root, on next-event estimation's chain of dependent operations.
                         normal: (point - center) * radius.recip(),
                         // As `sample` draws it: uniform by area.
-                        pdf_area: 1.0 / (4.0 * PI * radius * radius),
+                        pdf_area: sphere_area_pdf(radius),
                         prim: *prim,
                     },
                     pdf_solid: uniform_cone_pdf(cos_max),
@@ -335,6 +335,10 @@ impl AreaLight {
     /// Area density of [`AreaLight::sample`] at a point of this light with unit world normal
     /// `normal`.
     pub fn pdf_area(&self, normal: Vec3) -> f32 {
+        // A sphere lamp's, the same everywhere: no transformed normal's length to work out.
+        if let Some((_, radius)) = self.sphere {
+            return sphere_area_pdf(radius);
+        }
         match &self.sampler {
             Sampler::Shape { linear, .. } => self.shape_pdf(linear, normal),
             Sampler::Mesh { area, .. } => 1.0 / area,
@@ -347,6 +351,12 @@ impl AreaLight {
         };
         (linear.transpose() * normal).length() / (object_area * det)
     }
+}
+
+/// The area density of a sphere of `radius` sampled uniformly by area.
+#[inline]
+fn sphere_area_pdf(radius: f32) -> f32 {
+    1.0 / (4.0 * PI * radius * radius)
 }
 
 /// The cosine of the half-angle a sphere subtends from `from`; `None` inside or on it.
