@@ -243,6 +243,12 @@ mod avx {
             F32x8(avx!(_mm256_loadu_ps(pair.as_ptr().cast::<f32>())))
         }
 
+        /// The lanes of `low`, then those of `high`.
+        #[inline(always)]
+        pub(crate) fn from_halves(low: glam::Vec4, high: glam::Vec4) -> F32x8 {
+            F32x8(avx!(_mm256_set_m128(high.into(), low.into())))
+        }
+
         /// The lanes as an array.
         #[inline(always)]
         pub(crate) fn to_array(self) -> [f32; 8] {

@@ -10,10 +10,17 @@
 use glam::Vec4;
 
 use super::triangle::{Triangle, TriangleHit, TriangleRay};
+#[cfg(target_arch = "x86_64")]
+use crate::accel::lanes::F32x8;
+use crate::accel::lanes::Lanes;
 use crate::math::Vec3;
 
 /// Lanes per packet.
 pub const LANES: usize = 4;
+
+/// Lanes of a [`PacketPair`]: the first packet's, then the second's.
+#[cfg(target_arch = "x86_64")]
+const PAIR_LANES: usize = 2 * LANES;
 
 /// Up to four triangles, vertex coordinates as lanes: `v[vertex][axis]` holds that coordinate of
 /// vertex `a`, `b` or `c` for each triangle. Unused lanes hold NaN and never hit.
@@ -47,38 +54,11 @@ impl TrianglePacket {
         Triangle::new(vertex(0), vertex(1), vertex(2))
     }
 
-    /// Hits with `0 < t < t_max` in each lane: the lanes hit (bit per lane) and, per lane, `t`
-    /// and the unnormalised barycentric weights with their sum.
+    /// Hits with `0 < t < t_max` in each lane: the lanes hit (bit per lane, edge lanes in the
+    /// bits above) and their `t` and barycentrics.
     #[inline(always)]
-    fn hits(&self, ray: &TriangleRay, t_max: f32) -> (u32, Lanes) {
-        let [kx, ky, kz] = ray.k;
-        let [ox, oy, oz] = ray.origin;
-        let [sx, sy] = ray.shear;
-        // Per vertex: coordinates relative to the origin, sheared so the ray runs along +z.
-        let sheared = |vertex: usize| {
-            let z = self.v[vertex][kz] - oz;
-            let x = (self.v[vertex][kx] - ox) - sx * z;
-            let y = (self.v[vertex][ky] - oy) - sy * z;
-            (x, y, z)
-        };
-        let (xa, ya, za) = sheared(0);
-        let (xb, yb, zb) = sheared(1);
-        let (xc, yc, zc) = sheared(2);
-        // Edge functions: the unnormalised barycentric weights of a, b and c.
-        let wa = xc * yb - yc * xb;
-        let wb = xa * yc - ya * xc;
-        let wc = xb * ya - yb * xa;
-        let zero = Vec4::ZERO;
-        let neg = wa.cmplt(zero) | wb.cmplt(zero) | wc.cmplt(zero);
-        let pos = wa.cmpgt(zero) | wb.cmpgt(zero) | wc.cmpgt(zero);
-        let det = wa + wb + wc;
-        let t = (wa * za + wb * zb + wc * zc) * ray.inv_dz / det;
-        // NaN lanes (unused, or det == 0) fail both comparisons.
-        let in_range = t.cmpgt(zero) & t.cmplt(Vec4::splat(t_max));
-        let hit = !(neg & pos) & in_range;
-        let on_edge = wa.cmpeq(zero) | wb.cmpeq(zero) | wc.cmpeq(zero);
-        let lanes = Lanes { t, wb, wc, det };
-        (hit.bitmask() | (on_edge.bitmask() << LANES), lanes)
+    fn hits(&self, ray: &TriangleRay, t_max: f32) -> (u32, LaneHits<LANES>) {
+        lane_hits(self, ray, t_max)
     }
 
     /// The nearest hit with `0 < t < t_max` and its lane; ties go to the lower lane, as testing
@@ -86,91 +66,229 @@ impl TrianglePacket {
     #[inline(always)]
     pub fn closest_hit(&self, ray: &TriangleRay, t_max: f32) -> Option<(usize, TriangleHit)> {
         let (mask, lanes) = self.hits(ray, t_max);
-        if mask >> LANES != 0 {
-            return self.closest_hit_on_edge(ray, t_max, mask, &lanes);
-        }
-        if mask == 0 {
-            return None;
-        }
-        // Missed lanes hold NaN or out-of-range values: take the minimum over hit lanes only.
-        let t = lanes.t.to_array();
-        let mut lane = mask.trailing_zeros() as usize;
-        let mut rest = mask & (mask - 1);
-        while rest != 0 {
-            let other = rest.trailing_zeros() as usize;
-            if t[other] < t[lane] {
-                lane = other;
-            }
-            rest &= rest - 1;
-        }
-        Some((lane, lanes.hit(lane)))
-    }
-
-    /// [`TrianglePacket::closest_hit`] when some lane has an edge function of exactly zero:
-    /// those lanes are settled by the scalar test.
-    #[cold]
-    fn closest_hit_on_edge(
-        &self,
-        ray: &TriangleRay,
-        t_max: f32,
-        mask: u32,
-        lanes: &Lanes,
-    ) -> Option<(usize, TriangleHit)> {
-        let mut best: Option<(usize, TriangleHit)> = None;
-        let mut t_max = t_max;
-        for lane in 0..LANES {
-            let hit = if mask & (1 << (LANES + lane)) != 0 {
-                self.triangle(lane).intersect_pre(ray, t_max)
-            } else if mask & (1 << lane) != 0 && lanes.t[lane] < t_max {
-                Some(lanes.hit(lane))
-            } else {
-                None
-            };
-            if let Some(h) = hit {
-                t_max = h.t;
-                best = Some((lane, h));
-            }
-        }
-        best
+        closest_of_lanes(mask, &lanes, |lane| self.triangle(lane), ray, t_max)
     }
 
     /// Calls `visit(lane, hit)` for each lane hit with `0 < t < t_max`, in lane order, until it
     /// returns `true`; returns whether it did.
     #[inline(always)]
-    pub fn each_hit(&self, ray: &TriangleRay, t_max: f32, mut visit: impl FnMut(usize, TriangleHit) -> bool) -> bool {
+    pub fn each_hit(&self, ray: &TriangleRay, t_max: f32, visit: impl FnMut(usize, TriangleHit) -> bool) -> bool {
         let (mask, lanes) = self.hits(ray, t_max);
-        if mask == 0 {
-            return false;
-        }
-        for lane in 0..LANES {
-            let hit = if mask & (1 << (LANES + lane)) != 0 {
-                self.triangle(lane).intersect_pre(ray, t_max)
-            } else if mask & (1 << lane) != 0 {
-                Some(lanes.hit(lane))
-            } else {
-                None
-            };
-            if let Some(h) = hit {
-                if visit(lane, h) {
-                    return true;
-                }
-            }
-        }
-        false
+        each_of_lanes(mask, &lanes, |lane| self.triangle(lane), ray, t_max, visit)
     }
 }
 
-/// Per-lane results of the packet test.
-struct Lanes {
-    t: Vec4,
-    wb: Vec4,
-    wc: Vec4,
-    det: Vec4,
+/// Two packets tested as one of eight lanes (the first packet's lanes, then the second's) in an
+/// AVX register: the same answers, to the bit, as testing the two one after the other, in one
+/// test instead of two. Its functions run AVX instructions: call them only inside
+/// [`in_avx`](crate::accel::lanes::in_avx).
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PacketPair<'a>(pub(crate) &'a [TrianglePacket; 2]);
+
+#[cfg(target_arch = "x86_64")]
+impl PacketPair<'_> {
+    #[inline(always)]
+    fn hits(&self, ray: &TriangleRay, t_max: f32) -> (u32, LaneHits<PAIR_LANES>) {
+        lane_hits(self, ray, t_max)
+    }
+
+    /// The triangle in `lane` of the eight.
+    fn triangle(&self, lane: usize) -> Triangle {
+        self.0[(lane / LANES) % 2].triangle(lane % LANES)
+    }
+
+    /// [`TrianglePacket::closest_hit`] over the eight lanes.
+    #[inline(always)]
+    pub(crate) fn closest_hit(&self, ray: &TriangleRay, t_max: f32) -> Option<(usize, TriangleHit)> {
+        let (mask, lanes) = self.hits(ray, t_max);
+        closest_of_lanes(mask, &lanes, |lane| self.triangle(lane), ray, t_max)
+    }
+
+    /// [`TrianglePacket::each_hit`] over the eight lanes.
+    #[inline(always)]
+    pub(crate) fn each_hit(
+        &self,
+        ray: &TriangleRay,
+        t_max: f32,
+        visit: impl FnMut(usize, TriangleHit) -> bool,
+    ) -> bool {
+        let (mask, lanes) = self.hits(ray, t_max);
+        each_of_lanes(mask, &lanes, |lane| self.triangle(lane), ray, t_max, visit)
+    }
 }
 
-impl Lanes {
+/// Where a packet test reads its triangles' coordinates, a vector of lanes at a time.
+trait Coordinates<L> {
+    /// That coordinate (`axis`) of vertex `a`, `b` or `c` (`vertex`) of each lane's triangle.
+    fn coordinate(&self, vertex: usize, axis: usize) -> L;
+}
+
+impl Coordinates<Vec4> for TrianglePacket {
+    #[inline(always)]
+    fn coordinate(&self, vertex: usize, axis: usize) -> Vec4 {
+        self.v[vertex][axis]
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Coordinates<F32x8> for PacketPair<'_> {
+    #[inline(always)]
+    fn coordinate(&self, vertex: usize, axis: usize) -> F32x8 {
+        let [first, second] = self.0;
+        F32x8::from_halves(first.v[vertex][axis], second.v[vertex][axis])
+    }
+}
+
+/// The watertight test of [`Triangle::intersect_pre`] with triangles in the lanes of `L`: the
+/// lanes hit with `0 < t < t_max` (bit per lane), those with an edge function of exactly zero
+/// (in the bits above), and per lane `t` and the unnormalised barycentric weights with their
+/// sum. No closures: one left out of line would run eight lanes outside the AVX code.
+#[inline(always)]
+fn lane_hits<L: Lanes, const N: usize>(
+    triangles: &impl Coordinates<L>,
+    ray: &TriangleRay,
+    t_max: f32,
+) -> (u32, LaneHits<N>) {
+    let (xa, ya, za) = sheared(triangles, 0, ray);
+    let (xb, yb, zb) = sheared(triangles, 1, ray);
+    let (xc, yc, zc) = sheared(triangles, 2, ray);
+    // Edge functions: the unnormalised barycentric weights of a, b and c.
+    let wa = xc * yb - yc * xb;
+    let wb = xa * yc - ya * xc;
+    let wc = xb * ya - yb * xa;
+    let zero = L::splat(0.0);
+    let neg = wa.lt(zero) | wb.lt(zero) | wc.lt(zero);
+    let pos = wa.gt(zero) | wb.gt(zero) | wc.gt(zero);
+    let det = wa + wb + wc;
+    let t = (wa * za + wb * zb + wc * zc) * L::splat(ray.inv_dz) / det;
+    // NaN lanes (unused, or det == 0) fail both comparisons.
+    let in_range = t.gt(zero) & t.lt(L::splat(t_max));
+    let hit = !(neg & pos) & in_range;
+    let on_edge = wa.eq(zero) | wb.eq(zero) | wc.eq(zero);
+    let mut lanes = LaneHits {
+        t: [0.0; N],
+        wb: [0.0; N],
+        wc: [0.0; N],
+        det: [0.0; N],
+    };
+    t.write_to(&mut lanes.t);
+    wb.write_to(&mut lanes.wb);
+    wc.write_to(&mut lanes.wc);
+    det.write_to(&mut lanes.det);
+    (L::bitmask(hit) | (L::bitmask(on_edge) << N), lanes)
+}
+
+/// A vertex's coordinates relative to the ray's origin, sheared so the ray runs along +z.
+#[inline(always)]
+fn sheared<L: Lanes>(triangles: &impl Coordinates<L>, vertex: usize, ray: &TriangleRay) -> (L, L, L) {
+    let [kx, ky, kz] = ray.k;
+    let z = triangles.coordinate(vertex, kz) - L::splat(ray.origin[2].x);
+    let x = (triangles.coordinate(vertex, kx) - L::splat(ray.origin[0].x)) - L::splat(ray.shear[0].x) * z;
+    let y = (triangles.coordinate(vertex, ky) - L::splat(ray.origin[1].x)) - L::splat(ray.shear[1].x) * z;
+    (x, y, z)
+}
+
+/// The nearest of the lanes `mask` reports hit ([`lane_hits`]); ties go to the lower lane.
+#[inline(always)]
+fn closest_of_lanes<const N: usize>(
+    mask: u32,
+    lanes: &LaneHits<N>,
+    triangle: impl Fn(usize) -> Triangle,
+    ray: &TriangleRay,
+    t_max: f32,
+) -> Option<(usize, TriangleHit)> {
+    if mask >> N != 0 {
+        return closest_on_edge(mask, lanes, triangle, ray, t_max);
+    }
+    if mask == 0 {
+        return None;
+    }
+    // Missed lanes hold NaN or out-of-range values: take the minimum over hit lanes only.
+    let t = &lanes.t;
+    let mut lane = mask.trailing_zeros() as usize % N;
+    let mut rest = mask & (mask - 1);
+    while rest != 0 {
+        let other = rest.trailing_zeros() as usize % N;
+        if t[other] < t[lane] {
+            lane = other;
+        }
+        rest &= rest - 1;
+    }
+    Some((lane, lanes.hit(lane)))
+}
+
+/// [`closest_of_lanes`] when some lane has an edge function of exactly zero: those lanes are
+/// settled by the scalar test, and the lanes taken in order, each closer than the last.
+#[cold]
+fn closest_on_edge<const N: usize>(
+    mask: u32,
+    lanes: &LaneHits<N>,
+    triangle: impl Fn(usize) -> Triangle,
+    ray: &TriangleRay,
+    t_max: f32,
+) -> Option<(usize, TriangleHit)> {
+    let mut best: Option<(usize, TriangleHit)> = None;
+    let mut t_max = t_max;
+    for lane in 0..N {
+        let hit = if mask & (1 << (N + lane)) != 0 {
+            triangle(lane).intersect_pre(ray, t_max)
+        } else if mask & (1 << lane) != 0 && lanes.t[lane] < t_max {
+            Some(lanes.hit(lane))
+        } else {
+            None
+        };
+        if let Some(h) = hit {
+            t_max = h.t;
+            best = Some((lane, h));
+        }
+    }
+    best
+}
+
+/// Calls `visit(lane, hit)` for each lane `mask` reports hit ([`lane_hits`]), in lane order,
+/// until it returns `true`; returns whether it did.
+#[inline(always)]
+fn each_of_lanes<const N: usize>(
+    mask: u32,
+    lanes: &LaneHits<N>,
+    triangle: impl Fn(usize) -> Triangle,
+    ray: &TriangleRay,
+    t_max: f32,
+    mut visit: impl FnMut(usize, TriangleHit) -> bool,
+) -> bool {
+    if mask == 0 {
+        return false;
+    }
+    for lane in 0..N {
+        let hit = if mask & (1 << (N + lane)) != 0 {
+            triangle(lane).intersect_pre(ray, t_max)
+        } else if mask & (1 << lane) != 0 {
+            Some(lanes.hit(lane))
+        } else {
+            None
+        };
+        if let Some(h) = hit {
+            if visit(lane, h) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Per-lane results of a packet test.
+struct LaneHits<const N: usize> {
+    t: [f32; N],
+    wb: [f32; N],
+    wc: [f32; N],
+    det: [f32; N],
+}
+
+impl<const N: usize> LaneHits<N> {
     #[inline(always)]
     fn hit(&self, lane: usize) -> TriangleHit {
+        let lane = lane % N;
         let inv = 1.0 / self.det[lane];
         TriangleHit {
             t: self.t[lane],
@@ -245,6 +363,72 @@ mod tests {
             hits += usize::from(expected.is_some());
         }
         assert!(hits > 5_000, "the cases exercise hits: {hits}");
+    }
+
+    /// Two packets tested as one of eight lanes answer as the two tested one after the other,
+    /// bit for bit: the nearest (ties to the first packet), and every hit in lane order;
+    /// rays through shared edges and vertices included.
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn a_pair_in_eight_lanes_agrees_with_its_packets_in_turn() {
+        let Some(avx) = crate::accel::lanes::Avx::detect() else {
+            eprintln!("skipped: this CPU has no AVX");
+            return;
+        };
+        let mut rng = Rng::new(0x0e16_4715_0000_0001, 0);
+        let (mut hits, mut seconds) = (0, 0);
+        for case in 0..20_000 {
+            let count = LANES + 1 + case % LANES;
+            let shared = v(&mut rng);
+            let tris: Vec<Triangle> = (0..count)
+                .map(|i| {
+                    let a = if i > 0 && case % 3 == 0 { shared } else { v(&mut rng) };
+                    Triangle::new(a, v(&mut rng), if case % 5 == 0 { shared * 0.5 } else { v(&mut rng) })
+                })
+                .collect();
+            let packets = [TrianglePacket::new(&tris[..LANES]), TrianglePacket::new(&tris[LANES..])];
+            let target = match case % 4 {
+                0 => tris[0].vertices()[case % 3],
+                1 => tris[count - 1].point(rng.uniform(), 0.0),
+                _ => tris[case % count].point(rng.uniform() * 0.5, rng.uniform() * 0.5),
+            };
+            let origin = v(&mut rng) * 3.0;
+            let ray = Ray::new(origin, (target - origin) * (0.5 + rng.uniform()));
+            let tr = TriangleRay::new(&ray);
+            let t_max = if case % 7 == 0 {
+                rng.uniform() * 2.0
+            } else {
+                f32::INFINITY
+            };
+            // The packets in turn, the second searching only nearer than the first's hit.
+            let first = packets[0].closest_hit(&tr, t_max);
+            let second = packets[1].closest_hit(&tr, first.map_or(t_max, |(_, h)| h.t));
+            let expected = second.map(|(lane, h)| (LANES + lane, h)).or(first);
+            let mut expected_all = Vec::new();
+            for (p, packet) in packets.iter().enumerate() {
+                packet.each_hit(&tr, t_max, |lane, h| {
+                    expected_all.push((p * LANES + lane, h));
+                    false
+                });
+            }
+            let pair = PacketPair(&packets);
+            let (closest, all) = crate::accel::lanes::in_avx(avx, || {
+                let mut all = Vec::new();
+                pair.each_hit(&tr, t_max, |lane, h| {
+                    all.push((lane, h));
+                    false
+                });
+                (pair.closest_hit(&tr, t_max), all)
+            });
+            assert_eq!(closest, expected, "case {case}");
+            assert_eq!(all, expected_all, "case {case}");
+            hits += usize::from(expected.is_some());
+            seconds += usize::from(second.is_some());
+        }
+        assert!(
+            hits > 5_000 && seconds > 1_000,
+            "the cases exercise hits: {hits}, {seconds} in the second packet"
+        );
     }
 
     #[test]
