@@ -119,12 +119,20 @@ impl Camera {
 
     /// The primary ray through normalised screen point (sx, sy) ∈ [0, 1]², sy = 0 at the bottom;
     /// the direction is unit length.
-    #[inline]
+    /// A pinhole's ray is inlined into the caller (returned through memory, it cost the tile's
+    /// set-up a stalled reload); a lens's is drawn out of line.
+    #[inline(always)]
     pub fn generate_ray(&self, sx: f32, sy: f32) -> Ray {
         let dir = self.look + (sx - 0.5) * self.u + (sy - 0.5) * self.v;
-        let Some(lens) = self.lens else {
-            return Ray::new(self.eye, dir.normalize_or_zero());
-        };
+        match self.lens {
+            None => Ray::new(self.eye, dir.normalize_or_zero()),
+            Some(lens) => self.lens_ray(lens, dir, sx, sy),
+        }
+    }
+
+    /// [`Camera::generate_ray`] through a thin lens, given the pinhole ray's direction `dir`.
+    #[inline(never)]
+    fn lens_ray(&self, lens: ThinLens, dir: Vec3, sx: f32, sy: f32) -> Ray {
         // Through the point of the focus plane the pinhole ray meets, from a lens point drawn
         // from the screen point's bits (the same screen point, the same lens point).
         let axis = self.axis();

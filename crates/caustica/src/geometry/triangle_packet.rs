@@ -5,7 +5,8 @@
 //! its branches depend on the four lanes together, so they mispredict less. The arithmetic is
 //! the scalar test's, operation for operation, so hits (and their `t`, `u`, `v`) are the same
 //! bits; lanes with an edge function of exactly zero are redone by the scalar test, which settles
-//! them in `f64`.
+//! them in `f64`. Where the CPU has AVX two packets are tested as one of eight lanes
+//! ([`PacketPair`]), to the same bits again.
 
 use glam::Vec4;
 
