@@ -310,6 +310,32 @@ mod tests {
         Vec3::new(rng.uniform(), rng.uniform(), rng.uniform()) * 2.0 - Vec3::ONE
     }
 
+    /// Case `case` of a test: `count` random triangles, some sharing a vertex or an edge with
+    /// the first, and a ray aimed at a vertex, an edge or the inside of one of them, with its
+    /// segment's end (at times short).
+    fn random_case(rng: &mut Rng, case: usize, count: usize) -> (Vec<Triangle>, TriangleRay, f32) {
+        let shared = v(rng);
+        let tris: Vec<Triangle> = (0..count)
+            .map(|i| {
+                let a = if i > 0 && case % 3 == 0 { shared } else { v(rng) };
+                Triangle::new(a, v(rng), if case % 5 == 0 { shared * 0.5 } else { v(rng) })
+            })
+            .collect();
+        let target = match case % 4 {
+            0 => tris[0].vertices()[case % 3],
+            1 => tris[count - 1].point(rng.uniform(), 0.0),
+            _ => tris[case % count].point(rng.uniform() * 0.5, rng.uniform() * 0.5),
+        };
+        let origin = v(rng) * 3.0;
+        let ray = Ray::new(origin, (target - origin) * (0.5 + rng.uniform()));
+        let t_max = if case % 7 == 0 {
+            rng.uniform() * 2.0
+        } else {
+            f32::INFINITY
+        };
+        (tris, TriangleRay::new(&ray), t_max)
+    }
+
     /// The packet's closest hit and hit list equal the scalar test's on each triangle, bit for
     /// bit, including rays through shared edges and vertices and partly filled packets.
     #[test]
@@ -317,30 +343,8 @@ mod tests {
         let mut rng = Rng::new(0x1234_5678_9abc_def1, 0);
         let mut hits = 0;
         for case in 0..20_000 {
-            let count = 1 + case % LANES;
-            let shared = v(&mut rng);
-            let tris: Vec<Triangle> = (0..count)
-                .map(|i| {
-                    // Some triangles share a vertex or an edge with the first.
-                    let a = if i > 0 && case % 3 == 0 { shared } else { v(&mut rng) };
-                    Triangle::new(a, v(&mut rng), if case % 5 == 0 { shared * 0.5 } else { v(&mut rng) })
-                })
-                .collect();
+            let (tris, tr, t_max) = random_case(&mut rng, case, 1 + case % LANES);
             let packet = TrianglePacket::new(&tris);
-            // Aim at a vertex, an edge or the inside of one of the triangles.
-            let target = match case % 4 {
-                0 => tris[0].vertices()[case % 3],
-                1 => tris[count - 1].point(rng.uniform(), 0.0),
-                _ => tris[case % count].point(rng.uniform() * 0.5, rng.uniform() * 0.5),
-            };
-            let origin = v(&mut rng) * 3.0;
-            let ray = Ray::new(origin, (target - origin) * (0.5 + rng.uniform()));
-            let tr = TriangleRay::new(&ray);
-            let t_max = if case % 7 == 0 {
-                rng.uniform() * 2.0
-            } else {
-                f32::INFINITY
-            };
 
             let mut expected = None;
             let mut t_best = t_max;
@@ -379,28 +383,8 @@ mod tests {
         let mut rng = Rng::new(0x0e16_4715_0000_0001, 0);
         let (mut hits, mut seconds) = (0, 0);
         for case in 0..20_000 {
-            let count = LANES + 1 + case % LANES;
-            let shared = v(&mut rng);
-            let tris: Vec<Triangle> = (0..count)
-                .map(|i| {
-                    let a = if i > 0 && case % 3 == 0 { shared } else { v(&mut rng) };
-                    Triangle::new(a, v(&mut rng), if case % 5 == 0 { shared * 0.5 } else { v(&mut rng) })
-                })
-                .collect();
+            let (tris, tr, t_max) = random_case(&mut rng, case, LANES + 1 + case % LANES);
             let packets = [TrianglePacket::new(&tris[..LANES]), TrianglePacket::new(&tris[LANES..])];
-            let target = match case % 4 {
-                0 => tris[0].vertices()[case % 3],
-                1 => tris[count - 1].point(rng.uniform(), 0.0),
-                _ => tris[case % count].point(rng.uniform() * 0.5, rng.uniform() * 0.5),
-            };
-            let origin = v(&mut rng) * 3.0;
-            let ray = Ray::new(origin, (target - origin) * (0.5 + rng.uniform()));
-            let tr = TriangleRay::new(&ray);
-            let t_max = if case % 7 == 0 {
-                rng.uniform() * 2.0
-            } else {
-                f32::INFINITY
-            };
             // The packets in turn, the second searching only nearer than the first's hit.
             let first = packets[0].closest_hit(&tr, t_max);
             let second = packets[1].closest_hit(&tr, first.map_or(t_max, |(_, h)| h.t));
