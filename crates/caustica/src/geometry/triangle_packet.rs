@@ -317,8 +317,12 @@ mod tests {
         let shared = v(rng);
         let tris: Vec<Triangle> = (0..count)
             .map(|i| {
-                let a = if i > 0 && case % 3 == 0 { shared } else { v(rng) };
-                Triangle::new(a, v(rng), if case % 5 == 0 { shared * 0.5 } else { v(rng) })
+                let a = if i > 0 && case.is_multiple_of(3) {
+                    shared
+                } else {
+                    v(rng)
+                };
+                Triangle::new(a, v(rng), if case.is_multiple_of(5) { shared * 0.5 } else { v(rng) })
             })
             .collect();
         let target = match case % 4 {
@@ -328,7 +332,7 @@ mod tests {
         };
         let origin = v(rng) * 3.0;
         let ray = Ray::new(origin, (target - origin) * (0.5 + rng.uniform()));
-        let t_max = if case % 7 == 0 {
+        let t_max = if case.is_multiple_of(7) {
             rng.uniform() * 2.0
         } else {
             f32::INFINITY
