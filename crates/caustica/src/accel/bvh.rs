@@ -253,7 +253,7 @@ impl Bvh {
     /// same tree whatever the thread count.
     ///
     /// # Panics
-    /// If there are 2^31 or more primitives.
+    /// If there are 2^30 or more primitives.
     pub fn build(prim_bounds: &[Aabb]) -> Bvh {
         Bvh::build_reporting(prim_bounds, &NoProgress)
     }

@@ -4,7 +4,7 @@
 use glam::{Vec3A, Vec4};
 use rayon::prelude::*;
 
-use super::{Node, END, LEAF, MAX_WIDTH};
+use super::{Node, END, LEAF, MAX_WIDTH, PAIR};
 use crate::math::Aabb;
 use crate::progress::Progress;
 
@@ -264,9 +264,11 @@ pub(super) struct Bvh2 {
 /// Builds the binary tree over the hittable primitives (finite, non-empty bounds).
 /// Progress is reported per subtree built on one thread, so the report costs nothing per node.
 pub(super) fn build_bvh2(prim_bounds: &[Aabb], leaf: LeafCost, progress: &dyn Progress) -> Bvh2 {
+    // Leaf positions stay below the child references' flags (`LEAF`, and `PAIR` for triangle
+    // trees).
     assert!(
-        prim_bounds.len() < LEAF as usize,
-        "BVH supports fewer than 2^31 primitives"
+        prim_bounds.len() < PAIR as usize,
+        "BVH supports fewer than 2^30 primitives"
     );
     let make = |(i, b): (usize, &Aabb)| {
         let ok = b.min.is_finite() && b.max.is_finite() && b.min.cmple(b.max).all();
