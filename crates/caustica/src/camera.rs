@@ -119,6 +119,7 @@ impl Camera {
 
     /// The primary ray through normalised screen point (sx, sy) ∈ [0, 1]², sy = 0 at the bottom;
     /// the direction is unit length.
+    ///
     /// A pinhole's ray is inlined into the caller (returned through memory, it cost the tile's
     /// set-up a stalled reload); a lens's is drawn out of line.
     #[inline(always)]
