@@ -852,8 +852,9 @@ impl Scene {
         };
         let shape_blocks = match &self.shape_packets {
             // Without boundaries a shape the packets find blocks: its own test is theirs.
-            Some(packets) if !self.boundaries => packets.each(ray, t_max, |prim| prim != own),
-            Some(packets) => packets.each(ray, t_max, blocks),
+            Some(packets) if !self.boundaries && own < n_shapes => packets.each_except(ray, t_max, own, |_| true),
+            Some(packets) if !self.boundaries => packets.each(ray, t_max, |_| true),
+            Some(packets) => packets.each_except(ray, t_max, own, blocks),
             None => self.shape_bvh.any_hit(ray, t_max, |prim, _| blocks(prim)),
         };
         shape_blocks

@@ -57,6 +57,9 @@ struct SpherePacket<L> {
 struct Packets<L> {
     squares: Vec<SquarePacket<L>>,
     spheres: Vec<SpherePacket<L>>,
+    /// Where each shape (by id) sits: its packet's place, squares' packets first, and its
+    /// lane's bit; `(u32::MAX, 0)` for a shape left out.
+    slots: Vec<(u32, u32)>,
 }
 
 /// The shapes of a scene of few squares and round spheres, in packets.
@@ -160,9 +163,22 @@ impl ShapePackets {
     #[inline]
     pub fn each(&self, ray: &Ray, t_max: f32, visit: impl FnMut(u32) -> bool) -> bool {
         match &self.lanes {
-            PacketLanes::Four(p) => p.each(ray, t_max, visit),
+            PacketLanes::Four(p) => p.each::<false>(ray, t_max, NO_SHAPE, visit),
             #[cfg(target_arch = "x86_64")]
-            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.each(ray, t_max, visit)),
+            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.each::<false>(ray, t_max, NO_SHAPE, visit)),
+        }
+    }
+
+    /// [`ShapePackets::each`] passing over shape `own`, whose lane neither counts nor keeps the
+    /// test from stopping early: a shadow ray towards a sphere lamp ends on the lamp, which
+    /// would otherwise take the whole test every time. (Its own instance of the test, so that
+    /// [`ShapePackets::each`] pays nothing for it.)
+    #[inline]
+    pub fn each_except(&self, ray: &Ray, t_max: f32, own: u32, visit: impl FnMut(u32) -> bool) -> bool {
+        match &self.lanes {
+            PacketLanes::Four(p) => p.each::<true>(ray, t_max, own, visit),
+            #[cfg(target_arch = "x86_64")]
+            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.each::<true>(ray, t_max, own, visit)),
         }
     }
 }
@@ -180,7 +196,7 @@ impl<L: Lanes> Packets<L> {
             ids.iter_mut().zip(chunk).for_each(|(slot, id)| *slot = id);
             ids
         };
-        let squares = forms
+        let squares: Vec<SquarePacket<L>> = forms
             .squares
             .chunks(L::N)
             .map(|c| SquarePacket {
@@ -191,7 +207,7 @@ impl<L: Lanes> Packets<L> {
                 ids: ids(&mut c.iter().map(|s| s.0)),
             })
             .collect();
-        let spheres = forms
+        let spheres: Vec<SpherePacket<L>> = forms
             .spheres
             .chunks(L::N)
             .map(|c| SpherePacket {
@@ -201,7 +217,18 @@ impl<L: Lanes> Packets<L> {
                 ids: ids(&mut c.iter().map(|s| s.0)),
             })
             .collect();
-        Packets { squares, spheres }
+        let mut slots = vec![(u32::MAX, 0); MAX_SHAPES];
+        let packed = squares.iter().map(|p| &p.ids).chain(spheres.iter().map(|p| &p.ids));
+        for (packet, ids) in packed.enumerate() {
+            for (lane, &id) in ids.iter().enumerate().filter(|&(_, &id)| id != NO_SHAPE) {
+                slots[id as usize] = (packet as u32, 1 << lane);
+            }
+        }
+        Packets {
+            squares,
+            spheres,
+            slots,
+        }
     }
 
     #[inline(always)]
@@ -221,39 +248,65 @@ impl<L: Lanes> Packets<L> {
             }
         };
         for p in &self.squares {
-            let (mask, t) = p.hits(&pr, t_max);
+            let (mask, t) = p.hits(&pr, t_max, 0);
             keep(mask, t, &p.ids);
         }
         for p in &self.spheres {
-            let (mask, t) = p.hits(&pr, t_max);
+            let (mask, t) = p.hits(&pr, t_max, 0);
             keep(mask, t, &p.ids);
         }
         best
     }
 
+    /// Calls `visit` for each shape hit, until it returns `true`; with `SKIPS`, passing over
+    /// shape `own`.
     #[inline(always)]
-    fn each(&self, ray: &Ray, t_max: f32, mut visit: impl FnMut(u32) -> bool) -> bool {
+    fn each<const SKIPS: bool>(&self, ray: &Ray, t_max: f32, own: u32, mut visit: impl FnMut(u32) -> bool) -> bool {
         let pr = PacketRay::<L>::new(ray);
-        let mut any = |mask: u32, ids: &[u32; MAX_LANES]| {
-            let mut rest = mask;
-            while rest != 0 {
-                if visit(ids[rest.trailing_zeros() as usize]) {
-                    return true;
-                }
-                rest &= rest - 1;
-            }
-            false
+        let (own_packet, own_lane) = match self.slots.get(own as usize) {
+            Some(&slot) if SKIPS => slot,
+            _ => (u32::MAX, 0),
         };
-        self.squares.iter().any(|p| any(p.hits(&pr, t_max).0, &p.ids))
-            || self.spheres.iter().any(|p| any(p.hits(&pr, t_max).0, &p.ids))
+        // Plain loops: a closure around a packet's test, left out of line, would run its lanes
+        // outside the AVX code.
+        let mut packet = 0;
+        for p in &self.squares {
+            let skip = if SKIPS && packet == own_packet { own_lane } else { 0 };
+            if visit_lanes(p.hits(&pr, t_max, skip).0, &p.ids, &mut visit) {
+                return true;
+            }
+            packet += 1;
+        }
+        for p in &self.spheres {
+            let skip = if SKIPS && packet == own_packet { own_lane } else { 0 };
+            if visit_lanes(p.hits(&pr, t_max, skip).0, &p.ids, &mut visit) {
+                return true;
+            }
+            packet += 1;
+        }
+        false
     }
 }
 
+/// Calls `visit(shape)` for the shape of each lane of `mask`, until it returns `true`; returns
+/// whether it did.
+#[inline(always)]
+fn visit_lanes(mask: u32, ids: &[u32; MAX_LANES], visit: &mut impl FnMut(u32) -> bool) -> bool {
+    let mut rest = mask;
+    while rest != 0 {
+        if visit(ids[rest.trailing_zeros() as usize]) {
+            return true;
+        }
+        rest &= rest - 1;
+    }
+    false
+}
+
 impl<L: Lanes> SquarePacket<L> {
-    /// The lanes hit with `0 < t < t_max` (bit per lane) and their `t`: the square test of
-    /// `Shape::intersect_square`, lane by lane.
+    /// The lanes hit with `0 < t < t_max` (bit per lane), but for the lanes of `skip`, and their
+    /// `t`: the square test of `Shape::intersect_square`, lane by lane.
     #[inline(always)]
-    fn hits(&self, ray: &PacketRay<L>, t_max: f32) -> (u32, L) {
+    fn hits(&self, ray: &PacketRay<L>, t_max: f32, skip: u32) -> (u32, L) {
         let [row_x, row_y, row_z] = &self.rows;
         let zero = L::splat(0.0);
         let dir_z = dot(row_z, &ray.dir);
@@ -263,7 +316,7 @@ impl<L: Lanes> SquarePacket<L> {
         let facing = distance_z.gt(zero) ^ dir_z.gt(zero);
         let far = distance_z.abs().ge(L::splat(t_max) * dir_z.abs());
         let turned_away = dir_z.eq(zero) | facing | far;
-        if L::bitmask(!turned_away) == 0 {
+        if L::bitmask(!turned_away) & !skip == 0 {
             return (0, zero);
         }
         let t = distance_z / dir_z;
@@ -271,15 +324,16 @@ impl<L: Lanes> SquarePacket<L> {
         let offset: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] + ray.dir[axis] * t - self.origin[axis]);
         let half = L::splat(0.5);
         let outside = dot(row_x, &offset).abs().gt(half) | dot(row_y, &offset).abs().gt(half);
-        (L::bitmask(!turned_away & in_range & !outside), t)
+        (L::bitmask(!turned_away & in_range & !outside) & !skip, t)
     }
 }
 
 impl<L: Lanes> SpherePacket<L> {
-    /// The lanes hit with `0 < t < t_max` (bit per lane) and their `t`: the round-sphere test of
-    /// `Shape::intersect_round_sphere` with [`crate::geometry::quadratic_roots`], lane by lane.
+    /// The lanes hit with `0 < t < t_max` (bit per lane), but for the lanes of `skip`, and their
+    /// `t`: the round-sphere test of `Shape::intersect_round_sphere` with
+    /// [`crate::geometry::quadratic_roots`], lane by lane.
     #[inline(always)]
-    fn hits(&self, ray: &PacketRay<L>, t_max: f32) -> (u32, L) {
+    fn hits(&self, ray: &PacketRay<L>, t_max: f32, skip: u32) -> (u32, L) {
         let zero = L::splat(0.0);
         let oc: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] - self.center[axis]);
         let a = L::splat(ray.dir2);
@@ -288,7 +342,7 @@ impl<L: Lanes> SpherePacket<L> {
         let l: [L; 3] = std::array::from_fn(|axis| oc[axis] - ray.dir[axis] * k);
         let (l2, r2) = (dot(&l, &l), self.radius * self.radius);
         let near = !l2.gt(r2);
-        if L::bitmask(near) & self.used == 0 {
+        if L::bitmask(near) & self.used & !skip == 0 {
             return (0, zero);
         }
         let l_len = l2.sqrt();
@@ -306,7 +360,7 @@ impl<L: Lanes> SpherePacket<L> {
         let mask = if ray.dir2 == 0.0 {
             0
         } else {
-            L::bitmask(near & real & in_range)
+            L::bitmask(near & real & in_range) & !skip
         };
         (mask, t)
     }
@@ -367,8 +421,8 @@ mod tests {
 
     /// On 200,000 random rays — from inside the box, from far outside, grazing, and bounded
     /// by a random `t_max` — the packets of every width this CPU runs pick the shape and `t` (to
-    /// the bit) that testing each shape by its own test picks, and `each` visits exactly the
-    /// shapes those tests hit.
+    /// the bit) that testing each shape by its own test picks, `each` visits exactly the
+    /// shapes those tests hit, and `each_except` all of them but the one it passes over.
     #[test]
     fn packets_find_what_each_shapes_own_test_finds() {
         let shapes = shapes();
@@ -418,6 +472,20 @@ mod tests {
                 });
                 each_found.sort();
                 assert_eq!(each_found, each_expected, "{width:?}: {ray:?} {t_max}");
+                // Passing over one shape (or none) drops exactly that shape.
+                let own = if i % 5 == 0 {
+                    NO_SHAPE
+                } else {
+                    (i % shapes.len()) as u32
+                };
+                let mut except_found = vec![];
+                packets.each_except(&ray, t_max, own, |id| {
+                    except_found.push(id);
+                    false
+                });
+                except_found.sort();
+                let except_expected: Vec<u32> = each_expected.iter().copied().filter(|&id| id != own).collect();
+                assert_eq!(except_found, except_expected, "{width:?}: {ray:?} {t_max} except {own}");
             }
             hits += usize::from(expected.is_some());
             several += usize::from(each_expected.len() > 1);
