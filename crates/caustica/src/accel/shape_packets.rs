@@ -171,8 +171,8 @@ impl ShapePackets {
 
     /// [`ShapePackets::each`] passing over shape `own`, whose lane neither counts nor keeps the
     /// test from stopping early: a shadow ray towards a sphere lamp ends on the lamp, which
-    /// would otherwise take the whole test every time. (Its own instance of the test, so that
-    /// [`ShapePackets::each`] pays nothing for it.)
+    /// would otherwise take the whole test every time. (An instance of the test of its own:
+    /// [`ShapePackets::each`] keeps one without the skipping.)
     #[inline]
     pub fn each_except(&self, ray: &Ray, t_max: f32, own: u32, visit: impl FnMut(u32) -> bool) -> bool {
         match &self.lanes {
