@@ -59,7 +59,7 @@ struct Packets<L> {
     spheres: Vec<SpherePacket<L>>,
     /// Where each shape (by id) sits: its packet's place, squares' packets first, and its
     /// lane's bit; `(u32::MAX, 0)` for a shape left out.
-    slots: Vec<(u32, u32)>,
+    slots: [(u32, u32); MAX_SHAPES],
 }
 
 /// The shapes of a scene of few squares and round spheres, in packets.
@@ -217,7 +217,7 @@ impl<L: Lanes> Packets<L> {
                 ids: ids(&mut c.iter().map(|s| s.0)),
             })
             .collect();
-        let mut slots = vec![(u32::MAX, 0); MAX_SHAPES];
+        let mut slots = [(u32::MAX, 0); MAX_SHAPES];
         let packed = squares.iter().map(|p| &p.ids).chain(spheres.iter().map(|p| &p.ids));
         for (packet, ids) in packed.enumerate() {
             for (lane, &id) in ids.iter().enumerate().filter(|&(_, &id)| id != NO_SHAPE) {
