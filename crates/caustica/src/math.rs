@@ -226,14 +226,15 @@ pub fn luminance(c: Vec3) -> f32 {
 #[inline]
 pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
     // The nearest quarter turn, and the rest as an angle in [-π/4, π/4].
-    let quarter = (turns * 4.0).round();
+    let q = nearest_quarter(turns);
+    let quarter = q as f32;
     let x = (turns - quarter * 0.25) * std::f32::consts::TAU;
     let x2 = x * x;
     // Taylor series to x⁹ and x⁸: their first terms left out are below 3·10⁻⁸ there.
     let sin = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362_880.0)))));
     let cos = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40_320.0))));
     // A quarter turn more swaps them and turns the new cosine's sign; two turn both.
-    let q = quarter as i32 as u32;
+    let q = q as u32;
     let (s, c) = if q & 1 == 0 { (sin, cos) } else { (cos, sin) };
     (
         f32::from_bits(s.to_bits() ^ ((q & 2) << 30)),
@@ -241,9 +242,34 @@ pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
     )
 }
 
+/// `(turns * 4.0).round()` as an integer, for |`turns`| up to 2²²: halves away from zero, as
+/// `round`, without the library call baseline x86-64 makes for it (the fraction left after
+/// truncating is exact).
+#[inline]
+fn nearest_quarter(turns: f32) -> i32 {
+    let whole = (turns * 4.0) as i32;
+    let rest = turns * 4.0 - whole as f32;
+    whole + i32::from(rest >= 0.5) - i32::from(rest <= -0.5)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nearest_quarter_rounds_as_round_does() {
+        let mut rng = crate::sampling::Rng::new(7, 0);
+        let ties = (-40..=40).map(|k| k as f32 * 0.125);
+        let near_ties = ties.clone().flat_map(|t| [t.next_down(), t.next_up()]);
+        let random = (0..100_000).map(|_| (rng.uniform() - 0.5) * 2f32.powi((rng.uniform() * 23.0) as i32));
+        for turns in ties
+            .chain(near_ties)
+            .chain(random)
+            .chain([4_194_303.75, -4_194_303.75, 0.0, -0.0])
+        {
+            assert_eq!(nearest_quarter(turns), (turns * 4.0).round() as i32, "{turns}");
+        }
+    }
 
     #[test]
     fn frame_is_orthonormal() {
