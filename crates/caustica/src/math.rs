@@ -262,10 +262,10 @@ mod tests {
         let ties = (-40..=40).map(|k| k as f32 * 0.125);
         let near_ties = ties.clone().flat_map(|t| [t.next_down(), t.next_up()]);
         let random = (0..100_000).map(|_| (rng.uniform() - 0.5) * 2f32.powi((rng.uniform() * 23.0) as i32));
-        for turns in ties
-            .chain(near_ties)
-            .chain(random)
-            .chain([4_194_303.75, -4_194_303.75, 0.0, -0.0])
+        for turns in
+            ties.chain(near_ties)
+                .chain(random)
+                .chain([2f32.powi(21) - 0.125, 0.125 - 2f32.powi(21), 0.0, -0.0])
         {
             assert_eq!(nearest_quarter(turns), (turns * 4.0).round() as i32, "{turns}");
         }
