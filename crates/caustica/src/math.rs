@@ -226,7 +226,7 @@ pub fn luminance(c: Vec3) -> f32 {
 #[inline]
 pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
     // The nearest quarter turn, and the rest as an angle in [-π/4, π/4].
-    let q = nearest_quarter(turns);
+    let q = round_to_i32(turns * 4.0);
     let quarter = q as f32;
     let x = (turns - quarter * 0.25) * std::f32::consts::TAU;
     let x2 = x * x;
@@ -242,13 +242,12 @@ pub fn sin_cos_turns(turns: f32) -> (f32, f32) {
     )
 }
 
-/// `(turns * 4.0).round()` as an integer, for |`turns`| up to 2²²: halves away from zero, as
-/// `round`, without the library call baseline x86-64 makes for it (the fraction left after
-/// truncating is exact).
+/// `x.round()` as an integer, for |`x`| below 2³¹: halves away from zero, as `round`, without
+/// the library call baseline x86-64 makes for it (the fraction left after truncating is exact).
 #[inline]
-fn nearest_quarter(turns: f32) -> i32 {
-    let whole = (turns * 4.0) as i32;
-    let rest = turns * 4.0 - whole as f32;
+pub fn round_to_i32(x: f32) -> i32 {
+    let whole = x as i32;
+    let rest = x - whole as f32;
     whole + i32::from(rest >= 0.5) - i32::from(rest <= -0.5)
 }
 
@@ -257,7 +256,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn nearest_quarter_rounds_as_round_does() {
+    fn rounding_to_an_integer_matches_round_on_quarter_turns() {
         let mut rng = crate::sampling::Rng::new(7, 0);
         let ties = (-40..=40).map(|k| k as f32 * 0.125);
         let near_ties = ties.clone().flat_map(|t| [t.next_down(), t.next_up()]);
@@ -267,7 +266,7 @@ mod tests {
                 .chain(random)
                 .chain([2f32.powi(21) - 0.125, 0.125 - 2f32.powi(21), 0.0, -0.0])
         {
-            assert_eq!(nearest_quarter(turns), (turns * 4.0).round() as i32, "{turns}");
+            assert_eq!(round_to_i32(turns * 4.0), (turns * 4.0).round() as i32, "{turns}");
         }
     }
 

@@ -18,7 +18,7 @@ pub mod trace;
 pub use budget::{NoCaustics, PhotonSettings, PhotonStats};
 pub use map::{EstimateSettings, Estimator, PhotonMap};
 
-use crate::math::{Vec2, Vec3, Vec4};
+use crate::math::{round_to_i32, Vec2, Vec3, Vec4};
 
 /// The median distance to the k-th nearest item, measured around up to 256 items spread
 /// through `items` (in tree order): how wide a gather of about k photons is where they are
@@ -178,25 +178,17 @@ fn encode_shared_exponent(c: Vec4) -> ([u8; 4], u8) {
     // m = f · 2^e with f in [0.5, 1), read from its bits (m is a normal float here).
     let mut e = ((m.to_bits() >> 23) & 0xff) as i32 - 126;
     let mut scale = power_of_two(8 - e);
-    if round_non_negative(m * scale) >= 256 {
+    if round_to_i32(m * scale) >= 256 {
         e += 1;
         scale *= 0.5;
     }
-    let q = |x: f32| round_non_negative(x * scale).min(255) as u8;
+    let q = |x: f32| round_to_i32(x * scale).min(255) as u8;
     ([q(c.x), q(c.y), q(c.z), q(c.w)], (e + 128).clamp(0, 255) as u8)
 }
 
 /// 2^k for an exponent of a normal float, built from its bits.
 fn power_of_two(k: i32) -> f32 {
     f32::from_bits(((k + 127) as u32) << 23)
-}
-
-/// `x.round()` for finite x in [0, 2^23), without the library call that baseline x86-64 makes
-/// for it: the fraction left after truncation is exact, and halves round up as `round` does.
-#[inline]
-fn round_non_negative(x: f32) -> u32 {
-    let whole = x as u32;
-    whole + u32::from(x - whole as f32 >= 0.5)
 }
 
 fn decode_shared_exponent(c: [u8; 4], exponent: u8) -> Vec4 {
@@ -235,18 +227,12 @@ fn decode_oct(e: Vec2) -> Vec3 {
 
 fn encode_oct16(v: Vec3) -> [u16; 2] {
     let e = encode_oct(v);
-    [
-        round_non_negative(e.x * 65535.0) as u16,
-        round_non_negative(e.y * 65535.0) as u16,
-    ]
+    [round_to_i32(e.x * 65535.0) as u16, round_to_i32(e.y * 65535.0) as u16]
 }
 
 fn encode_oct8(v: Vec3) -> [u8; 2] {
     let e = encode_oct(v);
-    [
-        round_non_negative(e.x * 255.0) as u8,
-        round_non_negative(e.y * 255.0) as u8,
-    ]
+    [round_to_i32(e.x * 255.0) as u8, round_to_i32(e.y * 255.0) as u8]
 }
 
 #[cfg(test)]
@@ -304,7 +290,7 @@ mod tests {
             x = x * 1.01 + 0.013;
         }
         for x in edges {
-            assert_eq!(round_non_negative(x), x.round() as u32, "{x}");
+            assert_eq!(round_to_i32(x) as u32, x.round() as u32, "{x}");
         }
     }
 
