@@ -36,7 +36,7 @@ pub use soft::SoftLight;
 use aim::{camera_targets, Aim};
 use emission::Emitters;
 
-use crate::math::{luminance, Ray, Vec3};
+use crate::math::{luminance, Ray, Vec2, Vec3};
 use crate::sampling::{power_heuristic, Rng};
 use crate::scene::{ObjectRef, Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -563,7 +563,17 @@ impl LightSet {
         wl: &Wavelengths,
         rng: &mut Rng,
     ) -> Option<DirectSample> {
-        let (u_pick, u) = (rng.uniform(), rng.uniform2());
+        // A point, spot or directional light has one direction to offer: it draws nothing
+        // (three unused numbers were 1.7% of the point-lit box's instructions).
+        let delta = matches!(
+            self.lights[index],
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
+        );
+        let (u_pick, u) = if delta {
+            (0.0, Vec2::ZERO)
+        } else {
+            (rng.uniform(), rng.uniform2())
+        };
         let q = DirectQuery {
             scene,
             hit,

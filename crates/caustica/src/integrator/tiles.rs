@@ -179,14 +179,16 @@ pub fn sample_pass_tiles<F>(
 where
     F: Fn(Vec<PixelSample>) -> Vec<Vec3> + Sync,
 {
+    // Multiplied by, not divided: two divisions a pixel were 1% of a glass ball's render.
+    let (inv_width, inv_height) = (1.0 / width as f32, 1.0 / height as f32);
     let (pixels, complete) = shade_tile_blocks(width, height, control, false, |(x0, y0), (x1, y1)| {
         let mut points = Vec::with_capacity((x1 - x0) * (y1 - y0));
         for y in y0..y1 {
             for x in x0..x1 {
                 let mut rng = Rng::new(seed, (pass << 32) ^ (y * width + x) as u64);
                 let (jx, jy) = (rng.uniform(), rng.uniform());
-                let sx = (x as f32 + jx) / width as f32;
-                let sy = 1.0 - (y as f32 + jy) / height as f32;
+                let sx = (x as f32 + jx) * inv_width;
+                let sy = 1.0 - (y as f32 + jy) * inv_height;
                 points.push(PixelSample { screen: (sx, sy), rng });
             }
         }
