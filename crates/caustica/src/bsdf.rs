@@ -122,6 +122,14 @@ impl Lambertian {
     pub fn pdf(&self, wi: Vec3) -> Option<f32> {
         lit_pdf(self.n, self.ng, self.pick, wi)
     }
+
+    /// f, the cosine at `wi` ([`Bsdf::cos`]) and the density of drawing `wi`, where f is not
+    /// zero (`None` off the lit side, or for a black surface).
+    #[inline]
+    pub fn toward(&self, wi: Vec3) -> Option<(Spectrum, f32, f32)> {
+        let pdf = lit_pdf(self.n, self.ng, self.pick, wi)?;
+        (self.f != Spectrum::ZERO).then(|| (self.f, self.n.dot(wi), pdf))
+    }
 }
 
 /// The density of drawing `wi` from a Lambertian lobe picked with probability `pick`, under
@@ -659,6 +667,23 @@ impl Bsdf {
             pick: self.pick[0],
             reverse,
         })
+    }
+
+    /// [`Bsdf::lambertian`] where the Lambertian lobe is all there is to evaluate: no
+    /// highlight, diffuse transmission or rough glass, so that its f, cosine and density are
+    /// [`Bsdf::eval`]'s, [`Bsdf::cos`]'s and [`Bsdf::pdf`]'s to the bit, for a fraction of their
+    /// cost (next-event estimation asks all three).
+    #[inline]
+    pub fn plain_lambertian(&self, wo: Vec3) -> Option<Lambertian> {
+        let plain = self.rough == 0.0
+            && self.p_coat == 0.0
+            && self.glossy == Spectrum::ZERO
+            && self.diffuse_transmission == Spectrum::ZERO;
+        if plain {
+            self.lambertian(wo)
+        } else {
+            None
+        }
     }
 
     /// f of a purely Lambertian reflection, as [`Bsdf::eval_in`] computes it.
@@ -1285,6 +1310,59 @@ mod tests {
         }
         // Most samples are taken, and some fall below the geometric surface.
         assert!(taken > tried * 3 / 4 && taken < tried, "{taken} of {tried}");
+    }
+
+    /// Next-event estimation's shortcut for a plain Lambertian reflector gives `eval`'s f,
+    /// `cos`'s cosine, and `pdf`'s and `pdf_reverse`'s densities to the bit wherever f is not
+    /// zero, and says so exactly where f is zero; surfaces with other lobes take no shortcut.
+    #[test]
+    fn a_plain_lambertian_answers_as_eval_cos_and_pdf_bit_for_bit() {
+        let mut rng = Rng::new(11, 0);
+        let bits = |s: Spectrum| s.to_array().map(f32::to_bits);
+        let (mut lit, mut unlit) = (0, 0);
+        for kd in [0.8, 0.25, 0.0] {
+            for _ in 0..20_000 {
+                let ng = Vec3::Z;
+                let tilt = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, 0.0);
+                let ns = (ng + tilt).normalize();
+                let wo = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform()).normalize();
+                let wi = Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.3).normalize();
+                let bsdf = Bsdf::new(&Lobes::new(&params(kd, 0.0, 1.0)), ns, ng, wo, &RGB, None, None);
+                let Some(lambertian) = bsdf.plain_lambertian(wo) else {
+                    // A black surface has no lobe to pick.
+                    assert_eq!(kd, 0.0);
+                    continue;
+                };
+                let f = bsdf.eval(wo, wi);
+                match lambertian.toward(wi) {
+                    Some((fast_f, cos, pdf)) => {
+                        lit += 1;
+                        assert_eq!(bits(fast_f), bits(f));
+                        assert_eq!(cos.to_bits(), bsdf.cos(wi).to_bits());
+                        assert_eq!(pdf.to_bits(), bsdf.pdf(wo, wi).to_bits());
+                        assert_eq!(lambertian.reverse.to_bits(), bsdf.pdf_reverse(wo, wi).to_bits());
+                    }
+                    None => {
+                        unlit += 1;
+                        assert_eq!(f, Spectrum::ZERO, "{wo} {wi}");
+                    }
+                }
+            }
+        }
+        assert!(lit > 10_000 && unlit > 5_000, "{lit} lit, {unlit} unlit");
+        // A highlight, or a coat's worth of mirror, is more than the lobe.
+        for (kd, ks) in [(0.5, 0.4), (0.0, 0.9)] {
+            let bsdf = Bsdf::new(
+                &Lobes::new(&params(kd, ks, 30.0)),
+                Vec3::Z,
+                Vec3::Z,
+                Vec3::Z,
+                &RGB,
+                None,
+                None,
+            );
+            assert!(bsdf.plain_lambertian(Vec3::Z).is_none());
+        }
     }
 
     #[test]

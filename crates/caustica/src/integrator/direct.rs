@@ -24,14 +24,20 @@ pub fn direct_light(
 ) -> Spectrum {
     let mut l = Spectrum::ZERO;
     let takes = |wi: Vec3| bsdf.may_take(wi);
+    // A wall's f, cosine and density at once: the values asked one by one, for less.
+    let lambertian = bsdf.plain_lambertian(wo);
     scene.lights().sample_direct((scene, hit, &takes), wl, rng, |sample| {
-        let f = bsdf.eval(wo, sample.wi);
+        let lit = lambertian.as_ref().and_then(|lambertian| lambertian.toward(sample.wi));
+        let f = lit.map_or_else(|| bsdf.eval(wo, sample.wi), |(f, _, _)| f);
         if f == Spectrum::ZERO {
             return;
         }
-        let cos = bsdf.cos(sample.wi);
+        let cos = lit.map_or_else(|| bsdf.cos(sample.wi), |(_, cos, _)| cos);
         let weight = if mis && sample.pdf > 0.0 {
-            power_heuristic(sample.pdf, bsdf.pdf(wo, sample.wi))
+            power_heuristic(
+                sample.pdf,
+                lit.map_or_else(|| bsdf.pdf(wo, sample.wi), |(_, _, pdf)| pdf),
+            )
         } else {
             1.0
         };

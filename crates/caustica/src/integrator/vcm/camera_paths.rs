@@ -346,6 +346,8 @@ impl<'a> Vcm<'a> {
         let lights = self.scene.lights();
         let mut l = Spectrum::ZERO;
         let takes = |wi: Vec3| v.bsdf.may_take(wi);
+        // A wall's f, cosine and densities at once: the values asked one by one, for less.
+        let lambertian = v.bsdf.plain_lambertian(v.wo);
         let mut one = |number: usize, pick: f32, rng: &mut Rng| {
             work.rays += 1;
             if self.emitters.emits(number) {
@@ -359,14 +361,20 @@ impl<'a> Vcm<'a> {
                     let Some(s) = lights.sample_light(number, choice, (self.scene, v.hit, &takes), wl, rng) else {
                         continue;
                     };
-                    let value = v.bsdf.eval(v.wo, s.wi);
+                    let lit = lambertian.as_ref().and_then(|lambertian| lambertian.toward(s.wi));
+                    let value = lit.map_or_else(|| v.bsdf.eval(v.wo, s.wi), |(f, _, _)| f);
                     if value == Spectrum::ZERO {
                         continue;
                     }
-                    let cos_here = v.bsdf.cos(s.wi);
+                    let cos_here = lit.map_or_else(|| v.bsdf.cos(s.wi), |(_, cos, _)| cos);
+                    // Lit, a Lambertian lobe's reverse density is its density of drawing `wo`.
+                    let reverse = match (&lambertian, lit) {
+                        (Some(lambertian), Some(_)) => lambertian.reverse,
+                        _ => v.bsdf.pdf_reverse(v.wo, s.wi),
+                    };
                     let pdfs = DirectPdfs {
-                        bsdf: v.bsdf.pdf(v.wo, s.wi),
-                        bsdf_reverse: self.light_pdf(v.bsdf, v.hit.point, v.wo, v.bsdf.pdf_reverse(v.wo, s.wi)),
+                        bsdf: lit.map_or_else(|| v.bsdf.pdf(v.wo, s.wi), |(_, _, pdf)| pdf),
+                        bsdf_reverse: self.light_pdf(v.bsdf, v.hit.point, v.wo, reverse),
                         // Several samples are one strategy of that many times the density.
                         direct: s.direct_pdf * samples as f32,
                         emission: self.emitters.emission_pdf_of(self.scene, number, &s, v.hit.point),
@@ -394,14 +402,16 @@ impl<'a> Vcm<'a> {
                 }
             } else if let Some(s) = lights.sample_light(number, pick, (self.scene, v.hit, &takes), wl, rng) {
                 // Far lights and lights with a size: the camera's strategies only.
-                let value = v.bsdf.eval(v.wo, s.wi);
+                let lit = lambertian.as_ref().and_then(|lambertian| lambertian.toward(s.wi));
+                let value = lit.map_or_else(|| v.bsdf.eval(v.wo, s.wi), |(f, _, _)| f);
                 // (A point a free flight picked on a beam's segment is not scattered from.)
                 let weight = if s.pdf > 0.0 && v.along.is_none() {
-                    power_heuristic(s.pdf, v.bsdf.pdf(v.wo, s.wi))
+                    power_heuristic(s.pdf, lit.map_or_else(|| v.bsdf.pdf(v.wo, s.wi), |(_, _, pdf)| pdf))
                 } else {
                     1.0
                 };
-                l += v.throughput * value * s.contribution * (v.bsdf.cos(s.wi) * weight);
+                let cos = lit.map_or_else(|| v.bsdf.cos(s.wi), |(_, cos, _)| cos);
+                l += v.throughput * value * s.contribution * (cos * weight);
             }
         };
         if lights.samples_every_light() {
