@@ -25,10 +25,10 @@ use super::beam_estimate::BeamEstimate;
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light, emitted, power_heuristic};
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::camera_chain;
-use super::tiles::sample_pass;
+use super::specular_chain::{camera_chain, camera_chains};
+use super::tiles::{sample_pass, sample_pass_tiles};
 use super::Progressive;
-use crate::bsdf::{Bsdf, Transport};
+use crate::bsdf::{Bsdf, BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
 use crate::photon::light_walk::{Passage, Step};
 use crate::photon::map::PhotonMap;
@@ -36,7 +36,7 @@ use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of the photon-map global illumination integrator.
@@ -112,6 +112,8 @@ pub struct Gi<'a> {
     mis: bool,
     /// Whether light is carried at sampled wavelengths.
     spectral: bool,
+    /// Whether a tile's camera chains walk together ([`Scene::streams_pay`]).
+    pub(super) waves: bool,
 }
 
 impl<'a> Gi<'a> {
@@ -127,6 +129,7 @@ impl<'a> Gi<'a> {
             camera,
             mis: bsdf_can_reach_light(scene),
             spectral: settings_spectral(&settings.spectral, scene),
+            waves: scene.streams_pay(),
             settings,
         }
     }
@@ -174,54 +177,101 @@ impl<'a> Gi<'a> {
             (s.specular_camera_paths, false),
             wl,
             rng,
-            (
-                |hit, bsdf, wo, path_length, dispersed, left, _caustic_only, rng| {
-                    let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
-                    let min_left = needed_bounces_left(s.max_depth, left);
-                    let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
-                    if bsdf.is_phase() {
-                        // In a medium: the volume photons within a ball, as ppm gathers them.
-                        let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
-                        let indirect = &maps.volume_indirect;
-                        return direct
-                            + indirect.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
-                    }
-                    direct
-                        + maps
-                            .caustic
-                            .radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
-                },
-                |hit, sample, path_length, dispersed, left, rng| {
-                    if hit.is_in_medium() {
-                        // The volume photons counted the rest.
-                        return if self.mis {
-                            sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
-                        } else {
-                            Spectrum::ZERO
-                        };
-                    }
-                    let origin = hit.ray_origin(sample.wi);
-                    let gather = Gather {
-                        from: Some((hit.point, sample.pdf)),
-                        path_length,
-                        dispersed,
-                        level: 0,
-                        left,
-                        medium: hit.media.towards(hit.geometric_normal, sample.wi),
+            self.gathers(maps, wl),
+            &mut self.beams(maps, wl),
+        )
+    }
+
+    /// [`Gi::radiance`] along each of a tile's camera rays, walked together.
+    fn radiances(&self, maps: &GiMaps, starts: Vec<(Ray, Rng)>, wl: &Wavelengths) -> Vec<Spectrum> {
+        let s = &self.settings;
+        camera_chains(
+            self.scene,
+            starts,
+            s.max_depth,
+            (s.specular_camera_paths, false),
+            wl,
+            self.gathers(maps, wl),
+            || self.beams(maps, wl),
+        )
+    }
+
+    /// What a camera chain gathers at its smooth surface (next-event estimation and the
+    /// caustic photons around it) and beyond it (a final gather).
+    #[allow(clippy::type_complexity)]
+    fn gathers<'s>(
+        &'s self,
+        maps: &'s GiMaps,
+        wl: &'s Wavelengths,
+    ) -> (
+        impl FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum + Clone + 's,
+        impl FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum + Clone + 's,
+    ) {
+        let s = &self.settings;
+        (
+            move |hit: &SurfaceHit,
+                  bsdf: &Bsdf,
+                  wo: Vec3,
+                  path_length: f32,
+                  dispersed: bool,
+                  left: u32,
+                  _caustic_only: bool,
+                  rng: &mut Rng| {
+                let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
+                let min_left = needed_bounces_left(s.max_depth, left);
+                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
+                if bsdf.is_phase() {
+                    // In a medium: the volume photons within a ball, as ppm gathers them.
+                    let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
+                    let indirect = &maps.volume_indirect;
+                    return direct
+                        + indirect.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
+                }
+                direct
+                    + maps
+                        .caustic
+                        .radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
+            },
+            move |hit: &SurfaceHit,
+                  sample: &BsdfSample,
+                  path_length: f32,
+                  dispersed: bool,
+                  left: u32,
+                  rng: &mut Rng| {
+                if hit.is_in_medium() {
+                    // The volume photons counted the rest.
+                    return if self.mis {
+                        sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
+                    } else {
+                        Spectrum::ZERO
                     };
-                    sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
-                },
-            ),
-            &mut BeamEstimate {
-                scene: self.scene,
-                volume: &maps.volume_indirect,
-                radius: s.caustic_radius,
-                pixel_angle: self.pixel_angle,
-                factor: maps.caustic_factor,
-                max_depth: s.max_depth,
-                wl,
+                }
+                let origin = hit.ray_origin(sample.wi);
+                let gather = Gather {
+                    from: Some((hit.point, sample.pdf)),
+                    path_length,
+                    dispersed,
+                    level: 0,
+                    left,
+                    medium: hit.media.towards(hit.geometric_normal, sample.wi),
+                };
+                sample.weight * self.gather(maps, Ray::new(origin, sample.wi), gather, wl, rng)
             },
         )
+    }
+
+    /// The beam estimate of a camera chain's segments through media.
+    fn beams<'s>(&'s self, maps: &'s GiMaps, wl: &'s Wavelengths) -> BeamEstimate<'s> {
+        let s = &self.settings;
+        BeamEstimate {
+            scene: self.scene,
+            volume: &maps.volume_indirect,
+            radius: s.caustic_radius,
+            pixel_angle: self.pixel_angle,
+            factor: maps.caustic_factor,
+            max_depth: s.max_depth,
+            wl,
+        }
     }
 
     /// Light arriving along a gather ray: the global map's estimate at the smooth surface it
@@ -366,6 +416,17 @@ impl Progressive for Gi<'_> {
             return None;
         }
         let camera = &self.camera;
+        if self.waves {
+            // A tile's chains walked together: the same random streams, so the same image.
+            return sample_pass_tiles(self.width, self.height, self.seed, pass, control, |points| {
+                let starts = points
+                    .into_iter()
+                    .map(|p| (camera.generate_ray(p.screen.0, p.screen.1), p.rng))
+                    .collect();
+                let radiances = self.radiances(&maps, starts, &wl);
+                radiances.into_iter().map(|l| wl.to_rgb(l)).collect()
+            });
+        }
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             wl.to_rgb(self.radiance(&maps, camera.generate_ray(sx, sy), &wl, rng))
         })

@@ -12,16 +12,17 @@
 use super::beam_estimate::BeamEstimate;
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::camera_chain;
-use super::tiles::sample_pass;
+use super::specular_chain::{camera_chain, camera_chains};
+use super::tiles::{sample_pass, sample_pass_tiles};
 use super::Progressive;
+use crate::bsdf::{Bsdf, BsdfSample};
 use crate::math::{Ray, Vec3};
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left, Photon};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of progressive photon mapping.
@@ -111,6 +112,8 @@ pub struct Ppm<'a> {
     mis: bool,
     /// Whether light is carried at sampled wavelengths.
     spectral: bool,
+    /// Whether a tile's camera chains walk together ([`Scene::streams_pay`]).
+    pub(super) waves: bool,
 }
 
 impl<'a> Ppm<'a> {
@@ -127,6 +130,7 @@ impl<'a> Ppm<'a> {
             pixel_angle,
             mis: bsdf_can_reach_light(scene),
             spectral: settings_spectral(&settings.spectral, scene),
+            waves: scene.streams_pay(),
             settings,
         }
     }
@@ -158,7 +162,7 @@ impl<'a> Ppm<'a> {
     /// direct light and the photons that reached it by mirrors and glass alone.
     fn radiance(
         &self,
-        (map, volume): (&PhotonMap, &PhotonMap),
+        maps: (&PhotonMap, &PhotonMap),
         ray: Ray,
         radius_factor: f32,
         wl: &Wavelengths,
@@ -168,41 +172,91 @@ impl<'a> Ppm<'a> {
             self.scene,
             ray,
             self.settings.max_depth,
-            (self.settings.specular_camera_paths, self.settings.glossy_camera_paths),
+            self.through(),
             wl,
             rng,
-            (
-                |hit, bsdf, wo, path_length, dispersed, left, caustic_only, rng| {
-                    let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
-                    let min_left = needed_bounces_left(self.settings.max_depth, left);
-                    let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
-                    if bsdf.is_phase() {
-                        // In a medium: the volume photons within a ball of the same radius.
-                        let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
-                        return direct
-                            + volume.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
-                    }
-                    let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
-                    direct + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
-                },
-                |hit, sample, _, _, _, rng| {
-                    if self.mis {
-                        sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
-                    } else {
-                        Spectrum::ZERO
-                    }
-                },
-            ),
-            &mut BeamEstimate {
-                scene: self.scene,
-                volume,
-                radius: self.settings.initial_radius,
-                pixel_angle: self.pixel_angle,
-                factor: radius_factor,
-                max_depth: self.settings.max_depth,
-                wl,
+            self.gathers(maps, radius_factor, wl),
+            &mut self.beams(maps.1, radius_factor, wl),
+        )
+    }
+
+    /// [`Ppm::radiance`] along each of a tile's camera rays, walked together.
+    fn radiances(
+        &self,
+        maps: (&PhotonMap, &PhotonMap),
+        starts: Vec<(Ray, Rng)>,
+        radius_factor: f32,
+        wl: &Wavelengths,
+    ) -> Vec<Spectrum> {
+        camera_chains(
+            self.scene,
+            starts,
+            self.settings.max_depth,
+            self.through(),
+            wl,
+            self.gathers(maps, radius_factor, wl),
+            || self.beams(maps.1, radius_factor, wl),
+        )
+    }
+
+    /// Whether camera paths go on through mirrors and glass, and through sharp highlights.
+    fn through(&self) -> (bool, bool) {
+        (self.settings.specular_camera_paths, self.settings.glossy_camera_paths)
+    }
+
+    /// What a camera chain gathers at its smooth surface (next-event estimation and the
+    /// photons around it) and beyond it (the BSDF half of direct light).
+    #[allow(clippy::type_complexity)]
+    fn gathers<'s>(
+        &'s self,
+        (map, volume): (&'s PhotonMap, &'s PhotonMap),
+        radius_factor: f32,
+        wl: &'s Wavelengths,
+    ) -> (
+        impl FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum + Clone + 's,
+        impl FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum + Clone + 's,
+    ) {
+        (
+            move |hit: &SurfaceHit,
+                  bsdf: &Bsdf,
+                  wo: Vec3,
+                  path_length: f32,
+                  dispersed: bool,
+                  left: u32,
+                  caustic_only: bool,
+                  rng: &mut Rng| {
+                let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
+                let min_left = needed_bounces_left(self.settings.max_depth, left);
+                let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
+                if bsdf.is_phase() {
+                    // In a medium: the volume photons within a ball of the same radius.
+                    let sigma_s = self.scene.medium(hit.media.back).sigma_s_at(hit.point, wl);
+                    return direct + volume.in_scattered_within(hit.point, bsdf, wo, (r, min_left), dispersed, sigma_s);
+                }
+                let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
+                direct + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
+            },
+            move |hit: &SurfaceHit, sample: &BsdfSample, _: f32, _: bool, _: u32, rng: &mut Rng| {
+                if self.mis {
+                    sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
+                } else {
+                    Spectrum::ZERO
+                }
             },
         )
+    }
+
+    /// The beam estimate of a camera chain's segments through media.
+    fn beams<'s>(&'s self, volume: &'s PhotonMap, radius_factor: f32, wl: &'s Wavelengths) -> BeamEstimate<'s> {
+        BeamEstimate {
+            scene: self.scene,
+            volume,
+            radius: self.settings.initial_radius,
+            pixel_angle: self.pixel_angle,
+            factor: radius_factor,
+            max_depth: self.settings.max_depth,
+            wl,
+        }
     }
 }
 
@@ -215,6 +269,17 @@ impl Progressive for Ppm<'_> {
         }
         let factor = radius_factor(pass, self.settings.alpha);
         let camera = &self.camera;
+        if self.waves {
+            // A tile's chains walked together: the same random streams, so the same image.
+            return sample_pass_tiles(self.width, self.height, self.seed, pass, control, |points| {
+                let starts = points
+                    .into_iter()
+                    .map(|p| (camera.generate_ray(p.screen.0, p.screen.1), p.rng))
+                    .collect();
+                let radiances = self.radiances((&map, &volume), starts, factor, &wl);
+                radiances.into_iter().map(|l| wl.to_rgb(l)).collect()
+            });
+        }
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {
             wl.to_rgb(self.radiance((&map, &volume), camera.generate_ray(sx, sy), factor, &wl, rng))
         })
