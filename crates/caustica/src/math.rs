@@ -251,9 +251,44 @@ pub fn round_to_i32(x: f32) -> i32 {
     whole + i32::from(rest >= 0.5) - i32::from(rest <= -0.5)
 }
 
+/// `x.floor() as i32` (saturating, NaN to 0), without the library call baseline x86-64 makes
+/// for `floor`: truncated, then one less where that rounded a negative fraction up.
+#[inline]
+pub fn floor_to_i32(x: f32) -> i32 {
+    let whole = x as i32;
+    whole.saturating_sub(i32::from(x < whole as f32))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn flooring_to_an_integer_matches_floor() {
+        let mut rng = crate::sampling::Rng::new(9, 0);
+        let whole = (-40..=40).map(|k| k as f32 * 0.5);
+        let near = whole.clone().flat_map(|t| [t.next_down(), t.next_up()]);
+        let random = (0..100_000).map(|_| (rng.uniform() - 0.5) * 2f32.powi((rng.uniform() * 40.0) as i32));
+        let edges = [
+            0.0,
+            -0.0,
+            f32::NAN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::MAX,
+            f32::MIN,
+            2f32.powi(31),
+            -(2f32.powi(31)),
+            -(2f32.powi(31)).next_up(),
+            -(2f32.powi(32)),
+            2f32.powi(24) + 2.0,
+            -(2f32.powi(24)) - 2.0,
+            -1e-30,
+        ];
+        for x in whole.chain(near).chain(random).chain(edges) {
+            assert_eq!(floor_to_i32(x), x.floor() as i32, "{x}");
+        }
+    }
 
     #[test]
     fn rounding_to_an_integer_matches_round_on_quarter_turns() {

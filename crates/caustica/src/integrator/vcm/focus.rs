@@ -7,6 +7,7 @@
 //! The pilot run has its own fixed random stream, so every pass (on any machine of a split
 //! run) sees the same cells.
 
+use super::grid::cell_of;
 use crate::math::Vec3;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -65,11 +66,6 @@ impl CausticFocus {
     pub fn contains(&self, p: Vec3) -> bool {
         !self.cells.is_empty() && self.cells.contains(&cell_of(p, self.inv_cell))
     }
-}
-
-fn cell_of(p: Vec3, inv_cell: f32) -> [i32; 3] {
-    let c = (p * inv_cell).floor();
-    [c.x as i32, c.y as i32, c.z as i32]
 }
 
 #[cfg(test)]
