@@ -251,9 +251,17 @@ pub fn round_to_i32(x: f32) -> i32 {
     whole + i32::from(rest >= 0.5) - i32::from(rest <= -0.5)
 }
 
-/// `x.floor() as i32` (saturating, NaN to 0), without the library call baseline x86-64 makes
-/// for `floor`: truncated, then one less where that rounded a negative fraction up.
-#[inline]
+/// `x.floor()` as an integer, exact for |x| ≤ 2⁴⁰ (the conversion truncates toward zero, and
+/// an f32 that large is whole), without the library call baseline x86-64 makes for `floor`.
+#[inline(always)]
+pub fn floor_to_i64(x: f32) -> i64 {
+    let whole = x as i64;
+    whole.saturating_sub(i64::from(x < whole as f32))
+}
+
+/// `x.floor() as i32`, saturating as that conversion does (NaN to 0): [`floor_to_i64`] in
+/// 32 bits, for a grid's cells (clamping the 64-bit floor cost vcm 0.4% more instructions).
+#[inline(always)]
 pub fn floor_to_i32(x: f32) -> i32 {
     let whole = x as i32;
     whole.saturating_sub(i32::from(x < whole as f32))
@@ -263,6 +271,8 @@ pub fn floor_to_i32(x: f32) -> i32 {
 mod tests {
     use super::*;
 
+    /// Both integer floors agree with `f32::floor` on whole numbers and halves, their
+    /// neighbours, random values of every scale and the edges of the integer types.
     #[test]
     fn flooring_to_an_integer_matches_floor() {
         let mut rng = crate::sampling::Rng::new(9, 0);
@@ -284,9 +294,16 @@ mod tests {
             2f32.powi(24) + 2.0,
             -(2f32.powi(24)) - 2.0,
             -1e-30,
+            1e12,
+            -1e12,
+            16_777_217.0,
+            -8_388_609.5,
         ];
         for x in whole.chain(near).chain(random).chain(edges) {
             assert_eq!(floor_to_i32(x), x.floor() as i32, "{x}");
+            if x.abs() <= 2f32.powi(40) {
+                assert_eq!(floor_to_i64(x), x.floor() as i64, "{x}");
+            }
         }
     }
 
