@@ -25,10 +25,10 @@ use super::beam_estimate::BeamEstimate;
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light, emitted, power_heuristic};
 use super::ppm::{pass_wavelengths, settings_spectral, PHOTON_SEED};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::{camera_chain, camera_chains};
-use super::tiles::{sample_pass, sample_pass_tiles};
+use super::specular_chain::{camera_chain, camera_chains, chain_pass, gathers, AtSmooth, Beyond};
+use super::tiles::sample_pass;
 use super::Progressive;
-use crate::bsdf::{Bsdf, BsdfSample, Transport};
+use crate::bsdf::{Bsdf, Transport};
 use crate::math::{Ray, Vec3};
 use crate::photon::light_walk::{Passage, Step};
 use crate::photon::map::PhotonMap;
@@ -36,7 +36,7 @@ use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::{Scene, SurfaceHit};
+use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of the photon-map global illumination integrator.
@@ -203,20 +203,10 @@ impl<'a> Gi<'a> {
         &'s self,
         maps: &'s GiMaps,
         wl: &'s Wavelengths,
-    ) -> (
-        impl FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum + Clone + 's,
-        impl FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum + Clone + 's,
-    ) {
+    ) -> (impl AtSmooth + Clone + 's, impl Beyond + Clone + 's) {
         let s = &self.settings;
-        (
-            move |hit: &SurfaceHit,
-                  bsdf: &Bsdf,
-                  wo: Vec3,
-                  path_length: f32,
-                  dispersed: bool,
-                  left: u32,
-                  _caustic_only: bool,
-                  rng: &mut Rng| {
+        gathers(
+            move |hit, bsdf, wo, path_length, dispersed, left, _caustic_only, rng| {
                 let r = s.caustic_radius.at(self.pixel_angle, path_length) * maps.caustic_factor;
                 let min_left = needed_bounces_left(s.max_depth, left);
                 let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
@@ -232,12 +222,7 @@ impl<'a> Gi<'a> {
                         .caustic
                         .radiance_within(hit.point, bsdf, wo, (r, min_left), dispersed)
             },
-            move |hit: &SurfaceHit,
-                  sample: &BsdfSample,
-                  path_length: f32,
-                  dispersed: bool,
-                  left: u32,
-                  rng: &mut Rng| {
+            move |hit, sample, path_length, dispersed, left, rng| {
                 if hit.is_in_medium() {
                     // The volume photons counted the rest.
                     return if self.mis {
@@ -418,13 +403,9 @@ impl Progressive for Gi<'_> {
         let camera = &self.camera;
         if self.waves {
             // A tile's chains walked together: the same random streams, so the same image.
-            return sample_pass_tiles(self.width, self.height, self.seed, pass, control, |points| {
-                let starts = points
-                    .into_iter()
-                    .map(|p| (camera.generate_ray(p.screen.0, p.screen.1), p.rng))
-                    .collect();
-                let radiances = self.radiances(&maps, starts, &wl);
-                radiances.into_iter().map(|l| wl.to_rgb(l)).collect()
+            let size = (self.width, self.height, self.seed);
+            return chain_pass(size, pass, control, camera, &wl, |starts| {
+                self.radiances(&maps, starts, &wl)
             });
         }
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {

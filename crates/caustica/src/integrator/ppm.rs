@@ -12,17 +12,16 @@
 use super::beam_estimate::BeamEstimate;
 use super::direct::{bsdf_can_reach_light, direct_by_bsdf, direct_light};
 use super::radius::{pixel_angle, radius_factor, InitialRadius};
-use super::specular_chain::{camera_chain, camera_chains};
-use super::tiles::{sample_pass, sample_pass_tiles};
+use super::specular_chain::{camera_chain, camera_chains, chain_pass, gathers, AtSmooth, Beyond};
+use super::tiles::sample_pass;
 use super::Progressive;
-use crate::bsdf::{Bsdf, BsdfSample};
 use crate::math::{Ray, Vec3};
 use crate::photon::map::PhotonMap;
 use crate::photon::trace::trace_count_in_media;
 use crate::photon::{is_caustic, is_direct, needed_bounces_left, Photon};
 use crate::progress::Control;
 use crate::sampling::Rng;
-use crate::scene::{Scene, SurfaceHit};
+use crate::scene::Scene;
 use crate::spectrum::{Spectrum, Wavelengths};
 
 /// Settings of progressive photon mapping.
@@ -212,19 +211,9 @@ impl<'a> Ppm<'a> {
         (map, volume): (&'s PhotonMap, &'s PhotonMap),
         radius_factor: f32,
         wl: &'s Wavelengths,
-    ) -> (
-        impl FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum + Clone + 's,
-        impl FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum + Clone + 's,
-    ) {
-        (
-            move |hit: &SurfaceHit,
-                  bsdf: &Bsdf,
-                  wo: Vec3,
-                  path_length: f32,
-                  dispersed: bool,
-                  left: u32,
-                  caustic_only: bool,
-                  rng: &mut Rng| {
+    ) -> (impl AtSmooth + Clone + 's, impl Beyond + Clone + 's) {
+        gathers(
+            move |hit, bsdf, wo, path_length, dispersed, left, caustic_only, rng| {
                 let r = self.settings.initial_radius.at(self.pixel_angle, path_length) * radius_factor;
                 let min_left = needed_bounces_left(self.settings.max_depth, left);
                 let direct = direct_light(self.scene, hit, bsdf, wo, self.mis, wl, rng);
@@ -236,7 +225,7 @@ impl<'a> Ppm<'a> {
                 let kept = |photon: &Photon| !caustic_only || is_caustic(photon);
                 direct + map.radiance_within_of(hit.point, bsdf, wo, (r, min_left), dispersed, kept)
             },
-            move |hit: &SurfaceHit, sample: &BsdfSample, _: f32, _: bool, _: u32, rng: &mut Rng| {
+            move |hit, sample, _, _, _, rng| {
                 if self.mis {
                     sample.weight * direct_by_bsdf(self.scene, hit, sample, wl, rng)
                 } else {
@@ -271,13 +260,9 @@ impl Progressive for Ppm<'_> {
         let camera = &self.camera;
         if self.waves {
             // A tile's chains walked together: the same random streams, so the same image.
-            return sample_pass_tiles(self.width, self.height, self.seed, pass, control, |points| {
-                let starts = points
-                    .into_iter()
-                    .map(|p| (camera.generate_ray(p.screen.0, p.screen.1), p.rng))
-                    .collect();
-                let radiances = self.radiances((&map, &volume), starts, factor, &wl);
-                radiances.into_iter().map(|l| wl.to_rgb(l)).collect()
+            let size = (self.width, self.height, self.seed);
+            return chain_pass(size, pass, control, camera, &wl, |starts| {
+                self.radiances((&map, &volume), starts, factor, &wl)
             });
         }
         sample_pass(self.width, self.height, self.seed, pass, control, |sx, sy, rng| {

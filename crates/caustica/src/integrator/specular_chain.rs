@@ -4,9 +4,12 @@
 use super::camera_walk::{
     bounce_as_surface, visit_as_surface, walk_camera, CameraArrival, CameraPath, CameraVisitor, CameraWalk,
 };
+use super::tiles::sample_pass_tiles;
 use crate::bsdf::{Bsdf, BsdfSample, Transport};
+use crate::camera::Camera;
 use crate::math::{Ray, Vec3};
 use crate::photon::light_walk::{walk_together, MediumArrival, Passage, Walker};
+use crate::progress::Control;
 use crate::sampling::Rng;
 use crate::scene::{Scene, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
@@ -46,8 +49,8 @@ pub fn camera_chain<S, B>(
     along: &mut dyn Along,
 ) -> Spectrum
 where
-    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum,
-    B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum,
+    S: AtSmooth,
+    B: Beyond,
 {
     let mut chain = Chain::new(
         scene,
@@ -77,8 +80,8 @@ pub fn camera_chains<S, B, A>(
     along: impl Fn() -> A,
 ) -> Vec<Spectrum>
 where
-    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum + Clone,
-    B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum + Clone,
+    S: AtSmooth + Clone,
+    B: Beyond + Clone,
     A: Along,
 {
     let mut alongs: Vec<A> = starts.iter().map(|_| along()).collect();
@@ -104,6 +107,44 @@ where
         .collect();
     walk_together(scene, &mut chains);
     chains.into_iter().map(|c| c.visitor.l).collect()
+}
+
+/// A pass of camera chains with a tile's chains walked together ([`camera_chains`]):
+/// `radiances` takes a tile's camera rays with their pixels' random streams, those
+/// [`sample_pass_tiles`] draws, and gives each chain's radiance in order; the image is
+/// [`sample_pass`](super::tiles::sample_pass)'s with the chains walked one by one.
+pub fn chain_pass(
+    (width, height, seed): (usize, usize, u64),
+    pass: u64,
+    control: Control,
+    camera: &Camera,
+    wl: &Wavelengths,
+    radiances: impl Fn(Vec<(Ray, Rng)>) -> Vec<Spectrum> + Sync,
+) -> Option<Vec<Vec3>> {
+    sample_pass_tiles(width, height, seed, pass, control, |points| {
+        let starts = points
+            .into_iter()
+            .map(|p| (camera.generate_ray(p.screen.0, p.screen.1), p.rng))
+            .collect();
+        radiances(starts).into_iter().map(|l| wl.to_rgb(l)).collect()
+    })
+}
+
+/// What a camera chain adds at its smooth surface ([`camera_chain`]'s `at_smooth`):
+/// `(hit, bsdf, wo, path length, dispersed, surfaces left, caustic only, rng)`.
+pub trait AtSmooth: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum {}
+
+impl<F: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum> AtSmooth for F {}
+
+/// What a camera chain adds beyond its smooth surface ([`camera_chain`]'s `beyond`):
+/// `(hit, sample, path length, dispersed, surfaces left, rng)`.
+pub trait Beyond: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum {}
+
+impl<F: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum> Beyond for F {}
+
+/// A chain's two closures, their arguments' types given by [`AtSmooth`] and [`Beyond`].
+pub fn gathers<S: AtSmooth, B: Beyond>(at_smooth: S, beyond: B) -> (S, B) {
+    (at_smooth, beyond)
 }
 
 /// What a camera chain gathers along its segments through media before its first smooth
@@ -150,8 +191,8 @@ struct Chain<'c, S, B> {
 
 impl<S, B> CameraVisitor for Chain<'_, S, B>
 where
-    S: FnMut(&SurfaceHit, &Bsdf, Vec3, f32, bool, u32, bool, &mut Rng) -> Spectrum,
-    B: FnMut(&SurfaceHit, &BsdfSample, f32, bool, u32, &mut Rng) -> Spectrum,
+    S: AtSmooth,
+    B: Beyond,
 {
     fn escaped(&mut self, dir: Vec3, throughput: Spectrum, _length: u32) {
         // Only the camera and specular chains get here: the sky counts in full.
@@ -279,40 +320,45 @@ mod tests {
     /// beside a polished ball.
     #[test]
     fn chains_walked_together_make_the_image_single_chains_make() {
-        let text = "SBT-raytracer 1.0
-camera { position = (-2.5, 2.5, 0); viewdir = (1, -1.1, 0); updir = (0, 1, 0); fov = 40; }
-spot_light { position = (1.2, 2, 0); direction = (-1.2, -1.5, 0); color = (3, 3, 3); size = 50; blend = 0.3;
-  constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
-translate(0, 0.5, 0, scale(0.5, sphere { material = { transmissive = (1, 1, 1); index = 1.5; } }))
-translate(0, 0.4, 1.1, scale(0.4, sphere { material = { diffuse = (0.1, 0.1, 0.1); specular = (0.8, 0.8, 0.8); shininess = 200; } }))
-rotate(1, 0, 0, -1.5707963, scale(40, square { material = { diffuse = (0.6, 0.6, 0.6); } }))";
-        let scene = crate::loader::from_text(text, std::path::Path::new("."), &Default::default()).unwrap();
+        let scene = crate::scene::build::spot_through_glass(
+            "translate(0, 0.4, 1.1, scale(0.4, sphere { material = { diffuse = (0.1, 0.1, 0.1); \
+             specular = (0.8, 0.8, 0.8); shininess = 200; } }))",
+        );
         let cancel = std::sync::atomic::AtomicBool::new(false);
         let control = || Control {
             progress: &NoProgress,
             cancel: &cancel,
+        };
+        // The pass rendered with waves and without, and how many pixels it lights.
+        let both_ways = |mut render: Box<dyn FnMut(bool) -> Vec<crate::math::Vec3> + '_>| {
+            let films = [true, false].map(&mut render);
+            assert_eq!(films[0], films[1]);
+            films[0].iter().filter(|p| p.x > 0.0).count()
         };
         let settings = PpmSettings {
             photons_per_pass: 20_000,
             ..PpmSettings::default()
         };
         let mut ppm = Ppm::new(&scene, settings, 40, 40, 3);
-        let films = [true, false].map(|waves| {
+        let lit = both_ways(Box::new(|waves| {
             ppm.waves = waves;
             ppm.render_pass(1, control()).expect("not cancelled")
-        });
-        assert!(films[0].iter().filter(|p| p.x > 0.0).count() > 400, "a lit image");
-        assert_eq!(films[0], films[1]);
-        let settings = GiSettings {
-            photons_per_pass: 5_000,
-            ..GiSettings::default()
-        };
-        let mut gi = Gi::new(&scene, settings, 24, 24, 3);
-        let films = [true, false].map(|waves| {
+        }));
+        assert!(lit > 400, "{lit} pixels lit by ppm");
+        let mut gi = Gi::new(
+            &scene,
+            GiSettings {
+                photons_per_pass: 5_000,
+                ..GiSettings::default()
+            },
+            24,
+            24,
+            3,
+        );
+        let lit = both_ways(Box::new(|waves| {
             gi.waves = waves;
             gi.render_pass(1, control()).expect("not cancelled")
-        });
-        assert!(films[0].iter().filter(|p| p.x > 0.0).count() > 100, "a lit image");
-        assert_eq!(films[0], films[1]);
+        }));
+        assert!(lit > 100, "{lit} pixels lit by gi");
     }
 }

@@ -771,6 +771,22 @@ pub(crate) fn test_scene(objects: &str) -> Scene {
     crate::loader::from_text(&text, std::path::Path::new("."), &Default::default()).unwrap()
 }
 
+/// A spot light through a glass ball onto a floor, its caustic in view of a camera above, and
+/// `objects` beside them, for unit tests of the caustics integrators.
+#[cfg(test)]
+pub(crate) fn spot_through_glass(objects: &str) -> Scene {
+    let text = format!(
+        "SBT-raytracer 1.0
+camera {{ position = (-2.5, 2.5, 0); viewdir = (1, -1.1, 0); updir = (0, 1, 0); fov = 40; }}
+spot_light {{ position = (1.2, 2, 0); direction = (-1.2, -1.5, 0); color = (3, 3, 3); size = 50; blend = 0.3;
+  constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }}
+translate(0, 0.5, 0, scale(0.5, sphere {{ material = {{ transmissive = (1, 1, 1); index = 1.5; }} }}))
+rotate(1, 0, 0, -1.5707963, scale(40, square {{ material = {{ diffuse = (0.6, 0.6, 0.6); }} }}))
+{objects}"
+    );
+    crate::loader::from_text(&text, std::path::Path::new("."), &Default::default()).unwrap()
+}
+
 /// A `polymesh` of a bumpy sheet over [−2, 2]², `n`×`n` quads of two triangles each.
 #[cfg(test)]
 pub(crate) fn bumpy_sheet(n: usize) -> String {

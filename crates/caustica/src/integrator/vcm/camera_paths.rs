@@ -521,13 +521,7 @@ mod tests {
     /// its caustic in view.
     #[test]
     fn waves_make_the_image_single_walks_make() {
-        let text = "SBT-raytracer 1.0
-camera { position = (-2.5, 2.5, 0); viewdir = (1, -1.1, 0); updir = (0, 1, 0); fov = 40; }
-spot_light { position = (1.2, 2, 0); direction = (-1.2, -1.5, 0); color = (3, 3, 3); size = 50; blend = 0.3;
-  constant_attenuation_coeff = 0; linear_attenuation_coeff = 0; quadratic_attenuation_coeff = 1; }
-translate(0, 0.5, 0, scale(0.5, sphere { material = { transmissive = (1, 1, 1); index = 1.5; } }))
-rotate(1, 0, 0, -1.5707963, scale(40, square { material = { diffuse = (0.6, 0.6, 0.6); } }))";
-        let scene = crate::loader::from_text(text, std::path::Path::new("."), &Default::default()).unwrap();
+        let scene = crate::scene::build::spot_through_glass("");
         let cancel = std::sync::atomic::AtomicBool::new(false);
         let control = || Control {
             progress: &NoProgress,
