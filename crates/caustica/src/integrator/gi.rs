@@ -198,7 +198,6 @@ impl<'a> Gi<'a> {
 
     /// What a camera chain gathers at its smooth surface (next-event estimation and the
     /// caustic photons around it) and beyond it (a final gather).
-    #[allow(clippy::type_complexity)]
     fn gathers<'s>(
         &'s self,
         maps: &'s GiMaps,

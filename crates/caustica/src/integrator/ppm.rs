@@ -205,7 +205,6 @@ impl<'a> Ppm<'a> {
 
     /// What a camera chain gathers at its smooth surface (next-event estimation and the
     /// photons around it) and beyond it (the BSDF half of direct light).
-    #[allow(clippy::type_complexity)]
     fn gathers<'s>(
         &'s self,
         (map, volume): (&'s PhotonMap, &'s PhotonMap),

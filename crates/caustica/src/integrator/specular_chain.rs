@@ -64,12 +64,11 @@ where
     chain.l
 }
 
-/// [`camera_chain`] for each of `starts` (a camera ray and its random stream, the same
-/// streams afterwards), the chains walked together: each bounce's rays traced as one wave
+/// [`camera_chain`] for each of `starts` (a camera ray and the random stream its chain draws
+/// from), the chains walked together: each bounce's rays traced as one wave
 /// ([`walk_together`]), which pays where the scene's triangles outgrow the caches
 /// ([`Scene::streams_pay`]). `along` gives each chain its own [`Along`]. The same radiance as
 /// each chain alone, in the order of `starts`.
-#[allow(clippy::too_many_arguments)]
 pub fn camera_chains<S, B, A>(
     scene: &Scene,
     starts: Vec<(Ray, Rng)>,
