@@ -563,17 +563,6 @@ impl LightSet {
         wl: &Wavelengths,
         rng: &mut Rng,
     ) -> Option<DirectSample> {
-        // A point, spot or directional light has one direction to offer: it draws nothing
-        // (three unused numbers were 1.7% of the point-lit box's instructions).
-        let delta = matches!(
-            self.lights[index],
-            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
-        );
-        let (u_pick, u) = if delta {
-            (0.0, Vec2::ZERO)
-        } else {
-            (rng.uniform(), rng.uniform2())
-        };
         let q = DirectQuery {
             scene,
             hit,
@@ -581,12 +570,17 @@ impl LightSet {
             choice: p_pick,
             takes: if scene.has_media() { &|_| true } else { takes },
         };
+        // Three numbers for each light with a size or a spread (the first, a point on a
+        // mesh lamp, only an area light's); a point, spot or directional light has one
+        // direction to offer and draws none (three unused were 1.7% of the point box).
+        let mut draw = || (rng.uniform(), rng.uniform2());
         let sample = match &self.lights[index] {
             light @ (Light::Point { .. } | Light::Spot { .. }) => point::sample_direct(&q, light),
-            light @ (Light::Directional { .. } | Light::Sun { .. }) => distant::sample_direct(&q, light, u),
-            Light::Environment(env) => env.sample_direct(&q, u),
-            Light::Area(light) => light.sample_direct(&q, (u_pick, u)),
-            Light::Soft(light) => light.sample_direct(&q, u),
+            light @ Light::Directional { .. } => distant::sample_direct(&q, light, Vec2::ZERO),
+            light @ Light::Sun { .. } => distant::sample_direct(&q, light, draw().1),
+            Light::Environment(env) => env.sample_direct(&q, draw().1),
+            Light::Area(light) => light.sample_direct(&q, draw()),
+            Light::Soft(light) => light.sample_direct(&q, draw().1),
         };
         if !scene.has_media() {
             return sample;
