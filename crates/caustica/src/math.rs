@@ -271,14 +271,22 @@ pub fn floor_to_i32(x: f32) -> i32 {
 mod tests {
     use super::*;
 
+    /// Test values for the integer roundings: the multiples of `step` from −40 to 40 steps,
+    /// each with its neighbours a ULP away, then 100,000 random values up to 2^`scales` drawn
+    /// with `seed`.
+    fn steps_and_scales((step, scales): (f32, i32), seed: u64) -> impl Iterator<Item = f32> {
+        let steps = (-40..=40).map(move |k| k as f32 * step);
+        let near = steps.clone().flat_map(|t| [t.next_down(), t.next_up()]);
+        let mut rng = crate::sampling::Rng::new(seed, 0);
+        let random =
+            (0..100_000).map(move |_| (rng.uniform() - 0.5) * 2f32.powi((rng.uniform() * scales as f32) as i32));
+        steps.chain(near).chain(random)
+    }
+
     /// Both integer floors agree with `f32::floor` on whole numbers and halves, their
     /// neighbours, random values of every scale and the edges of the integer types.
     #[test]
     fn flooring_to_an_integer_matches_floor() {
-        let mut rng = crate::sampling::Rng::new(9, 0);
-        let whole = (-40..=40).map(|k| k as f32 * 0.5);
-        let near = whole.clone().flat_map(|t| [t.next_down(), t.next_up()]);
-        let random = (0..100_000).map(|_| (rng.uniform() - 0.5) * 2f32.powi((rng.uniform() * 40.0) as i32));
         let edges = [
             0.0,
             -0.0,
@@ -299,7 +307,7 @@ mod tests {
             16_777_217.0,
             -8_388_609.5,
         ];
-        for x in whole.chain(near).chain(random).chain(edges) {
+        for x in steps_and_scales((0.5, 40), 9).chain(edges) {
             assert_eq!(floor_to_i32(x), x.floor() as i32, "{x}");
             if x.abs() <= 2f32.powi(40) {
                 assert_eq!(floor_to_i64(x), x.floor() as i64, "{x}");
@@ -309,15 +317,8 @@ mod tests {
 
     #[test]
     fn rounding_to_an_integer_matches_round_on_quarter_turns() {
-        let mut rng = crate::sampling::Rng::new(7, 0);
-        let ties = (-40..=40).map(|k| k as f32 * 0.125);
-        let near_ties = ties.clone().flat_map(|t| [t.next_down(), t.next_up()]);
-        let random = (0..100_000).map(|_| (rng.uniform() - 0.5) * 2f32.powi((rng.uniform() * 23.0) as i32));
-        for turns in
-            ties.chain(near_ties)
-                .chain(random)
-                .chain([2f32.powi(21) - 0.125, 0.125 - 2f32.powi(21), 0.0, -0.0])
-        {
+        let edges = [2f32.powi(21) - 0.125, 0.125 - 2f32.powi(21), 0.0, -0.0];
+        for turns in steps_and_scales((0.125, 23), 7).chain(edges) {
             assert_eq!(round_to_i32(turns * 4.0), (turns * 4.0).round() as i32, "{turns}");
         }
     }
