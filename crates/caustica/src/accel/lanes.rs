@@ -1,9 +1,10 @@
 //! The SIMD vectors that packet tests run on: four lanes everywhere (glam's `Vec4`: SSE2 on
 //! every x86-64 CPU), eight where the CPU has AVX, chosen when the scene is built
 //! ([`Width::of_host`]). The build targets baseline x86-64, so the eight-lane code is compiled
-//! for AVX inside [`in_avx`] and entered only with the proof ([`Avx`]) that the CPU has it. This
-//! is the crate's one module with `unsafe` code: the AVX intrinsics, that entry and the cache
-//! prefetch hint ([`prefetch`]).
+//! for AVX inside [`in_avx`] and entered only with the proof ([`Avx`]) that the CPU has it; the
+//! few AVX2 integer operations (a walk's sorting of a node's children, [`sorted_entries`]) the
+//! same way, inside [`in_avx2`]. This is the crate's one module with `unsafe` code: the
+//! intrinsics, those entries and the cache prefetch hint ([`prefetch`]).
 //!
 //! Both widths do the same IEEE operations (no fused multiply-adds; `min`, `max` and the
 //! comparisons treat NaN as SSE does), so a packet test finds the same hits, to the bit, at
@@ -18,37 +19,62 @@ use glam::{BVec4A, Vec4};
 pub enum Width {
     /// Four (SSE2, or glam's scalar fallback off x86-64).
     Four,
-    /// Eight, with the proof that this CPU has AVX.
+    /// Eight, with the proof that this CPU has AVX (and whether AVX2).
     #[cfg(target_arch = "x86_64")]
     Eight(Avx),
 }
 
 impl Width {
-    /// The widest this CPU runs: eight lanes with AVX.
+    /// The widest this CPU runs: eight lanes with AVX, with AVX2's operations where it has them.
     pub fn of_host() -> Width {
         Width::on_host().pop().unwrap_or(Width::Four)
     }
 
-    /// Every width this CPU runs, narrowest first.
+    /// Every width this CPU runs, narrowest first; eight lanes twice where the CPU has AVX2,
+    /// without its operations and with them.
     pub fn on_host() -> Vec<Width> {
         #[cfg(target_arch = "x86_64")]
         if let Some(avx) = Avx::detect() {
-            return vec![Width::Four, Width::Eight(avx)];
+            let mut widths = vec![Width::Four, Width::Eight(avx.without_avx2())];
+            if avx.avx2().is_some() {
+                widths.push(Width::Eight(avx));
+            }
+            return widths;
         }
         vec![Width::Four]
     }
 }
 
-/// Proof that the CPU has AVX: made only by [`Avx::detect`].
+/// Proof that the CPU has AVX, carrying AVX2's where it has that too: made only by
+/// [`Avx::detect`].
 #[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Avx(());
+pub struct Avx {
+    avx2: Option<Avx2>,
+}
+
+/// Proof that the CPU has AVX2 (and so AVX): made only by [`Avx::detect`].
+#[cfg(target_arch = "x86_64")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Avx2(());
 
 #[cfg(target_arch = "x86_64")]
 impl Avx {
     /// The proof, if the CPU reports AVX.
     pub fn detect() -> Option<Avx> {
-        std::arch::is_x86_feature_detected!("avx").then_some(Avx(()))
+        std::arch::is_x86_feature_detected!("avx").then(|| Avx {
+            avx2: std::arch::is_x86_feature_detected!("avx2").then_some(Avx2(())),
+        })
+    }
+
+    /// AVX2's proof, if the CPU reported it.
+    pub fn avx2(self) -> Option<Avx2> {
+        self.avx2
+    }
+
+    /// This proof without AVX2's: the code for CPUs with AVX alone, to compare the two.
+    pub fn without_avx2(self) -> Avx {
+        Avx { avx2: None }
     }
 }
 
@@ -63,6 +89,19 @@ pub(crate) fn in_avx<R>(_proof: Avx, f: impl FnOnce() -> R) -> R {
         f()
     }
     // SAFETY: `Avx` exists only where the CPU reported AVX.
+    unsafe { run(f) }
+}
+
+/// [`in_avx`] for AVX2: runs `f` from a function compiled for AVX2 (and so AVX).
+#[cfg(target_arch = "x86_64")]
+#[allow(unsafe_code)]
+#[inline(always)]
+pub(crate) fn in_avx2<R>(_proof: Avx2, f: impl FnOnce() -> R) -> R {
+    #[target_feature(enable = "avx2")]
+    unsafe fn run<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
+    // SAFETY: `Avx2` exists only where the CPU reported AVX2.
     unsafe { run(f) }
 }
 
@@ -190,7 +229,7 @@ impl Lanes for Vec4 {
 }
 
 #[cfg(target_arch = "x86_64")]
-pub(crate) use avx::F32x8;
+pub(crate) use avx::{sorted_entries, F32x8, M32x8};
 
 /// Eight lanes in an AVX register. Every function here runs AVX instructions: they may only be
 /// called inside [`in_avx`] (which needs the proof that the CPU has AVX), where they are inlined.
@@ -255,6 +294,69 @@ mod avx {
             let mut out = [0.0; 8];
             self.write_to(&mut out);
             out
+        }
+    }
+
+    // A traversal stack's entry (child reference, entry distance) is two 32-bit words in this
+    // order, so `sorted_entries` writes eight as two registers.
+    const _: () = assert!(
+        std::mem::size_of::<(u32, f32)>() == 8
+            && std::mem::offset_of!((u32, f32), 0) == 0
+            && std::mem::offset_of!((u32, f32), 1) == 4
+    );
+
+    /// The entries (child, entry distance) of a node's `hit` lanes, farthest first, into the
+    /// first places of `out`; returns how many. Branch-free: the keys (the distance's bits, the
+    /// slot in their low three; non-negative floats order as their bits, missed lanes are -1)
+    /// go through a bitonic sorting network of six compare-exchange stages, then pick their
+    /// children. Runs AVX2 instructions: called only inside [`in_avx2`](super::in_avx2).
+    #[inline(always)]
+    pub(crate) fn sorted_entries<const NEAR_LAST: bool>(
+        t_near: F32x8,
+        hit: M32x8,
+        children: &[u32; 8],
+        out: &mut [(u32, f32); 8],
+    ) -> usize {
+        // SAFETY: called only inside `in_avx2`, entered only where the CPU reported AVX2; the
+        // two stores cover the 64 bytes of `out` (its layout asserted above), unaligned.
+        unsafe {
+            let low = _mm256_set1_epi32(7);
+            let slots = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+            let missed = _mm256_xor_si256(_mm256_castps_si256(hit.0), _mm256_set1_epi32(-1));
+            let mut k = _mm256_or_si256(
+                _mm256_or_si256(_mm256_andnot_si256(low, _mm256_castps_si256(t_near.0)), slots),
+                missed,
+            );
+            if !NEAR_LAST {
+                // Nearest first: missed lanes sort last as the largest key.
+                k = _mm256_and_si256(k, _mm256_set1_epi32(i32::MAX));
+            }
+            // Each stage pairs lane i with a partner; the lower lane keeps the larger key with
+            // `NEAR_LAST`, else the smaller.
+            macro_rules! stage {
+                ($partner:expr, $upper_lanes:literal) => {{
+                    let p = $partner;
+                    let (big, small) = (_mm256_max_epi32(k, p), _mm256_min_epi32(k, p));
+                    k = if NEAR_LAST {
+                        _mm256_blend_epi32::<$upper_lanes>(big, small)
+                    } else {
+                        _mm256_blend_epi32::<$upper_lanes>(small, big)
+                    };
+                }};
+            }
+            stage!(_mm256_shuffle_epi32::<0xB1>(k), 0xAA); // i ^ 1
+            stage!(_mm256_shuffle_epi32::<0x1B>(k), 0xCC); // i ^ 3
+            stage!(_mm256_shuffle_epi32::<0xB1>(k), 0xAA); // i ^ 1
+            stage!(_mm256_shuffle_epi32::<0x1B>(_mm256_permute2x128_si256::<1>(k, k)), 0xF0); // i ^ 7
+            stage!(_mm256_shuffle_epi32::<0x4E>(k), 0xCC); // i ^ 2
+            stage!(_mm256_shuffle_epi32::<0xB1>(k), 0xAA); // i ^ 1
+            let c = _mm256_permutevar8x32_epi32(_mm256_loadu_si256(children.as_ptr().cast()), _mm256_and_si256(k, low));
+            let t = _mm256_andnot_si256(low, k);
+            let (lo, hi) = (_mm256_unpacklo_epi32(c, t), _mm256_unpackhi_epi32(c, t));
+            let dst = out.as_mut_ptr().cast::<__m256i>();
+            _mm256_storeu_si256(dst, _mm256_permute2x128_si256::<0x20>(lo, hi));
+            _mm256_storeu_si256(dst.add(1), _mm256_permute2x128_si256::<0x31>(lo, hi));
+            _mm256_movemask_ps(hit.0).count_ones() as usize
         }
     }
 

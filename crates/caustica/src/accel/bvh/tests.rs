@@ -694,3 +694,54 @@ fn a_floor_passes_over_only_the_rays_that_move_away() {
         assert!(hits > 3_000 && away > 3_000, "{hits} hits, {away} rays moving away");
     }
 }
+
+/// The branch-free sort of a node's children (AVX2) gives the entries the scalar sort of the
+/// keys gives, to the bit: the same children in the same order with the same rounded distances,
+/// for rays from outside and from inside boxes (whose entry distances tie at zero), with and
+/// without a finite `t_max`.
+#[cfg(target_arch = "x86_64")]
+#[test]
+fn sorted_children_match_the_scalar_sort() {
+    use crate::accel::lanes::{in_avx2, Avx};
+    let Some(avx2) = Avx::detect().and_then(Avx::avx2) else {
+        eprintln!("skipped: this CPU has no AVX2");
+        return;
+    };
+    let mut rng = Rng(0x0050_f7ed);
+    let mut counts = [0usize; MAX_WIDTH + 1];
+    for tris in [random_triangles(&mut rng, 3000), sphere(40, 80)] {
+        let tree = TriangleBvh::new(&tris);
+        for i in 0..400 {
+            let ray = if i % 4 == 0 {
+                Ray::new(tris[i % tris.len()].point(0.3, 0.3), rng.dir())
+            } else {
+                random_ray(&mut rng, &tris)
+            };
+            let t_max = if i % 3 == 0 { 0.5 + 4.0 * rng.f() } else { f32::INFINITY };
+            for node in &tree.bvh.nodes {
+                let (fast, scalar) = in_avx2(avx2, || {
+                    let (mut fast, mut scalar) = ([(0, 0.0); MAX_WIDTH], [(0, 0.0); MAX_WIDTH]);
+                    let (sorting, wide) = (SortingRayPre::new(&ray), WideRayPre::new(&ray));
+                    let (n, m) = (
+                        sorting.hit_sorted::<true>(node, t_max, &mut fast),
+                        wide.hit_sorted::<true>(node, t_max, &mut scalar),
+                    );
+                    let (mut fast_near, mut scalar_near) = ([(0, 0.0); MAX_WIDTH], [(0, 0.0); MAX_WIDTH]);
+                    let (n_near, m_near) = (
+                        sorting.hit_sorted::<false>(node, t_max, &mut fast_near),
+                        wide.hit_sorted::<false>(node, t_max, &mut scalar_near),
+                    );
+                    let fast = [&fast[..n], &fast_near[..n_near]].concat();
+                    (fast, [&scalar[..m], &scalar_near[..m_near]].concat())
+                });
+                let bits = |entries: &[(u32, f32)]| entries.iter().map(|&(c, t)| (c, t.to_bits())).collect::<Vec<_>>();
+                assert_eq!(bits(&fast), bits(&scalar), "{ray:?} t_max {t_max}");
+                counts[fast.len() / 2] += 1;
+            }
+        }
+    }
+    assert!(
+        counts.iter().all(|&c| c > 0),
+        "every number of children met: {counts:?}"
+    );
+}

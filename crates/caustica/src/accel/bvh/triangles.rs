@@ -4,12 +4,12 @@
 //! The tree is built with leaves priced per packet, so it favours full packets.
 
 use super::build::LeafCost;
-#[cfg(target_arch = "x86_64")]
-use super::WideRayPre;
 use super::{Bvh, RayPre, SlabTest, StackSized, Traversal, Visit, END, LARGE_STACK, LEAF, PAIR};
+#[cfg(target_arch = "x86_64")]
+use super::{SortingRayPre, WideRayPre};
 use crate::accel::lanes::Width;
 #[cfg(target_arch = "x86_64")]
-use crate::accel::lanes::{in_avx, Avx};
+use crate::accel::lanes::{in_avx, in_avx2, Avx};
 use crate::geometry::triangle::{Triangle, TriangleHit, TriangleRay};
 #[cfg(target_arch = "x86_64")]
 use crate::geometry::triangle_packet::PacketPair;
@@ -307,9 +307,11 @@ impl TriangleBvh {
         );
     }
 
-    /// Walks `rays` [`STREAM`] at a time, interleaved, near child first with `NEAR_FIRST` (else in
-    /// slot order, for any-hit queries). Each ray's lane keeps a `F` (default at
-    /// the start); `leaf(ray, first, t_max, found)` tests the leaf starting at `first` and returns
+    /// Walks `rays` [`STREAM`] at a time, interleaved, near child first with `NEAR_FIRST` (else,
+    /// for any-hit queries, far child first where the CPU has AVX2 and in slot order where not).
+    /// A node's children are sorted without branches where the CPU has AVX2 ([`SortingRayPre`]).
+    /// Each ray's lane keeps a `F` (default at the start); `leaf(ray, first, t_max, found)` tests
+    /// the leaf starting at `first` and returns
     /// whether the ray's answer is settled; `answer(t_max, found)` is what goes to `out`.
     fn stream<const NEAR_FIRST: bool, F: Copy + Default, R: Default>(
         &self,
@@ -348,15 +350,26 @@ impl TriangleBvh {
                         &self.answer,
                     ),
                     #[cfg(target_arch = "x86_64")]
-                    Width::Eight(avx) => in_avx(avx, || {
-                        bvh.stream_with::<N, NEAR_FIRST, F, R, WideRayPre>(
-                            self.rays,
-                            self.t_max,
-                            (self.out, self.stacks),
-                            &self.leaf,
-                            &self.answer,
-                        )
-                    }),
+                    Width::Eight(avx) => match avx.avx2() {
+                        Some(avx2) => in_avx2(avx2, || {
+                            bvh.stream_with::<N, NEAR_FIRST, F, R, SortingRayPre>(
+                                self.rays,
+                                self.t_max,
+                                (self.out, self.stacks),
+                                &self.leaf,
+                                &self.answer,
+                            )
+                        }),
+                        None => in_avx(avx, || {
+                            bvh.stream_with::<N, NEAR_FIRST, F, R, WideRayPre>(
+                                self.rays,
+                                self.t_max,
+                                (self.out, self.stacks),
+                                &self.leaf,
+                                &self.answer,
+                            )
+                        }),
+                    },
                 }
             }
         }
