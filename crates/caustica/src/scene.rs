@@ -941,9 +941,10 @@ impl Scene {
     }
 
     /// Whether rays traced together ([`Scene::intersect_stream`]) are faster than one by one:
-    /// the triangles' tree is larger than the caches, so the stream overlaps its misses.
+    /// the triangles' tree is larger than the caches, so the stream overlaps its misses, or
+    /// its streams sort without branches.
     pub fn streams_pay(&self) -> bool {
-        self.triangle_bvh.walks() && self.triangle_bvh.fetches_ahead()
+        self.triangle_bvh.walks() && (self.triangle_bvh.fetches_ahead() || self.triangle_bvh.streams_sort())
     }
 
     /// The closest hit in `(0, ∞)` of each ray, into `hits` (one per ray): [`Scene::intersect`]

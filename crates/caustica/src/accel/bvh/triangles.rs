@@ -185,6 +185,16 @@ impl TriangleBvh {
         self.fetch_ahead
     }
 
+    /// Whether this tree's streams sort a node's children without branches (the CPU has AVX2,
+    /// [`SortingRayPre`]): they then outrun single walks even within the caches.
+    pub fn streams_sort(&self) -> bool {
+        #[cfg(target_arch = "x86_64")]
+        if let Width::Eight(avx) = self.width {
+            return avx.avx2().is_some();
+        }
+        false
+    }
+
     /// Bounds of all hittable triangles (empty if there are none).
     pub fn bounds(&self) -> Aabb {
         self.bvh.bounds()
