@@ -342,6 +342,21 @@ impl TriangleBvh {
             answer: A,
             found: std::marker::PhantomData<F>,
         }
+        impl<const NEAR_FIRST: bool, F, R, L, A> Stream<'_, '_, NEAR_FIRST, F, R, L, A>
+        where
+            F: Copy + Default,
+            L: Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
+            A: Fn(f32, F) -> R,
+        {
+            /// The walks with stacks of `N` entries and boxes tested by `T`.
+            #[inline(always)]
+            fn walk<const N: usize, T: SlabTest<2>>(self) {
+                let (rays, t_max) = (self.rays, self.t_max);
+                let slots = (self.out, self.stacks);
+                self.bvh
+                    .stream_with::<N, NEAR_FIRST, F, R, T>(rays, t_max, slots, &self.leaf, &self.answer);
+            }
+        }
         impl<const NEAR_FIRST: bool, F, R, L, A> StackSized for Stream<'_, '_, NEAR_FIRST, F, R, L, A>
         where
             F: Copy + Default,
@@ -350,35 +365,12 @@ impl TriangleBvh {
         {
             type Output = ();
             fn run<const N: usize>(self) {
-                let bvh = self.bvh;
-                match bvh.width {
-                    Width::Four => bvh.stream_with::<N, NEAR_FIRST, F, R, RayPre>(
-                        self.rays,
-                        self.t_max,
-                        (self.out, self.stacks),
-                        &self.leaf,
-                        &self.answer,
-                    ),
+                match self.bvh.width {
+                    Width::Four => self.walk::<N, RayPre>(),
                     #[cfg(target_arch = "x86_64")]
                     Width::Eight(avx) => match avx.avx2() {
-                        Some(avx2) => in_avx2(avx2, || {
-                            bvh.stream_with::<N, NEAR_FIRST, F, R, SortingRayPre>(
-                                self.rays,
-                                self.t_max,
-                                (self.out, self.stacks),
-                                &self.leaf,
-                                &self.answer,
-                            )
-                        }),
-                        None => in_avx(avx, || {
-                            bvh.stream_with::<N, NEAR_FIRST, F, R, WideRayPre>(
-                                self.rays,
-                                self.t_max,
-                                (self.out, self.stacks),
-                                &self.leaf,
-                                &self.answer,
-                            )
-                        }),
+                        Some(avx2) => in_avx2(avx2, || self.walk::<N, SortingRayPre>()),
+                        None => in_avx(avx, || self.walk::<N, WideRayPre>()),
                     },
                 }
             }
