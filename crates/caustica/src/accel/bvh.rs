@@ -204,8 +204,8 @@ pub(crate) trait SlabTest<const R: usize> {
 
     /// The entries (child, entry distance) of the children met into the first places of `out`,
     /// the one to visit first last: farthest first with `NEAR_LAST`, else nearest first;
-    /// returns how many. Ordered by [`sorted_keys`], the distances rounded down to a multiple
-    /// of eight ulps.
+    /// returns how many. Ordered by [`sorted_keys`], the distances with their low bits (which
+    /// hold the slot in the key) cleared.
     #[inline(always)]
     fn hit_sorted<const NEAR_LAST: bool>(
         &self,

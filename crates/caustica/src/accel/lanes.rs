@@ -305,11 +305,12 @@ mod avx {
             && std::mem::offset_of!((u32, f32), 1) == 4
     );
 
-    /// The entries (child, entry distance) of a node's `hit` lanes, farthest first, into the
-    /// first places of `out`; returns how many. Branch-free: the keys (the distance's bits, the
-    /// slot in their low three; non-negative floats order as their bits, missed lanes are -1)
-    /// go through a bitonic sorting network of six compare-exchange stages, then pick their
-    /// children. Runs AVX2 instructions: called only inside [`in_avx2`](super::in_avx2).
+    /// The entries (child, entry distance) of a node's `hit` lanes into the first places of
+    /// `out`, the one to visit first last: farthest first with `NEAR_LAST`, else nearest first;
+    /// returns how many. Branch-free: the keys (the distance's bits, the slot in their low
+    /// three; non-negative floats order as their bits; missed lanes sort last) go through a
+    /// bitonic sorting network of six compare-exchange stages, then pick their children. Runs
+    /// AVX2 instructions: called only inside [`in_avx2`](super::in_avx2).
     #[inline(always)]
     pub(crate) fn sorted_entries<const NEAR_LAST: bool>(
         t_near: F32x8,
