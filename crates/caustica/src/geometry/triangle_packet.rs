@@ -77,6 +77,13 @@ impl TrianglePacket {
         let (mask, lanes) = self.hits(ray, t_max);
         each_of_lanes(mask, &lanes, |lane| self.triangle(lane), ray, t_max, visit)
     }
+    /// Whether any lane is hit with `0 < t < t_max`: [`TrianglePacket::each_hit`] with a visit
+    /// that stops at once, without working out the hit.
+    #[inline(always)]
+    pub fn any_hit(&self, ray: &TriangleRay, t_max: f32) -> bool {
+        let (mask, _) = self.hits(ray, t_max);
+        any_of_lanes::<LANES>(mask, |lane| self.triangle(lane), ray, t_max)
+    }
 }
 
 /// Two packets tested as one of eight lanes (the first packet's lanes, then the second's) in an
@@ -116,6 +123,13 @@ impl PacketPair<'_> {
     ) -> bool {
         let (mask, lanes) = self.hits(ray, t_max);
         each_of_lanes(mask, &lanes, |lane| self.triangle(lane), ray, t_max, visit)
+    }
+
+    /// [`TrianglePacket::any_hit`] over the eight lanes.
+    #[inline(always)]
+    pub(crate) fn any_hit(&self, ray: &TriangleRay, t_max: f32) -> bool {
+        let (mask, _) = self.hits(ray, t_max);
+        any_of_lanes::<PAIR_LANES>(mask, |lane| self.triangle(lane), ray, t_max)
     }
 }
 
@@ -278,6 +292,21 @@ fn each_of_lanes<const N: usize>(
     false
 }
 
+/// Whether [`each_of_lanes`] would visit a lane: one the packet test found hit off its edges,
+/// or one on an edge (an edge function exactly zero) that the scalar test finds hit.
+#[inline(always)]
+fn any_of_lanes<const N: usize>(
+    mask: u32,
+    triangle: impl Fn(usize) -> Triangle,
+    ray: &TriangleRay,
+    t_max: f32,
+) -> bool {
+    let on_edge = mask >> N;
+    mask & !on_edge & ((1 << N) - 1) != 0
+        || (on_edge != 0
+            && (0..N).any(|lane| on_edge & (1 << lane) != 0 && triangle(lane).intersect_pre(ray, t_max).is_some()))
+}
+
 /// Per-lane results of a packet test.
 struct LaneHits<const N: usize> {
     t: [f32; N],
@@ -369,6 +398,7 @@ mod tests {
                 false
             });
             assert_eq!(all, expected_all, "case {case}");
+            assert_eq!(packet.any_hit(&tr, t_max), !expected_all.is_empty(), "case {case}");
             hits += usize::from(expected.is_some());
         }
         assert!(hits > 5_000, "the cases exercise hits: {hits}");
@@ -401,16 +431,17 @@ mod tests {
                 });
             }
             let pair = PacketPair(&packets);
-            let (closest, all) = crate::accel::lanes::in_avx(avx, || {
+            let (closest, all, any) = crate::accel::lanes::in_avx(avx, || {
                 let mut all = Vec::new();
                 pair.each_hit(&tr, t_max, |lane, h| {
                     all.push((lane, h));
                     false
                 });
-                (pair.closest_hit(&tr, t_max), all)
+                (pair.closest_hit(&tr, t_max), all, pair.any_hit(&tr, t_max))
             });
             assert_eq!(closest, expected, "case {case}");
             assert_eq!(all, expected_all, "case {case}");
+            assert_eq!(any, !expected_all.is_empty(), "case {case}");
             hits += usize::from(expected.is_some());
             seconds += usize::from(second.is_some());
         }

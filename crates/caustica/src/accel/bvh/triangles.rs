@@ -310,7 +310,7 @@ impl TriangleBvh {
             t_max,
             occluded,
             |tri, first, t_max, hit: &mut bool| {
-                *hit = self.each_in_leaf(tri, first, *t_max, &mut |_| true);
+                *hit = self.any_in_leaf(tri, first, *t_max);
                 *hit
             },
             |_, hit| hit,
@@ -600,6 +600,27 @@ impl TriangleBvh {
         let mut i = first;
         loop {
             if self.each_in_packet(tr, i, t_max, visit) {
+                return true;
+            }
+            if self.bvh.order[i] & END != 0 {
+                return false;
+            }
+            i += 1;
+        }
+    }
+
+    /// Whether any triangle of leaf `leaf` is hit with `0 < t < t_max`: [`TriangleBvh::each_in_leaf`]
+    /// with a visit that stops at once, without working out the hit or reading its id.
+    #[inline(always)]
+    fn any_in_leaf(&self, tr: &TriangleRay, leaf: usize, t_max: f32) -> bool {
+        let first = leaf & !(PAIR as usize);
+        #[cfg(target_arch = "x86_64")]
+        if let Some((avx, pair)) = self.leaf_pair(leaf) {
+            return in_avx(avx, || pair.any_hit(tr, t_max));
+        }
+        let mut i = first;
+        loop {
+            if self.packets[i].any_hit(tr, t_max) {
                 return true;
             }
             if self.bvh.order[i] & END != 0 {
