@@ -77,6 +77,7 @@ impl TrianglePacket {
         let (mask, lanes) = self.hits(ray, t_max);
         each_of_lanes(mask, &lanes, |lane| self.triangle(lane), ray, t_max, visit)
     }
+
     /// Whether any lane is hit with `0 < t < t_max`: [`TrianglePacket::each_hit`] with a visit
     /// that stops at once, without working out the hit.
     #[inline(always)]
