@@ -67,8 +67,8 @@ where
 /// [`camera_chain`] for each of `starts` (a camera ray and the random stream its chain draws
 /// from), the chains walked together: each bounce's rays traced as one wave
 /// ([`walk_together`]), which pays where the scene's triangles outgrow the caches or their
-/// streams sort without branches ([`Scene::streams_pay`]). `along` gives each chain its own [`Along`]. The same radiance as
-/// each chain alone, in the order of `starts`.
+/// streams sort without branches ([`Scene::streams_pay`]). `along` gives each chain its own
+/// [`Along`]. The same radiance as each chain alone, in the order of `starts`.
 pub fn camera_chains<S, B, A>(
     scene: &Scene,
     starts: Vec<(Ray, Rng)>,

@@ -609,8 +609,9 @@ impl TriangleBvh {
         }
     }
 
-    /// Whether any triangle of leaf `leaf` is hit with `0 < t < t_max`: [`TriangleBvh::each_in_leaf`]
-    /// with a visit that stops at once, without working out the hit or reading its id.
+    /// Whether any triangle of leaf `leaf` is hit with `0 < t < t_max`:
+    /// [`TriangleBvh::each_in_leaf`] with a visit that stops at once, without working out the
+    /// hit or reading its id.
     #[inline(always)]
     fn any_in_leaf(&self, tr: &TriangleRay, leaf: usize, t_max: f32) -> bool {
         let first = leaf & !(PAIR as usize);
