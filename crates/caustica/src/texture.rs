@@ -54,14 +54,64 @@ impl ImageSource {
 pub struct Image {
     width: usize,
     height: usize,
-    texels: Vec<Vec3>,
+    texels: Texels,
+}
+
+/// How an image holds its texels.
+#[derive(Clone, Debug)]
+enum Texels {
+    /// Linear values as they are: float images, and maps worked out from the file's values.
+    Linear(Vec<Vec3>),
+    /// An 8-bit image's bytes and the linear value of each byte: a quarter of the memory
+    /// (large textures spend their time waiting for texels), read back as the same floats.
+    Bytes {
+        /// R, G, B of each texel.
+        rgb: Vec<[u8; 3]>,
+        /// The linear value of a stored byte.
+        linear: Box<[f32; 256]>,
+    },
+}
+
+impl Texels {
+    fn len(&self) -> usize {
+        match self {
+            Texels::Linear(texels) => texels.len(),
+            Texels::Bytes { rgb, .. } => rgb.len(),
+        }
+    }
 }
 
 impl Image {
     /// An image from rows stored top to bottom; `None` if the size does not match.
     pub fn new(width: usize, height: usize, texels: Vec<Vec3>) -> Option<Image> {
+        Image::sized(width, height, Texels::Linear(texels))
+    }
+
+    /// An image of 8-bit channels (rows top to bottom), byte `b` meaning `linear[b]`; `None` if
+    /// the size does not match.
+    pub fn from_bytes(width: usize, height: usize, rgb: Vec<[u8; 3]>, linear: [f32; 256]) -> Option<Image> {
+        let linear = Box::new(linear);
+        Image::sized(width, height, Texels::Bytes { rgb, linear })
+    }
+
+    fn sized(width: usize, height: usize, texels: Texels) -> Option<Image> {
         (width > 0 && height > 0 && texels.len() == width * height).then_some(Image { width, height, texels })
     }
+
+    /// The texel at index `i` (row-major from the top).
+    #[inline]
+    fn texel(&self, i: usize) -> Vec3 {
+        match &self.texels {
+            Texels::Linear(texels) => texels[i],
+            Texels::Bytes { rgb, linear } => bytes_texel(rgb, linear, i),
+        }
+    }
+}
+
+#[inline(always)]
+fn bytes_texel(rgb: &[[u8; 3]], linear: &[f32; 256], i: usize) -> Vec3 {
+    let [r, g, b] = rgb[i];
+    Vec3::new(linear[usize::from(r)], linear[usize::from(g)], linear[usize::from(b)])
 }
 
 /// How an integer image's stored values become linear light (float images are linear).
@@ -190,22 +240,28 @@ impl Texture {
     /// The stored texel in column `x`, row `y` (rows from the top), without the sampler.
     #[inline]
     pub fn texel(&self, x: usize, y: usize) -> Vec3 {
-        self.image.texels[y * self.image.width + x]
-    }
-
-    /// The texel at wrapped column `x` and row `y_up` counted upwards from the bottom; black
-    /// where either wrapped to nothing.
-    #[inline(always)]
-    fn at(&self, x: Option<usize>, y_up: Option<usize>) -> Vec3 {
-        match (x, y_up) {
-            (Some(x), Some(y)) => self.image.texels[(self.image.height - 1 - y) * self.image.width + x],
-            _ => Vec3::ZERO,
-        }
+        self.image.texel(y * self.image.width + x)
     }
 
     /// The colour at `uv`, u to the right and v upwards: transformed, wrapped, filtered and
     /// scaled by the sampler.
     pub fn lookup(&self, uv: Vec2) -> Vec3 {
+        // The storage chosen once, not at each of the four texels.
+        match &self.image.texels {
+            Texels::Linear(texels) => self.filtered(uv, |i| texels[i]),
+            Texels::Bytes { rgb, linear } => self.filtered(uv, |i| bytes_texel(rgb, linear, i)),
+        }
+    }
+
+    /// [`Texture::lookup`] with texels read by `fetch`.
+    #[inline(always)]
+    fn filtered(&self, uv: Vec2, fetch: impl Fn(usize) -> Vec3) -> Vec3 {
+        // The texel at wrapped column `x` and row `y_up` counted upwards from the bottom;
+        // black where either wrapped to nothing.
+        let at = |x: Option<usize>, y_up: Option<usize>| match (x, y_up) {
+            (Some(x), Some(y)) => fetch((self.image.height - 1 - y) * self.image.width + x),
+            _ => Vec3::ZERO,
+        };
         let s = &self.sampler;
         let uv = s.transform.transform_point2(uv);
         let (w, h) = (self.image.width, self.image.height);
@@ -220,7 +276,7 @@ impl Texture {
         }
         let [wrap_x, wrap_y] = s.wrap;
         let colour = if s.nearest {
-            self.at(wrap_x.index(floor_to_i64(x), w), wrap_y.index(floor_to_i64(y), h))
+            at(wrap_x.index(floor_to_i64(x), w), wrap_y.index(floor_to_i64(y), h))
         } else {
             let (x, y) = (x - 0.5, y - 0.5);
             let (x0, y0) = (floor_to_i64(x), floor_to_i64(y));
@@ -228,8 +284,8 @@ impl Texture {
             // Each axis wrapped once for the two texels it reads.
             let (xa, xb) = (wrap_x.index(x0, w), wrap_x.index(x0 + 1, w));
             let (ya, yb) = (wrap_y.index(y0, h), wrap_y.index(y0 + 1, h));
-            let bottom = self.at(xa, ya).lerp(self.at(xb, ya), fx);
-            let top = self.at(xa, yb).lerp(self.at(xb, yb), fx);
+            let bottom = at(xa, ya).lerp(at(xb, ya), fx);
+            let top = at(xa, yb).lerp(at(xb, yb), fx);
             bottom.lerp(top, fy)
         };
         colour * s.scale
