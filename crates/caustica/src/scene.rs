@@ -154,6 +154,18 @@ impl SegmentsFrom<'_> {
     }
 }
 
+/// A segment that next-event estimation needs clear: from a surface point towards a light,
+/// passing over primitive `own` (the light's, or `u32::MAX`).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowRay {
+    /// From just off the surface, towards the light.
+    pub ray: Ray,
+    /// Where the segment ends.
+    pub t_max: f32,
+    /// The primitive that never blocks.
+    pub own: u32,
+}
+
 /// A scene ready to render. Its parts are read through methods: primitives are numbered
 /// shapes first, then triangles, and only the scene relies on that numbering.
 pub struct Scene {
@@ -820,27 +832,103 @@ impl Scene {
     /// Every surface blocks, glass included (the physical model's light through glass arrives
     /// as caustics).
     pub fn unoccluded(&self, hit: &SurfaceHit, wi: Vec3, distance: f32) -> bool {
+        !self.blocks(&self.shadow_ray(hit, wi, distance, u32::MAX))
+    }
+
+    /// As [`Scene::unoccluded`], but primitive `own` never blocks (the light whose point the
+    /// segment ends on, when nothing of it can lie in between).
+    pub fn unoccluded_except(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> bool {
+        !self.blocks(&self.shadow_ray(hit, wi, distance, own))
+    }
+
+    /// The segment [`Scene::unoccluded_except`] tests (`own`: `u32::MAX` for none).
+    #[inline(always)]
+    pub fn shadow_ray(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> ShadowRay {
         let (point, origin) = (hit.point, hit.ray_origin(wi));
         let t_max = if distance.is_finite() {
             (distance - (origin - point).length()) * (1.0 - 1e-5)
         } else {
             f32::INFINITY
         };
-        !self.blocked(&Ray::new(origin, wi), t_max, u32::MAX)
+        ShadowRay {
+            ray: Ray::new(origin, wi),
+            t_max,
+            own,
+        }
     }
 
-    /// As [`Scene::unoccluded`], but primitive `own` never blocks (the light whose point the
-    /// segment ends on, when nothing of it can lie in between).
-    pub fn unoccluded_except(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> bool {
-        let (point, origin) = (hit.point, hit.ray_origin(wi));
-        let t_max = (distance - (origin - point).length()) * (1.0 - 1e-5);
-        !self.blocked(&Ray::new(origin, wi), t_max, own)
+    /// Whether something blocks `shadow`.
+    #[inline(always)]
+    pub fn blocks(&self, shadow: &ShadowRay) -> bool {
+        self.blocked(&shadow.ray, shadow.t_max, shadow.own)
+    }
+
+    /// Whether shadow rays can be tested many at once ([`Scene::blocks_each`]) for less than
+    /// one by one: the triangles' tree is larger than the caches (within them, a shadow ray
+    /// walks what its camera ray just brought in, and the bookkeeping costs what the stream
+    /// saves), and no surface is passed over by what it is (a cut-out, a boundary between
+    /// media).
+    pub fn shadows_stream(&self) -> bool {
+        let large = self.triangle_bvh.walks() && self.triangle_bvh.fetches_ahead();
+        large && !self.cutouts && !self.boundaries && !self.has_media()
+    }
+
+    /// Whether something blocks each of `shadows`, into `blocked` (one per ray): [`Scene::blocks`]
+    /// ray by ray, with the same answers; the triangles are tested in an any-hit stream where
+    /// [`Scene::shadows_stream`] holds.
+    ///
+    /// # Panics
+    /// If `blocked` and `shadows` differ in length.
+    pub fn blocks_each(&self, shadows: &[ShadowRay], blocked: &mut [bool]) {
+        assert_eq!(shadows.len(), blocked.len(), "one answer per shadow ray");
+        let n_shapes = self.shapes.len() as u32;
+        // A segment ending on a triangle has to pass over it: the stream cannot, so it goes alone.
+        let alone = |s: &ShadowRay| s.own != u32::MAX && s.own >= n_shapes;
+        if !self.shadows_stream() {
+            for (s, b) in shadows.iter().zip(blocked.iter_mut()) {
+                *b = self.blocks(s);
+            }
+            return;
+        }
+        for (s, b) in shadows.iter().zip(blocked.iter_mut()) {
+            *b = if alone(s) {
+                self.blocks(s)
+            } else {
+                self.shape_blocks(&s.ray, s.t_max, s.own)
+            };
+        }
+        let rays: Vec<Ray> = shadows.iter().map(|s| s.ray).collect();
+        // Settled rays walk nothing: an empty segment meets no box.
+        let t_max = |i: usize| {
+            if blocked[i] || alone(&shadows[i]) {
+                0.0
+            } else {
+                shadows[i].t_max
+            }
+        };
+        let mut triangles = vec![false; shadows.len()];
+        self.triangle_bvh.any_hits_within(&rays, t_max, &mut triangles);
+        for (b, t) in blocked.iter_mut().zip(triangles) {
+            *b |= t;
+        }
     }
 
     /// Whether a surface other than primitive `own` (`u32::MAX`: none) and other than a
     /// boundary between media meets `ray` in `(0, t_max)`.
     #[inline]
     fn blocked(&self, ray: &Ray, t_max: f32, own: u32) -> bool {
+        let n_shapes = self.shapes.len() as u32;
+        self.shape_blocks(ray, t_max, own)
+            || self.triangle_bvh.each_hit(ray, t_max, |h| {
+                n_shapes + h.prim != own
+                    && !self.is_hole(ray, &h)
+                    && !(self.boundaries && self.is_boundary(&self.triangle_intersection(h)))
+            })
+    }
+
+    /// [`Scene::blocked`]'s shapes alone.
+    #[inline(always)]
+    fn shape_blocks(&self, ray: &Ray, t_max: f32, own: u32) -> bool {
         let n_shapes = self.shapes.len() as u32;
         // `own` is passed over before it is intersected: the segment ends on it, so the test
         // would find it on nearly every call only to throw the hit away.
@@ -850,19 +938,13 @@ impl Scene {
                     .intersect_shape(prim, ray, t_max)
                     .is_some_and(|h| !self.is_boundary(&h))
         };
-        let shape_blocks = match &self.shape_packets {
+        match &self.shape_packets {
             // Without boundaries a shape the packets find blocks: its own test is theirs.
             Some(packets) if !self.boundaries && own < n_shapes => packets.each_except(ray, t_max, own, |_| true),
             Some(packets) if !self.boundaries => packets.each(ray, t_max, |_| true),
             Some(packets) => packets.each_except(ray, t_max, own, blocks),
             None => self.shape_bvh.any_hit(ray, t_max, |prim, _| blocks(prim)),
-        };
-        shape_blocks
-            || self.triangle_bvh.each_hit(ray, t_max, |h| {
-                n_shapes + h.prim != own
-                    && !self.is_hole(ray, &h)
-                    && !(self.boundaries && self.is_boundary(&self.triangle_intersection(h)))
-            })
+        }
     }
 
     /// World bounds of everything.
@@ -1442,6 +1524,38 @@ mod tests {
             state ^= state << 17;
             (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
         }
+    }
+
+    /// Shadow rays tested together block where each alone does: segments from a bumpy sheet of
+    /// 135,000 triangles (streamed) towards points around it, short, long and unending, passing
+    /// over nothing, over a ball or over one of the sheet's triangles.
+    #[test]
+    fn shadow_rays_together_block_as_alone() {
+        let ball = "translate(0, 0, 1, scale(0.5, sphere { material = { diffuse = (1,1,1); } }))";
+        let scene = build::test_scene(&format!("{ball}\n{}", build::bumpy_sheet(260)));
+        assert!(scene.shadows_stream());
+        let n_shapes = scene.shapes().len() as u32;
+        let mut u = uniform_pm1();
+        let shadows: Vec<ShadowRay> = (0..3000)
+            .map(|i| {
+                let origin = Vec3::new(u() * 2.0, u() * 2.0, 0.4 + 0.4 * u());
+                let to = Vec3::new(u() * 3.0, u() * 3.0, u() * 2.0) - origin;
+                let own = [u32::MAX, 0, n_shapes + (i as u32 * 37) % 135_200][i % 3];
+                let t_max = [to.length(), f32::INFINITY, 0.0, 0.05][i % 4];
+                ShadowRay {
+                    ray: Ray::new(origin, to.normalize()),
+                    t_max,
+                    own,
+                }
+            })
+            .collect();
+        let mut blocked = vec![false; shadows.len()];
+        scene.blocks_each(&shadows, &mut blocked);
+        for (s, b) in shadows.iter().zip(&blocked) {
+            assert_eq!(*b, scene.blocks(s), "{s:?}");
+        }
+        let count = blocked.iter().filter(|&&b| b).count();
+        assert!((300..2700).contains(&count), "{count} of 3000 blocked");
     }
 
     /// Shapes and a mesh in one scene: the closest hit and the hits visited by `any_hit` are

@@ -3,10 +3,11 @@
 //! (power heuristic) where the caller also counts the emitters and sky its BSDF samples reach.
 
 use crate::bsdf::{Bsdf, BsdfSample};
+use crate::light::DirectSample;
 use crate::math::{Ray, Vec3};
 use crate::photon::light_walk::MediumArrival;
 use crate::sampling::Rng;
-use crate::scene::{Scene, SurfaceHit};
+use crate::scene::{Scene, ShadowRay, SurfaceHit};
 use crate::spectrum::{Spectrum, Wavelengths};
 
 pub use crate::sampling::power_heuristic;
@@ -27,23 +28,60 @@ pub fn direct_light(
     // A wall's f, cosine and density at once: the values asked one by one, for less.
     let lambertian = bsdf.plain_lambertian(wo);
     scene.lights().sample_direct((scene, hit, &takes), wl, rng, |sample| {
-        let lit = lambertian.as_ref().and_then(|lambertian| lambertian.toward(sample.wi));
-        let f = lit.map_or_else(|| bsdf.eval(wo, sample.wi), |(f, _, _)| f);
-        if f == Spectrum::ZERO {
-            return;
+        if let Some(t) = light_term((bsdf, lambertian.as_ref()), wo, mis, &sample) {
+            l += t;
         }
-        let cos = lit.map_or_else(|| bsdf.cos(sample.wi), |(_, cos, _)| cos);
-        let weight = if mis && sample.pdf > 0.0 {
-            power_heuristic(
-                sample.pdf,
-                lit.map_or_else(|| bsdf.pdf(wo, sample.wi), |(_, _, pdf)| pdf),
-            )
-        } else {
-            1.0
-        };
-        l += f * sample.contribution * (cos * weight);
     });
     l
+}
+
+/// [`direct_light`] with the shadow rays left untested: `add(term, shadow)` for each light
+/// sample, which counts `term` if nothing blocks `shadow` (`None`: nothing does), in the order
+/// `direct_light` sums them. Only in scenes without media.
+pub fn direct_light_deferred(
+    scene: &Scene,
+    (hit, bsdf, wo): (&SurfaceHit, &Bsdf, Vec3),
+    mis: bool,
+    wl: &Wavelengths,
+    rng: &mut Rng,
+    mut add: impl FnMut(Spectrum, Option<ShadowRay>),
+) {
+    let takes = |wi: Vec3| bsdf.may_take(wi);
+    let lambertian = bsdf.plain_lambertian(wo);
+    scene
+        .lights()
+        .sample_direct_deferred((scene, hit, &takes), wl, rng, |sample, shadow| {
+            if let Some(t) = light_term((bsdf, lambertian.as_ref()), wo, mis, &sample) {
+                add(t, shadow);
+            }
+        });
+}
+
+/// What a light sample adds at a surface point seen from `wo`: f · cos · its contribution,
+/// weighted by MIS when `mis` is set; `None` where the BSDF takes none of it. `lambertian`:
+/// the BSDF's plain Lambertian lobe, where that is all it is.
+#[inline(always)]
+fn light_term(
+    (bsdf, lambertian): (&Bsdf, Option<&crate::bsdf::Lambertian>),
+    wo: Vec3,
+    mis: bool,
+    sample: &DirectSample,
+) -> Option<Spectrum> {
+    let lit = lambertian.and_then(|lambertian| lambertian.toward(sample.wi));
+    let f = lit.map_or_else(|| bsdf.eval(wo, sample.wi), |(f, _, _)| f);
+    if f == Spectrum::ZERO {
+        return None;
+    }
+    let cos = lit.map_or_else(|| bsdf.cos(sample.wi), |(_, cos, _)| cos);
+    let weight = if mis && sample.pdf > 0.0 {
+        power_heuristic(
+            sample.pdf,
+            lit.map_or_else(|| bsdf.pdf(wo, sample.wi), |(_, _, pdf)| pdf),
+        )
+    } else {
+        1.0
+    };
+    Some(f * sample.contribution * (cos * weight))
 }
 
 /// Direct light in-scattered at a point in a medium by one light sample, weighted against

@@ -5,14 +5,15 @@
 //! after a mirror or through glass); that is what photon mapping is for.
 
 use super::camera_walk::{walk_camera, CameraArrival, CameraPath, CameraVisitor, CameraWalk};
-use super::direct::{direct_in_medium, direct_light, emitted, power_heuristic};
+use super::direct::{direct_in_medium, direct_light, direct_light_deferred, emitted, power_heuristic};
 use super::tiles::PixelSample;
 use crate::bsdf::{BsdfSample, Transport};
 use crate::math::{Ray, Vec3};
-use crate::photon::light_walk::{walk_together, MediumArrival, Walker};
+use crate::photon::light_walk::{in_waves, walk_together, walk_together_settling, MediumArrival, Walker};
 use crate::sampling::Rng;
-use crate::scene::Scene;
+use crate::scene::{Scene, ShadowRay};
 use crate::spectrum::{Spectrum, Wavelengths};
+use std::cell::RefCell;
 
 /// Settings of the path tracer.
 #[derive(Clone, Debug, PartialEq)]
@@ -46,7 +47,8 @@ impl Default for PathSettings {
 
 /// Radiance arriving along `ray` (unit direction) at the wavelengths `wl`.
 pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengths, rng: &mut Rng) -> Spectrum {
-    let mut path = PathRadiance::new(scene, settings, &ray, *wl);
+    let shared = PathsShared { settings, wave: None };
+    let mut path = PathRadiance::new(scene, &shared, &ray, *wl, 0);
     walk_camera(scene, ray, wl, path.limits(), rng, &mut path);
     path.radiance()
 }
@@ -55,7 +57,7 @@ pub fn radiance(scene: &Scene, settings: &PathSettings, ray: Ray, wl: &Wavelengt
 /// vertex makes.
 struct PathRadiance<'p> {
     scene: &'p Scene,
-    settings: &'p PathSettings,
+    shared: &'p PathsShared<'p>,
     wl: Wavelengths,
     /// Radiance gathered so far.
     l: Spectrum,
@@ -65,14 +67,68 @@ struct PathRadiance<'p> {
     /// The last bounce's pdf and point, for weighting emitters that BSDF sampling hits.
     last_pdf: f32,
     last_point: Vec3,
+    /// The path's number in its tile (for the wave's shadow rays).
+    number: u32,
+}
+
+/// What a tile's paths share: their settings, and the wave where next-event estimation leaves
+/// their shadow rays to be tested together (`None`: each tested at once).
+struct PathsShared<'p> {
+    settings: &'p PathSettings,
+    wave: Option<RefCell<WaveShadows>>,
+}
+
+/// A wave's light samples whose shadow rays are tested together ([`Scene::blocks_each`]),
+/// in the order the paths drew them.
+#[derive(Default)]
+struct WaveShadows {
+    terms: Vec<DeferredTerm>,
+    shadows: Vec<ShadowRay>,
+    blocked: Vec<bool>,
+}
+
+/// One light sample's term at a path's vertex, counted if its shadow ray is clear.
+struct DeferredTerm {
+    path: u32,
+    throughput: Spectrum,
+    term: Spectrum,
+    /// Its shadow ray's number, `None` for a sample already known clear.
+    shadow: Option<u32>,
+}
+
+impl WaveShadows {
+    /// Tests the wave's shadow rays and adds each vertex's clear terms to its path, summed as
+    /// [`direct_light`] sums them; then empties.
+    fn settle(&mut self, scene: &Scene, paths: &mut [CameraPath<PathRadiance>]) {
+        if self.terms.is_empty() {
+            return;
+        }
+        self.blocked.resize(self.shadows.len(), false);
+        scene.blocks_each(&self.shadows, &mut self.blocked);
+        // A path has at most one vertex in a wave: its terms follow each other.
+        let mut terms = self.terms.iter().peekable();
+        while let Some(first) = terms.peek() {
+            let (path, throughput) = (first.path, first.throughput);
+            let mut sum = Spectrum::ZERO;
+            while let Some(t) = terms.next_if(|t| t.path == path) {
+                if t.shadow.is_none_or(|k| !self.blocked[k as usize]) {
+                    sum += t.term;
+                }
+            }
+            paths[path as usize].visitor.l += throughput * sum;
+        }
+        self.terms.clear();
+        self.shadows.clear();
+    }
 }
 
 impl<'p> PathRadiance<'p> {
     /// Nothing gathered yet along the eye's `ray`.
-    fn new(scene: &'p Scene, settings: &'p PathSettings, ray: &Ray, wl: Wavelengths) -> PathRadiance<'p> {
+    fn new(scene: &'p Scene, shared: &'p PathsShared<'p>, ray: &Ray, wl: Wavelengths, number: u32) -> PathRadiance<'p> {
         PathRadiance {
             scene,
-            settings,
+            shared,
+            number,
             wl,
             l: Spectrum::ZERO,
             specular: true,
@@ -83,7 +139,36 @@ impl<'p> PathRadiance<'p> {
 
     /// The walk's surfaces and roulette start ([`walk_camera`]).
     fn limits(&self) -> (u32, u32) {
-        (self.settings.max_depth.saturating_add(1), self.settings.roulette_depth)
+        (
+            self.shared.settings.max_depth.saturating_add(1),
+            self.shared.settings.roulette_depth,
+        )
+    }
+
+    /// Next-event estimation at `at` with its shadow rays left to the `wave`. Out of line: the
+    /// paths that test at once keep their code as it was.
+    #[inline(never)]
+    fn defer_direct(&mut self, at: &CameraArrival, wave: &RefCell<WaveShadows>, rng: &mut Rng) {
+        let (wave, path) = (&mut *wave.borrow_mut(), self.number);
+        let drawn = wave.terms.len();
+        let at_vertex = (at.hit, at.bsdf, at.wo);
+        direct_light_deferred(self.scene, at_vertex, true, &self.wl, rng, |term, shadow| {
+            let shadow = shadow.map(|s| {
+                wave.shadows.push(s);
+                wave.shadows.len() as u32 - 1
+            });
+            let throughput = at.throughput;
+            wave.terms.push(DeferredTerm {
+                path,
+                throughput,
+                term,
+                shadow,
+            });
+        });
+        if wave.terms.len() == drawn {
+            // As `direct_light`'s zero would.
+            self.l += at.throughput * Spectrum::ZERO;
+        }
     }
 
     /// What the walk gathered, zero if it is not finite.
@@ -115,17 +200,20 @@ impl CameraVisitor for PathRadiance<'_> {
             self.l += at.throughput * le * weight;
         }
         // The last surface only shows its emission.
-        if at.length > self.settings.max_depth || at.bsdf.is_black() {
+        if at.length > self.shared.settings.max_depth || at.bsdf.is_black() {
             return false;
         }
         if at.bsdf.is_smooth() {
-            self.l += at.throughput * direct_light(scene, hit, at.bsdf, wo, true, &self.wl, rng);
+            match &self.shared.wave {
+                Some(wave) => self.defer_direct(at, wave, rng),
+                None => self.l += at.throughput * direct_light(scene, hit, at.bsdf, wo, true, &self.wl, rng),
+            }
         }
         true
     }
 
     fn visit_medium(&mut self, at: &MediumArrival, rng: &mut Rng) -> bool {
-        if at.length > self.settings.max_depth {
+        if at.length > self.shared.settings.max_depth {
             return false;
         }
         self.l += at.throughput * direct_in_medium(self.scene, at, true, &self.wl, rng);
@@ -144,7 +232,7 @@ impl CameraVisitor for PathRadiance<'_> {
         let sample = at
             .bsdf
             .sample(at.wo, rng.uniform(), rng.uniform2(), Transport::Radiance)?;
-        if at.length == 1 && sample.specular && !self.settings.specular_camera_paths {
+        if at.length == 1 && sample.specular && !self.shared.settings.specular_camera_paths {
             return None;
         }
         self.specular = sample.specular;
@@ -163,6 +251,9 @@ pub struct PathTracer<'a> {
     width: usize,
     height: usize,
     seed: u64,
+    /// A wave's shadow rays tested together ([`Scene::shadows_stream`]; off in tests, to
+    /// compare).
+    shadows_in_waves: bool,
 }
 
 impl<'a> PathTracer<'a> {
@@ -175,6 +266,7 @@ impl<'a> PathTracer<'a> {
             width,
             height,
             seed,
+            shadows_in_waves: scene.shadows_stream(),
         }
     }
 }
@@ -185,14 +277,23 @@ impl super::Progressive for PathTracer<'_> {
         let spectral = super::ppm::settings_spectral(&self.settings.spectral, self.scene);
         // A tile's paths walk together, a wave of rays per bounce.
         super::tiles::sample_pass_tiles(self.width, self.height, self.seed, pass, control, |points| {
+            // Shadow rays tested a wave at a time where streams pay for them.
+            let shared = PathsShared {
+                settings: &self.settings,
+                wave: (self.shadows_in_waves && in_waves(self.scene, points.len())).then(RefCell::default),
+            };
             let mut paths: Vec<CameraPath<PathRadiance>> = points
                 .into_iter()
+                .enumerate()
                 .map(
-                    |PixelSample {
-                         screen: (sx, sy),
-                         mut rng,
-                         ..
-                     }| {
+                    |(
+                        number,
+                        PixelSample {
+                            screen: (sx, sy),
+                            mut rng,
+                            ..
+                        },
+                    )| {
                         // Each sample its own wavelengths: no photons need to agree with it.
                         let wl = if spectral {
                             Wavelengths::sample(rng.uniform())
@@ -200,7 +301,7 @@ impl super::Progressive for PathTracer<'_> {
                             Wavelengths::Rgb
                         };
                         let ray = camera.generate_ray(sx, sy);
-                        let visitor = PathRadiance::new(self.scene, &self.settings, &ray, wl);
+                        let visitor = PathRadiance::new(self.scene, &shared, &ray, wl, number as u32);
                         Walker {
                             walk: CameraWalk::new(self.scene, ray, &wl, visitor.limits()),
                             wl,
@@ -210,8 +311,51 @@ impl super::Progressive for PathTracer<'_> {
                     },
                 )
                 .collect();
-            walk_together(self.scene, &mut paths);
+            match &shared.wave {
+                Some(wave) => walk_together_settling(self.scene, &mut paths, |paths| {
+                    wave.borrow_mut().settle(self.scene, paths)
+                }),
+                None => walk_together(self.scene, &mut paths),
+            }
             paths.iter().map(|p| p.wl.to_rgb(p.visitor.radiance())).collect()
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrator::Progressive;
+    use crate::progress::{Control, NoProgress};
+
+    /// A wave's shadow rays tested together make the image they make one by one, bit for bit:
+    /// a bumpy sheet of 135,000 triangles (a tree beyond the caches) under a point light, a
+    /// glowing ball and a glowing triangle (whose shadow rays pass over it, so go alone).
+    #[test]
+    fn shadow_rays_in_waves_make_the_image_one_by_one_makes() {
+        let lamps = "point_light { position = (0.5, -0.3, 2); colour = (4, 4, 4); }
+            translate(-0.8, 0.6, 1.2, scale(0.25, sphere { material = { emissive = (6, 5, 4); } }))
+            polymesh { points = ((1,1,1.2),(1.6,1,1.3),(1,1.6,1.1)); faces = ((0,1,2),(0,2,1));
+                       material = { emissive = (5, 5, 8); } }";
+        let scene = crate::scene::build::test_scene(&format!("{lamps}\n{}", crate::scene::build::bumpy_sheet(260)));
+        assert!(scene.shadows_stream());
+        assert_eq!(scene.lights().area_lights().count(), 2);
+        let cancel = std::sync::atomic::AtomicBool::new(false);
+        let control = Control {
+            progress: &NoProgress,
+            cancel: &cancel,
+        };
+        let settings = PathSettings {
+            max_depth: 4,
+            ..PathSettings::default()
+        };
+        let mut tracer = PathTracer::new(&scene, settings, 48, 40, 3);
+        let images = [true, false].map(|waves| {
+            tracer.shadows_in_waves = waves;
+            tracer.render_pass(1, control).expect("not cancelled")
+        });
+        let lit = images[1].iter().filter(|p| p.max_element() > 0.0).count();
+        assert!(lit > 48 * 40 / 2, "{lit} pixels lit");
+        assert!(images[0] == images[1], "the same image, bit for bit");
     }
 }

@@ -517,7 +517,7 @@ impl AreaLight {
     /// Next-event estimation's sample: a point on the light for lighting the query's point,
     /// visibility included.
     pub(super) fn sample_direct(&self, q: &DirectQuery, (u_pick, u): (f32, Vec2)) -> Option<DirectSample> {
-        let (scene, hit, wl, p_pick, light) = (q.scene, q.hit, q.wl, q.choice, self);
+        let (scene, hit, p_pick, light) = (q.scene, q.hit, q.choice, self);
         let p = hit.point;
         let drawn = light.sample_towards(scene, p, u_pick, u)?;
         let sample = drawn.point;
@@ -532,7 +532,7 @@ impl AreaLight {
         if !(q.takes)(wi) {
             return None;
         }
-        let le = visible_emission(scene, light, hit, &drawn, wi, d, wl)?;
+        let le = visible_emission(q, light, &drawn, wi, d)?;
         let pdf = p_pick * drawn.pdf_solid;
         Some(DirectSample {
             wi,

@@ -36,6 +36,7 @@ fn position(light: &Light) -> Option<Vec3> {
 }
 
 /// Next-event estimation's sample of a point or spot light.
+#[inline(always)]
 pub(super) fn sample_direct(q: &DirectQuery, light: &Light) -> Option<DirectSample> {
     let p = q.hit.point;
     let at = position(light)?;

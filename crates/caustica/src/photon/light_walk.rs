@@ -546,7 +546,17 @@ const PREFETCH_AHEAD: usize = 4;
 /// then each walk takes its step. In scenes with media (where a segment's end depends on the
 /// path's random numbers), or for one walker, the walks go one at a time.
 pub fn walk_together<W: Walk<V>, V>(scene: &Scene, walkers: &mut [Walker<W, V>]) {
-    if scene.has_media() || walkers.len() < 2 {
+    walk_together_settling(scene, walkers, |_| {});
+}
+
+/// [`walk_together`], calling `settle(walkers)` after each wave's steps (a wave's shadow rays
+/// tested together) where the walks go in waves ([`in_waves`]).
+pub fn walk_together_settling<W: Walk<V>, V>(
+    scene: &Scene,
+    walkers: &mut [Walker<W, V>],
+    mut settle: impl FnMut(&mut [Walker<W, V>]),
+) {
+    if !in_waves(scene, walkers.len()) {
         for w in walkers {
             w.walk.walk_to_end(scene, &w.wl, &mut w.rng, &mut w.visitor);
         }
@@ -576,7 +586,14 @@ pub fn walk_together<W: Walk<V>, V>(scene: &Scene, walkers: &mut [Walker<W, V>])
             w.walk.take_step(scene, &step, &w.wl, &mut w.rng, &mut w.visitor);
             w.walk.next_ray().is_some()
         });
+        settle(walkers);
     }
+}
+
+/// Whether [`walk_together`] walks `walkers` walks in waves: not in scenes with media (where a
+/// segment's end depends on the path's random numbers), nor for one walker.
+pub fn in_waves(scene: &Scene, walkers: usize) -> bool {
+    !scene.has_media() && walkers >= 2
 }
 
 /// How a light-side walk decides to go on.

@@ -580,6 +580,14 @@ fn stream_matches_single_rays() {
                     assert_eq!(*blocked, tbvh.any_hit(ray, t_max), "{ray:?} t_max {t_max}");
                 }
             }
+            // Each ray its own segment, empty ones included (shadow rays).
+            let own = |i: usize| [f32::INFINITY, 0.0, 0.4, 1.5, 3.0][i % 5] * (1.0 + i as f32 * 1e-3);
+            let batch = &rays[..count];
+            let mut occluded = vec![true; count];
+            tbvh.any_hits_within(batch, own, &mut occluded);
+            for (i, (ray, blocked)) in batch.iter().zip(&occluded).enumerate() {
+                assert_eq!(*blocked, tbvh.any_hit(ray, own(i)), "{ray:?} t_max {}", own(i));
+            }
         }
     }
 }

@@ -288,7 +288,7 @@ impl TriangleBvh {
     pub fn closest_hits(&self, rays: &[Ray], t_max: f32, hits: &mut [Option<TriangleBvhHit>]) {
         self.stream::<true, _, _>(
             rays,
-            t_max,
+            |_| t_max,
             hits,
             |tri, first, t_max, best: &mut Option<LeafHit>| {
                 self.closest_in_leaf(tri, first, t_max, best);
@@ -305,6 +305,14 @@ impl TriangleBvh {
     /// # Panics
     /// If `occluded` and `rays` differ in length.
     pub fn any_hits(&self, rays: &[Ray], t_max: f32, occluded: &mut [bool]) {
+        self.any_hits_within(rays, |_| t_max, occluded);
+    }
+
+    /// [`TriangleBvh::any_hits`] with each ray's own `t_max(i)` (shadow rays' segments).
+    ///
+    /// # Panics
+    /// If `occluded` and `rays` differ in length.
+    pub fn any_hits_within(&self, rays: &[Ray], t_max: impl Fn(usize) -> f32, occluded: &mut [bool]) {
         self.stream::<false, _, _>(
             rays,
             t_max,
@@ -320,46 +328,48 @@ impl TriangleBvh {
     /// Walks `rays` [`STREAM`] at a time, interleaved, near child first with `NEAR_FIRST` (else,
     /// for any-hit queries, far child first where the CPU has AVX2 and in slot order where not).
     /// A node's children are sorted without branches where the CPU has AVX2 ([`SortingRayPre`]).
-    /// Each ray's lane keeps a `F` (default at the start); `leaf(ray, first, t_max, found)` tests
+    /// Ray `i` is walked within `t_max(i)`. Each ray's lane keeps a `F` (default at the start);
+    /// `leaf(ray, first, t_max, found)` tests
     /// the leaf starting at `first` and returns
     /// whether the ray's answer is settled; `answer(t_max, found)` is what goes to `out`.
     fn stream<const NEAR_FIRST: bool, F: Copy + Default, R: Default>(
         &self,
         rays: &[Ray],
-        t_max: f32,
+        t_max: impl Fn(usize) -> f32,
         out: &mut [R],
         leaf: impl Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
         answer: impl Fn(f32, F) -> R,
     ) {
         /// The interleaved walks, generic over their stack size.
-        struct Stream<'a, 'b, const NEAR_FIRST: bool, F, R, L, A> {
+        struct Stream<'a, 'b, const NEAR_FIRST: bool, F, R, M, L, A> {
             bvh: &'a TriangleBvh,
             rays: &'a [Ray],
-            t_max: f32,
+            t_max: M,
             out: &'b mut [R],
             stacks: &'b mut LaneStacks,
             leaf: L,
             answer: A,
             found: std::marker::PhantomData<F>,
         }
-        impl<const NEAR_FIRST: bool, F, R, L, A> Stream<'_, '_, NEAR_FIRST, F, R, L, A>
+        impl<const NEAR_FIRST: bool, F, R, M, L, A> Stream<'_, '_, NEAR_FIRST, F, R, M, L, A>
         where
             F: Copy + Default,
+            M: Fn(usize) -> f32,
             L: Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
             A: Fn(f32, F) -> R,
         {
             /// The walks with stacks of `N` entries and boxes tested by `T`.
             #[inline(always)]
             fn walk<const N: usize, T: SlabTest<2>>(self) {
-                let (rays, t_max) = (self.rays, self.t_max);
                 let slots = (self.out, self.stacks);
                 self.bvh
-                    .stream_with::<N, NEAR_FIRST, F, R, T>(rays, t_max, slots, &self.leaf, &self.answer);
+                    .stream_with::<N, NEAR_FIRST, F, R, T>(self.rays, &self.t_max, slots, &self.leaf, &self.answer);
             }
         }
-        impl<const NEAR_FIRST: bool, F, R, L, A> StackSized for Stream<'_, '_, NEAR_FIRST, F, R, L, A>
+        impl<const NEAR_FIRST: bool, F, R, M, L, A> StackSized for Stream<'_, '_, NEAR_FIRST, F, R, M, L, A>
         where
             F: Copy + Default,
+            M: Fn(usize) -> f32,
             L: Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
             A: Fn(f32, F) -> R,
         {
@@ -391,7 +401,7 @@ impl TriangleBvh {
                     &mut *own
                 }
             };
-            self.bvh.with_stack(Stream::<NEAR_FIRST, _, _, _, _> {
+            self.bvh.with_stack(Stream::<NEAR_FIRST, _, _, _, _, _> {
                 bvh: self,
                 rays,
                 t_max,
@@ -409,7 +419,7 @@ impl TriangleBvh {
     fn stream_with<const N: usize, const NEAR_FIRST: bool, F: Copy + Default, R, T: SlabTest<2>>(
         &self,
         rays: &[Ray],
-        t_max: f32,
+        t_max: &impl Fn(usize) -> f32,
         (out, stacks): (&mut [R], &mut LaneStacks),
         leaf: &impl Fn(&TriangleRay, usize, &mut f32, &mut F) -> bool,
         answer: &impl Fn(f32, F) -> R,
@@ -436,7 +446,7 @@ impl TriangleBvh {
             }
             let stack = free.next().expect("a stack for each lane");
             let stack: &mut [(u32, f32); N] = (&mut stack[..N]).try_into().expect("N entries at most LARGE_STACK");
-            if let Some(walk) = Traversal::new(ray, t_max, stack) {
+            if let Some(walk) = Traversal::new(ray, t_max(index), stack) {
                 lanes.push(Lane {
                     index,
                     walk,
@@ -465,7 +475,7 @@ impl TriangleBvh {
                 }
                 out[lane.index] = answer(lane.walk.t_max, lane.found);
                 // The next ray reuses the lane, stack storage included.
-                let next = pending.by_ref().find(|(_, ray)| lane.walk.restart(ray, t_max));
+                let next = pending.by_ref().find(|&(i, ray)| lane.walk.restart(ray, t_max(i)));
                 match next {
                     Some((index, ray)) => {
                         lane.index = index;
