@@ -835,13 +835,8 @@ impl Scene {
         !self.blocks(&self.shadow_ray(hit, wi, distance, u32::MAX))
     }
 
-    /// As [`Scene::unoccluded`], but primitive `own` never blocks (the light whose point the
-    /// segment ends on, when nothing of it can lie in between).
-    pub fn unoccluded_except(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> bool {
-        !self.blocks(&self.shadow_ray(hit, wi, distance, own))
-    }
-
-    /// The segment [`Scene::unoccluded_except`] tests (`own`: `u32::MAX` for none).
+    /// The segment [`Scene::unoccluded`] tests, passing over primitive `own` (`u32::MAX`: none;
+    /// else the light whose point the segment ends on, when nothing of it can lie in between).
     #[inline(always)]
     pub fn shadow_ray(&self, hit: &SurfaceHit, wi: Vec3, distance: f32, own: u32) -> ShadowRay {
         let (point, origin) = (hit.point, hit.ray_origin(wi));
