@@ -57,6 +57,10 @@ struct SpherePacket<L> {
 struct Packets<L> {
     squares: Vec<SquarePacket<L>>,
     spheres: Vec<SpherePacket<L>>,
+    /// Each shape alone in every lane, in the packets' order: for testing a lane per ray
+    /// ([`ShapePackets::closest_each`]).
+    lone_squares: Vec<SquarePacket<L>>,
+    lone_spheres: Vec<SpherePacket<L>>,
     /// Where each shape (by id) sits: its packet's place, squares' packets first, and its
     /// lane's bit; `(u32::MAX, 0)` for a shape left out.
     slots: [(u32, u32); MAX_SHAPES],
@@ -75,22 +79,42 @@ enum PacketLanes {
     Eight(Avx, Packets<F32x8>),
 }
 
-/// Per-ray values every packet uses.
+/// Per-ray values every packet uses: one ray in every lane, or a ray a lane.
 struct PacketRay<L> {
     origin: [L; 3],
     dir: [L; 3],
     /// `dir · dir`, as the sphere test forms it.
-    dir2: f32,
+    dir2: L,
 }
 
 impl<L: Lanes> PacketRay<L> {
+    /// `ray` in every lane.
     #[inline(always)]
     fn new(ray: &Ray) -> PacketRay<L> {
         let (o, d) = (ray.origin, ray.dir);
         PacketRay {
             origin: [o.x, o.y, o.z].map(L::splat),
             dir: [d.x, d.y, d.z].map(L::splat),
-            dir2: d.dot(d),
+            dir2: L::splat(d.dot(d)),
+        }
+    }
+
+    /// `rays` (at most [`Lanes::N`], at least one) a lane each; lanes past them repeat the first.
+    #[inline(always)]
+    fn lanes(rays: &[Ray]) -> PacketRay<L> {
+        let mut v = [[0.0f32; MAX_LANES]; 7];
+        for lane in 0..L::N {
+            let r = rays.get(lane).unwrap_or(&rays[0]);
+            let (o, d) = (r.origin, r.dir);
+            for (row, value) in v.iter_mut().zip([o.x, o.y, o.z, d.x, d.y, d.z, d.dot(d)]) {
+                row[lane] = value;
+            }
+        }
+        let [ox, oy, oz, dx, dy, dz, d2] = v.map(|row| L::from_slice(&row));
+        PacketRay {
+            origin: [ox, oy, oz],
+            dir: [dx, dy, dz],
+            dir2: d2,
         }
     }
 }
@@ -158,6 +182,24 @@ impl ShapePackets {
         }
     }
 
+    /// [`ShapePackets::closest`] of each of `rays` with its own `t_max`, into `out`: the same
+    /// shapes and `t`, to the bit, with a ray in each lane and the shapes one after another,
+    /// which costs a fraction of testing the shapes in the lanes ray by ray.
+    ///
+    /// # Panics
+    /// If `rays`, `t_max` and `out` differ in length.
+    pub fn closest_each(&self, rays: &[Ray], t_max: &[f32], out: &mut [Option<(u32, f32)>]) {
+        assert!(
+            rays.len() == t_max.len() && rays.len() == out.len(),
+            "a t_max and an answer per ray"
+        );
+        match &self.lanes {
+            PacketLanes::Four(p) => p.closest_each(rays, t_max, out),
+            #[cfg(target_arch = "x86_64")]
+            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.closest_each(rays, t_max, out)),
+        }
+    }
+
     /// Calls `visit(shape)` for each shape whose own test finds a hit with `0 < t < t_max`,
     /// until it returns `true`; returns whether it did.
     #[inline]
@@ -217,6 +259,25 @@ impl<L: Lanes> Packets<L> {
                 ids: ids(&mut c.iter().map(|s| s.0)),
             })
             .collect();
+        let lone_squares = forms
+            .squares
+            .iter()
+            .map(|(id, rows, origin)| SquarePacket {
+                rows: rows.map(|row| row.map(L::splat)),
+                origin: origin.map(L::splat),
+                ids: [*id; MAX_LANES],
+            })
+            .collect();
+        let lone_spheres = forms
+            .spheres
+            .iter()
+            .map(|(id, center, radius)| SpherePacket {
+                center: center.map(L::splat),
+                radius: L::splat(*radius),
+                used: (1 << L::N) - 1,
+                ids: [*id; MAX_LANES],
+            })
+            .collect();
         let mut slots = [(u32::MAX, 0); MAX_SHAPES];
         let packed = squares.iter().map(|p| &p.ids).chain(spheres.iter().map(|p| &p.ids));
         for (packet, ids) in packed.enumerate() {
@@ -227,7 +288,36 @@ impl<L: Lanes> Packets<L> {
         Packets {
             squares,
             spheres,
+            lone_squares,
+            lone_spheres,
             slots,
+        }
+    }
+
+    /// [`ShapePackets::closest_each`], [`Lanes::N`] rays at a time. The shapes are tested in
+    /// [`Packets::closest`]'s order against each ray's own `t_max`, and a hit replaces the best
+    /// only when nearer, as there.
+    #[inline(always)]
+    fn closest_each(&self, rays: &[Ray], t_max: &[f32], out: &mut [Option<(u32, f32)>]) {
+        for ((rays, t_max), out) in rays.chunks(L::N).zip(t_max.chunks(L::N)).zip(out.chunks_mut(L::N)) {
+            let pr = PacketRay::<L>::lanes(rays);
+            // Lanes past the rays: no `t` is below zero.
+            let bound: [f32; MAX_LANES] = std::array::from_fn(|i| t_max.get(i).copied().unwrap_or(0.0));
+            let bound = L::from_slice(&bound);
+            let mut best = [(NO_SHAPE, 0.0f32); MAX_LANES];
+            // Plain loops, no closure: one left out of line would run its lanes outside the AVX
+            // code.
+            for p in &self.lone_squares {
+                let (mask, t) = p.hits(&pr, bound, 0);
+                keep_nearer(&mut best, mask, t, p.ids[0]);
+            }
+            for p in &self.lone_spheres {
+                let (mask, t) = p.hits(&pr, bound, 0);
+                keep_nearer(&mut best, mask, t, p.ids[0]);
+            }
+            for (slot, &(id, t)) in out.iter_mut().zip(&best) {
+                *slot = (id != NO_SHAPE).then_some((id, t));
+            }
         }
     }
 
@@ -248,11 +338,11 @@ impl<L: Lanes> Packets<L> {
             }
         };
         for p in &self.squares {
-            let (mask, t) = p.hits(&pr, t_max, 0);
+            let (mask, t) = p.hits(&pr, L::splat(t_max), 0);
             keep(mask, t, &p.ids);
         }
         for p in &self.spheres {
-            let (mask, t) = p.hits(&pr, t_max, 0);
+            let (mask, t) = p.hits(&pr, L::splat(t_max), 0);
             keep(mask, t, &p.ids);
         }
         best
@@ -272,19 +362,38 @@ impl<L: Lanes> Packets<L> {
         let mut packet = 0;
         for p in &self.squares {
             let skip = if SKIPS && packet == own_packet { own_lane } else { 0 };
-            if visit_lanes(p.hits(&pr, t_max, skip).0, &p.ids, &mut visit) {
+            if visit_lanes(p.hits(&pr, L::splat(t_max), skip).0, &p.ids, &mut visit) {
                 return true;
             }
             packet += 1;
         }
         for p in &self.spheres {
             let skip = if SKIPS && packet == own_packet { own_lane } else { 0 };
-            if visit_lanes(p.hits(&pr, t_max, skip).0, &p.ids, &mut visit) {
+            if visit_lanes(p.hits(&pr, L::splat(t_max), skip).0, &p.ids, &mut visit) {
                 return true;
             }
             packet += 1;
         }
         false
+    }
+}
+
+/// Keeps shape `id` as the best of each lane of `mask` (a ray a lane) where it is the first hit
+/// or nearer than the best, at that lane's `t`.
+#[inline(always)]
+fn keep_nearer<L: Lanes>(best: &mut [(u32, f32); MAX_LANES], mask: u32, t: L, id: u32) {
+    if mask == 0 {
+        return;
+    }
+    let mut ts = [0.0; MAX_LANES];
+    t.write_to(&mut ts);
+    let mut rest = mask;
+    while rest != 0 {
+        let lane = rest.trailing_zeros() as usize;
+        if best[lane].0 == NO_SHAPE || ts[lane] < best[lane].1 {
+            best[lane] = (id, ts[lane]);
+        }
+        rest &= rest - 1;
     }
 }
 
@@ -306,7 +415,7 @@ impl<L: Lanes> SquarePacket<L> {
     /// The lanes hit with `0 < t < t_max` (bit per lane), but for the lanes of `skip`, and their
     /// `t`: the square test of `Shape::intersect_square`, lane by lane.
     #[inline(always)]
-    fn hits(&self, ray: &PacketRay<L>, t_max: f32, skip: u32) -> (u32, L) {
+    fn hits(&self, ray: &PacketRay<L>, t_max: L, skip: u32) -> (u32, L) {
         let [row_x, row_y, row_z] = &self.rows;
         let zero = L::splat(0.0);
         let dir_z = dot(row_z, &ray.dir);
@@ -314,13 +423,13 @@ impl<L: Lanes> SquarePacket<L> {
         let distance_z = dot(row_z, &to_origin);
         // Behind the ray, parallel to it, or beyond `t_max`.
         let facing = distance_z.gt(zero) ^ dir_z.gt(zero);
-        let far = distance_z.abs().ge(L::splat(t_max) * dir_z.abs());
+        let far = distance_z.abs().ge(t_max * dir_z.abs());
         let turned_away = dir_z.eq(zero) | facing | far;
         if L::bitmask(!turned_away) & !skip == 0 {
             return (0, zero);
         }
         let t = distance_z / dir_z;
-        let in_range = t.gt(zero) & t.lt(L::splat(t_max));
+        let in_range = t.gt(zero) & t.lt(t_max);
         let offset: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] + ray.dir[axis] * t - self.origin[axis]);
         let half = L::splat(0.5);
         let outside = dot(row_x, &offset).abs().gt(half) | dot(row_y, &offset).abs().gt(half);
@@ -333,10 +442,10 @@ impl<L: Lanes> SpherePacket<L> {
     /// `t`: the round-sphere test of `Shape::intersect_round_sphere` with
     /// [`crate::geometry::quadratic_roots`], lane by lane.
     #[inline(always)]
-    fn hits(&self, ray: &PacketRay<L>, t_max: f32, skip: u32) -> (u32, L) {
+    fn hits(&self, ray: &PacketRay<L>, t_max: L, skip: u32) -> (u32, L) {
         let zero = L::splat(0.0);
         let oc: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] - self.center[axis]);
-        let a = L::splat(ray.dir2);
+        let a = ray.dir2;
         let half_b = dot(&oc, &ray.dir);
         let k = half_b / a;
         let l: [L; 3] = std::array::from_fn(|axis| oc[axis] - ray.dir[axis] * k);
@@ -355,14 +464,9 @@ impl<L: Lanes> SpherePacket<L> {
         let t1 = L::select(q_zero, zero, c / q);
         let (lo, hi) = (t0.min(t1), t0.max(t1));
         let t = L::select(lo.gt(zero), lo, hi);
-        let in_range = t.gt(zero) & t.lt(L::splat(t_max));
+        let in_range = t.gt(zero) & t.lt(t_max);
         // `a == 0` (a zero direction) takes the scalar test's other branch: no lane claims it.
-        let mask = if ray.dir2 == 0.0 {
-            0
-        } else {
-            L::bitmask(near & real & in_range) & !skip
-        };
-        (mask, t)
+        (L::bitmask(near & real & in_range & !a.eq(zero)) & !skip, t)
     }
 }
 
@@ -422,7 +526,9 @@ mod tests {
     /// On 200,000 random rays — from inside the box, from far outside, grazing, and bounded
     /// by a random `t_max` — the packets of every width this CPU runs pick the shape and `t` (to
     /// the bit) that testing each shape by its own test picks, `each` visits exactly the
-    /// shapes those tests hit, and `each_except` all of them but the one it passes over.
+    /// shapes those tests hit, and `each_except` all of them but the one it passes over; and
+    /// `closest_each`, a ray a lane, picks the same for all the rays at once (in runs of 1 to
+    /// 13 rays, so lanes are left over).
     #[test]
     fn packets_find_what_each_shapes_own_test_finds() {
         let shapes = shapes();
@@ -434,6 +540,7 @@ mod tests {
         let mut rng = Rng::new(7, 0);
         let mut random = |scale: f32| Vec3::new(rng.uniform() - 0.5, rng.uniform() - 0.5, rng.uniform() - 0.5) * scale;
         let (mut hits, mut several) = (0, 0);
+        let mut all = (Vec::new(), Vec::new(), Vec::new());
         for i in 0..200_000 {
             let origin = if i % 3 == 0 {
                 random(200.0)
@@ -489,6 +596,31 @@ mod tests {
             }
             hits += usize::from(expected.is_some());
             several += usize::from(each_expected.len() > 1);
+            all.0.push(ray);
+            all.1.push(t_max);
+            all.2.push(expected);
+        }
+        let (rays, t_max, expected) = all;
+        for (packets, width) in packets.iter().zip(&widths) {
+            let mut found = vec![Some((0, 0.0)); rays.len()];
+            let mut start = 0;
+            for run in (1..=13).cycle() {
+                let end = (start + run).min(rays.len());
+                packets.closest_each(&rays[start..end], &t_max[start..end], &mut found[start..end]);
+                start = end;
+                if start == rays.len() {
+                    break;
+                }
+            }
+            for i in 0..rays.len() {
+                assert_eq!(
+                    found[i].map(|(id, t)| (id, t.to_bits())),
+                    expected[i].map(|(id, t)| (id, t.to_bits())),
+                    "{width:?}, a ray a lane: {:?} {}",
+                    rays[i],
+                    t_max[i]
+                );
+            }
         }
         assert!(
             hits > 100_000 && several > 50_000,

@@ -14,7 +14,7 @@ use super::triangle::{Triangle, TriangleHit, TriangleRay};
 #[cfg(target_arch = "x86_64")]
 use crate::accel::lanes::F32x8;
 use crate::accel::lanes::Lanes;
-use crate::math::Vec3;
+use crate::math::{Aabb, Ray, Vec3};
 
 /// Lanes per packet.
 pub const LANES: usize = 4;
@@ -328,6 +328,107 @@ impl<const N: usize> LaneHits<N> {
         }
     }
 }
+
+/// Rays a lane, sheared each its own way ([`TriangleRay`]), for testing triangles one after
+/// another against all of them: each lane runs [`lane_hits`]'s arithmetic on its ray, the axes
+/// picked lane by lane, so a lane finds the bits a packet test of that ray finds.
+pub(crate) struct RayLanes<L: Lanes> {
+    /// The origin's permuted coordinates.
+    origin: [L; 3],
+    shear: [L; 2],
+    inv_dz: L,
+    /// Lanes whose ray runs mostly along x, and along y.
+    along_x: L::Mask,
+    along_y: L::Mask,
+}
+
+impl<L: Lanes> RayLanes<L> {
+    /// The first [`Lanes::N`] of `rays` (at least one), a lane each, sheared as
+    /// [`TriangleRay::new`] shears a ray, to the same bits; and the lanes whose ray may meet
+    /// something in `bounds` (bit per lane): a finite ray that does not start outside them
+    /// on some axis and move away along it.
+    #[inline(always)]
+    pub(crate) fn new(rays: &[Ray], bounds: &Aabb) -> (RayLanes<L>, u32) {
+        let mut v = [[0.0f32; PAIR_LANES_MAX]; 6];
+        for lane in 0..L::N {
+            let ray = rays.get(lane).unwrap_or(&rays[0]);
+            let (o, d) = (ray.origin, ray.dir);
+            for (row, value) in v.iter_mut().zip([o.x, o.y, o.z, d.x, d.y, d.z]) {
+                row[lane] = value;
+            }
+        }
+        let [ox, oy, oz, dx, dy, dz] = v.map(|row| L::from_slice(&row));
+        let zero = L::splat(0.0);
+        let finite =
+            ox.is_finite() & oy.is_finite() & oz.is_finite() & dx.is_finite() & dy.is_finite() & dz.is_finite();
+        let (min, max) = (bounds.min, bounds.max);
+        let away =
+            |o: L, d: L, min: f32, max: f32| (o.lt(L::splat(min)) & d.le(zero)) | (o.gt(L::splat(max)) & d.ge(zero));
+        let away = away(ox, dx, min.x, max.x) | away(oy, dy, min.y, max.y) | away(oz, dz, min.z, max.z);
+        let live = L::bitmask(finite & !away) & ((1u32 << rays.len().min(L::N)) - 1);
+        // The largest axis as `TriangleRay::new` picks it: x if above both, else y if above z.
+        let (ax, ay, az) = (dx.abs(), dy.abs(), dz.abs());
+        let along_x = ax.gt(ay) & ax.gt(az);
+        let along_y = !along_x & ay.gt(az);
+        let permuted = |x: L, y: L, z: L| {
+            [
+                L::select(along_x, y, L::select(along_y, z, x)),
+                L::select(along_x, z, L::select(along_y, x, y)),
+                L::select(along_x, x, L::select(along_y, y, z)),
+            ]
+        };
+        let origin = permuted(ox, oy, oz);
+        let [d_kx, d_ky, d_kz] = permuted(dx, dy, dz);
+        let lanes = RayLanes {
+            origin,
+            shear: [d_kx / d_kz, d_ky / d_kz],
+            inv_dz: L::splat(1.0) / d_kz,
+            along_x,
+            along_y,
+        };
+        (lanes, live)
+    }
+
+    /// The vertex `p` relative to each lane's origin, sheared as [`sheared`] shears it. No
+    /// closure: one left out of line would run its lanes outside the AVX code.
+    #[inline(always)]
+    fn sheared(&self, p: Vec3) -> (L, L, L) {
+        let (px, py, pz) = (L::splat(p.x), L::splat(p.y), L::splat(p.z));
+        // The axes after the largest, then the largest: (y, z, x), (z, x, y) or (x, y, z).
+        let kx = L::select(self.along_x, py, L::select(self.along_y, pz, px));
+        let ky = L::select(self.along_x, pz, L::select(self.along_y, px, py));
+        let kz = L::select(self.along_x, px, L::select(self.along_y, py, pz));
+        let z = kz - self.origin[2];
+        let x = (kx - self.origin[0]) - self.shear[0] * z;
+        let y = (ky - self.origin[1]) - self.shear[1] * z;
+        (x, y, z)
+    }
+
+    /// The triangle `[a, b, c]` against each lane's ray with `0 < t < t_max`: the lanes hit (bit
+    /// per lane), those with an edge function of exactly zero (for the scalar test to settle),
+    /// and per lane `t`, the weights of `b` and `c` and their sum with `a`'s.
+    #[inline(always)]
+    pub(crate) fn hits(&self, vertices: &[Vec3; 3], t_max: L) -> (u32, u32, [L; 4]) {
+        let (xa, ya, za) = self.sheared(vertices[0]);
+        let (xb, yb, zb) = self.sheared(vertices[1]);
+        let (xc, yc, zc) = self.sheared(vertices[2]);
+        let wa = xc * yb - yc * xb;
+        let wb = xa * yc - ya * xc;
+        let wc = xb * ya - yb * xa;
+        let zero = L::splat(0.0);
+        let neg = wa.lt(zero) | wb.lt(zero) | wc.lt(zero);
+        let pos = wa.gt(zero) | wb.gt(zero) | wc.gt(zero);
+        let det = wa + wb + wc;
+        let t = (wa * za + wb * zb + wc * zc) * self.inv_dz / det;
+        let in_range = t.gt(zero) & t.lt(t_max);
+        let hit = !(neg & pos) & in_range;
+        let on_edge = wa.eq(zero) | wb.eq(zero) | wc.eq(zero);
+        (L::bitmask(hit), L::bitmask(on_edge), [t, wb, wc, det])
+    }
+}
+
+/// Most lanes of any width.
+const PAIR_LANES_MAX: usize = 2 * LANES;
 
 #[cfg(test)]
 mod tests {

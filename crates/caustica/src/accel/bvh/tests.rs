@@ -537,13 +537,29 @@ fn build_reports_every_primitive_once() {
 
 /// The interleaved streams give each ray exactly its single-ray answers, whatever the tree's
 /// stack tier, ray order and number of rays (fewer, as many as, or more than the stream's lanes),
-/// loading ahead or not.
+/// loading ahead or not; and so do a few triangles tested a ray a lane (`closest_each`),
+/// rays through a floor's shared edge and corners (edge functions of exactly zero) among them.
 #[test]
 fn stream_matches_single_rays() {
     let mut rng = Rng(0x5eed);
+    let floor = vec![
+        Triangle::new(
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(4.0, 0.0, 4.0),
+            Vec3::new(4.0, 0.0, 0.0),
+        ),
+        Triangle::new(
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 4.0),
+            Vec3::new(4.0, 0.0, 4.0),
+        ),
+    ];
     let meshes = [
         Vec::new(),
         random_triangles(&mut rng, 1),
+        floor.clone(),
+        random_triangles(&mut rng, 5),
+        random_triangles(&mut rng, 8),
         random_triangles(&mut rng, 40),
         random_triangles(&mut rng, 3000),
         sphere(40, 80),
@@ -568,6 +584,25 @@ fn stream_matches_single_rays() {
                 .iter()
                 .map(|&x| Ray::new(Vec3::new(x, 0.5, 0.5), Vec3::new(1.0, x, 0.0))),
         );
+        // Down onto the floor's diagonal, its corners and its rim, from above and at a slant: for
+        // `closest_each` only (a walk's box test may miss the rim of a flat tree that its
+        // packets, tested without one, hit).
+        let mut each_rays = rays.clone();
+        each_rays.extend((0..=8).flat_map(|i| {
+            let s = i as f32 * 0.5;
+            [
+                Ray::new(Vec3::new(s, 2.0, s), Vec3::new(0.0, -1.0, 0.0)),
+                Ray::new(Vec3::new(s + 1.0, 2.0, s), Vec3::new(-0.5, -1.0, 0.0)),
+                Ray::new(Vec3::new(s, 1.0, 0.0), Vec3::new(0.0, -1.0, 0.0)),
+            ]
+        }));
+        // Directions with two or three largest components alike, where the axis a ray is
+        // sheared along is decided by a tie.
+        each_rays.extend((0..40).flat_map(|i| {
+            let origin = Vec3::new(0.1 * i as f32, 2.0, 0.05 * i as f32 - 0.5);
+            [(0.3, -1.0, 1.0), (1.0, -1.0, 1.0), (-1.0, -1.0, 0.3), (0.5, -1.0, -1.0)]
+                .map(|(x, y, z)| Ray::new(origin, Vec3::new(x, y, z)))
+        }));
         for count in [0, 1, 5, 8, 9, rays.len()] {
             for t_max in [f32::INFINITY, 3.0] {
                 let batch = &rays[..count];
@@ -579,6 +614,18 @@ fn stream_matches_single_rays() {
                     assert_eq!(*hit, tbvh.closest_hit(ray, t_max), "{ray:?} t_max {t_max}");
                     assert_eq!(*blocked, tbvh.any_hit(ray, t_max), "{ray:?} t_max {t_max}");
                 }
+            }
+            let batch = &each_rays[..count.min(each_rays.len())];
+            let batch = if count == rays.len() { &each_rays[..] } else { batch };
+            let mut each = vec![None; batch.len()];
+            tbvh.closest_each(batch, &mut each);
+            for (ray, hit) in batch.iter().zip(&each) {
+                assert_eq!(
+                    hit.map(|h| (h.prim, h.t.to_bits(), h.u.to_bits(), h.v.to_bits())),
+                    tbvh.closest_hit(ray, f32::INFINITY)
+                        .map(|h| (h.prim, h.t.to_bits(), h.u.to_bits(), h.v.to_bits())),
+                    "{width:?}, a ray a lane: {ray:?}"
+                );
             }
             // Each ray its own segment, empty ones included (shadow rays).
             let own = |i: usize| [f32::INFINITY, 0.0, 0.4, 1.5, 3.0][i % 5] * (1.0 + i as f32 * 1e-3);

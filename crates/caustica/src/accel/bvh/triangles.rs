@@ -7,13 +7,13 @@ use super::build::LeafCost;
 use super::{Bvh, RayPre, SlabTest, StackSized, Traversal, Visit, END, LARGE_STACK, LEAF, PAIR};
 #[cfg(target_arch = "x86_64")]
 use super::{SortingRayPre, WideRayPre};
-use crate::accel::lanes::Width;
 #[cfg(target_arch = "x86_64")]
-use crate::accel::lanes::{in_avx, in_avx2, Avx};
+use crate::accel::lanes::{in_avx, in_avx2, Avx, F32x8};
+use crate::accel::lanes::{Lanes, Width};
 use crate::geometry::triangle::{Triangle, TriangleHit, TriangleRay};
 #[cfg(target_arch = "x86_64")]
 use crate::geometry::triangle_packet::PacketPair;
-use crate::geometry::triangle_packet::{TrianglePacket, LANES};
+use crate::geometry::triangle_packet::{RayLanes, TrianglePacket, LANES};
 use crate::math::{Aabb, Ray, Vec3};
 use crate::progress::{NoProgress, Progress};
 use std::cell::RefCell;
@@ -213,6 +213,11 @@ impl TriangleBvh {
     /// Number of triangle packets.
     pub fn packet_count(&self) -> usize {
         self.packets.len()
+    }
+
+    /// Whether the tree holds no triangle.
+    pub fn is_empty(&self) -> bool {
+        self.packets.is_empty()
     }
 
     /// Whether queries walk the tree ([`TriangleBvh::closest_hits`] then pays); with a few
@@ -648,6 +653,100 @@ impl TriangleBvh {
             prim: self.ids[best.packet][best.lane],
             u: best.u,
             v: best.v,
+        }
+    }
+
+    /// [`TriangleBvh::closest_hit`] of each of `rays` with `t_max` ∞, into `out`: for a tree
+    /// that does not walk, a ray a lane and the triangles one after another, to the same bits
+    /// (in the same order, each hit kept only when nearer); ray by ray for one that walks.
+    ///
+    /// # Panics
+    /// If `rays` and `out` differ in length.
+    pub fn closest_each(&self, rays: &[Ray], out: &mut [Option<TriangleBvhHit>]) {
+        assert_eq!(rays.len(), out.len(), "an answer per ray");
+        if self.walks() {
+            for (ray, out) in rays.iter().zip(out) {
+                *out = self.closest_hit(ray, f32::INFINITY);
+            }
+            return;
+        }
+        match self.width {
+            Width::Four => self.closest_each_in::<glam::Vec4>(rays, out),
+            #[cfg(target_arch = "x86_64")]
+            Width::Eight(avx) => in_avx(avx, || self.closest_each_in::<F32x8>(rays, out)),
+        }
+    }
+
+    /// [`TriangleBvh::closest_each`] at the width of `L`.
+    #[inline(always)]
+    fn closest_each_in<L: Lanes>(&self, rays: &[Ray], out: &mut [Option<TriangleBvhHit>]) {
+        const MAX: usize = 2 * LANES;
+        // The triangles in the packets' order, lane by lane.
+        let mut triangles = [(0usize, 0usize, [Vec3::ZERO; 3]); LANES * FEW_PACKETS];
+        let mut count = 0;
+        for (packet, ids) in self.ids.iter().enumerate() {
+            for (lane, _) in ids.iter().enumerate().filter(|&(_, &id)| id != NO_TRIANGLE) {
+                triangles[count] = (packet, lane, self.packets[packet].triangle(lane).vertices());
+                count += 1;
+            }
+        }
+        let triangles = &triangles[..count];
+        for (rays, out) in rays.chunks(L::N).zip(out.chunks_mut(L::N)) {
+            // Lanes past the rays, and rays that meet no triangle (as `closest_hit` sees them
+            // before any test), keep a `t_max` of zero: no `t` is below it.
+            let (lanes, live) = RayLanes::<L>::new(rays, &self.bvh.bounds());
+            if live == 0 {
+                out.fill(None);
+                continue;
+            }
+            let mut t_max = [0.0f32; MAX];
+            for (lane, t_max) in t_max.iter_mut().enumerate() {
+                if live & (1 << lane) != 0 {
+                    *t_max = f32::INFINITY;
+                }
+            }
+            let mut best = [None::<LeafHit>; MAX];
+            for &(packet, lane, vertices) in triangles {
+                let (hit, edge, [t, wb, wc, det]) = lanes.hits(&vertices, L::from_slice(&t_max));
+                let (hit, edge) = (hit & live, edge & live);
+                if hit | edge == 0 {
+                    continue;
+                }
+                let mut values = [[0.0f32; MAX]; 4];
+                for (lanes, row) in [t, wb, wc, det].into_iter().zip(&mut values) {
+                    lanes.write_to(row);
+                }
+                let [t, wb, wc, det] = values;
+                let mut rest = hit | edge;
+                while rest != 0 {
+                    let ray = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    let found = if edge & (1 << ray) != 0 {
+                        // An edge function exactly zero: the scalar test settles it, in `f64`.
+                        let sheared = TriangleRay::new(&rays[ray]);
+                        self.packets[packet].triangle(lane).intersect_pre(&sheared, t_max[ray])
+                    } else {
+                        let inv = 1.0 / det[ray];
+                        Some(TriangleHit {
+                            t: t[ray],
+                            u: wb[ray] * inv,
+                            v: wc[ray] * inv,
+                        })
+                    };
+                    if let Some(h) = found {
+                        t_max[ray] = h.t;
+                        best[ray] = Some(LeafHit {
+                            packet,
+                            lane,
+                            u: h.u,
+                            v: h.v,
+                        });
+                    }
+                }
+            }
+            for ((out, best), &t) in out.iter_mut().zip(best).zip(&t_max) {
+                *out = best.map(|b| self.hit(t, b));
+            }
         }
     }
 
