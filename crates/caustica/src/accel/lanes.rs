@@ -135,6 +135,9 @@ pub(crate) trait Lanes:
     fn splat(v: f32) -> Self;
     /// The first [`Lanes::N`] values of `v`.
     fn from_slice(v: &[f32]) -> Self;
+    /// Lane `i` `f(i)`, put together in registers: lanes written one by one to memory and
+    /// loaded as a vector would wait for the narrow stores to retire.
+    fn from_fn(f: impl Fn(usize) -> f32) -> Self;
     /// The lanes into the first [`Lanes::N`] places of `out`.
     fn write_to(self, out: &mut [f32]);
     fn abs(self) -> Self;
@@ -169,6 +172,10 @@ impl Lanes for Vec4 {
     #[inline(always)]
     fn from_slice(v: &[f32]) -> Self {
         Vec4::from_slice(v)
+    }
+    #[inline(always)]
+    fn from_fn(f: impl Fn(usize) -> f32) -> Self {
+        Vec4::new(f(0), f(1), f(2), f(3))
     }
     #[inline(always)]
     fn write_to(self, out: &mut [f32]) {
@@ -396,6 +403,10 @@ mod avx {
         fn from_slice(v: &[f32]) -> Self {
             assert!(v.len() >= 8, "eight lanes");
             F32x8(avx!(_mm256_loadu_ps(v.as_ptr())))
+        }
+        #[inline(always)]
+        fn from_fn(f: impl Fn(usize) -> f32) -> Self {
+            F32x8(avx!(_mm256_setr_ps(f(0), f(1), f(2), f(3), f(4), f(5), f(6), f(7))))
         }
         #[inline(always)]
         fn write_to(self, out: &mut [f32]) {

@@ -102,19 +102,19 @@ impl<L: Lanes> PacketRay<L> {
     /// `rays` (at most [`Lanes::N`], at least one) a lane each; lanes past them repeat the first.
     #[inline(always)]
     fn lanes(rays: &[Ray]) -> PacketRay<L> {
-        let mut v = [[0.0f32; MAX_LANES]; 7];
-        for lane in 0..L::N {
-            let r = rays.get(lane).unwrap_or(&rays[0]);
-            let (o, d) = (r.origin, r.dir);
-            for (row, value) in v.iter_mut().zip([o.x, o.y, o.z, d.x, d.y, d.z, d.dot(d)]) {
-                row[lane] = value;
-            }
-        }
-        let [ox, oy, oz, dx, dy, dz, d2] = v.map(|row| L::from_slice(&row));
+        let ray = |lane: usize| rays.get(lane).unwrap_or(&rays[0]);
         PacketRay {
-            origin: [ox, oy, oz],
-            dir: [dx, dy, dz],
-            dir2: d2,
+            origin: [
+                L::from_fn(|i| ray(i).origin.x),
+                L::from_fn(|i| ray(i).origin.y),
+                L::from_fn(|i| ray(i).origin.z),
+            ],
+            dir: [
+                L::from_fn(|i| ray(i).dir.x),
+                L::from_fn(|i| ray(i).dir.y),
+                L::from_fn(|i| ray(i).dir.z),
+            ],
+            dir2: L::from_fn(|i| ray(i).dir.dot(ray(i).dir)),
         }
     }
 }
@@ -302,21 +302,27 @@ impl<L: Lanes> Packets<L> {
         for ((rays, t_max), out) in rays.chunks(L::N).zip(t_max.chunks(L::N)).zip(out.chunks_mut(L::N)) {
             let pr = PacketRay::<L>::lanes(rays);
             // Lanes past the rays: no `t` is below zero.
-            let bound: [f32; MAX_LANES] = std::array::from_fn(|i| t_max.get(i).copied().unwrap_or(0.0));
-            let bound = L::from_slice(&bound);
-            let mut best = [(NO_SHAPE, 0.0f32); MAX_LANES];
-            // Plain loops, no closure: one left out of line would run its lanes outside the AVX
-            // code.
+            let bound = L::from_fn(|i| t_max.get(i).copied().unwrap_or(0.0));
+            // Each lane's nearest hit so far and its shape (-1: none), kept without a branch: a
+            // hit is below the lane's bound, and replaces the best only when nearer.
+            let (mut nearest, mut shape) = (bound, L::splat(-1.0));
             for p in &self.lone_squares {
-                let (mask, t) = p.hits(&pr, bound, 0);
-                keep_nearer(&mut best, mask, t, p.ids[0]);
+                let (hit, t) = p.lanes_hit::<false>(&pr, bound, 0);
+                let nearer = hit & t.lt(nearest);
+                nearest = L::select(nearer, t, nearest);
+                shape = L::select(nearer, L::splat(p.ids[0] as f32), shape);
             }
             for p in &self.lone_spheres {
-                let (mask, t) = p.hits(&pr, bound, 0);
-                keep_nearer(&mut best, mask, t, p.ids[0]);
+                let (hit, t) = p.lanes_hit::<false>(&pr, bound, 0);
+                let nearer = hit & t.lt(nearest);
+                nearest = L::select(nearer, t, nearest);
+                shape = L::select(nearer, L::splat(p.ids[0] as f32), shape);
             }
-            for (slot, &(id, t)) in out.iter_mut().zip(&best) {
-                *slot = (id != NO_SHAPE).then_some((id, t));
+            let (mut t, mut id) = ([0.0f32; MAX_LANES], [0.0f32; MAX_LANES]);
+            nearest.write_to(&mut t);
+            shape.write_to(&mut id);
+            for (lane, slot) in out.iter_mut().enumerate() {
+                *slot = (id[lane] >= 0.0).then_some((id[lane] as u32, t[lane]));
             }
         }
     }
@@ -378,25 +384,6 @@ impl<L: Lanes> Packets<L> {
     }
 }
 
-/// Keeps shape `id` as the best of each lane of `mask` (a ray a lane) where it is the first hit
-/// or nearer than the best, at that lane's `t`.
-#[inline(always)]
-fn keep_nearer<L: Lanes>(best: &mut [(u32, f32); MAX_LANES], mask: u32, t: L, id: u32) {
-    if mask == 0 {
-        return;
-    }
-    let mut ts = [0.0; MAX_LANES];
-    t.write_to(&mut ts);
-    let mut rest = mask;
-    while rest != 0 {
-        let lane = rest.trailing_zeros() as usize;
-        if best[lane].0 == NO_SHAPE || ts[lane] < best[lane].1 {
-            best[lane] = (id, ts[lane]);
-        }
-        rest &= rest - 1;
-    }
-}
-
 /// Calls `visit(shape)` for the shape of each lane of `mask`, until it returns `true`; returns
 /// whether it did.
 #[inline(always)]
@@ -416,6 +403,15 @@ impl<L: Lanes> SquarePacket<L> {
     /// `t`: the square test of `Shape::intersect_square`, lane by lane.
     #[inline(always)]
     fn hits(&self, ray: &PacketRay<L>, t_max: L, skip: u32) -> (u32, L) {
+        let (hit, t) = self.lanes_hit::<true>(ray, t_max, skip);
+        (L::bitmask(hit) & !skip, t)
+    }
+
+    /// The lanes hit with `0 < t < t_max`, and their `t`. With `STOPS`, none as soon as no lane
+    /// but those of `skip` can be (a ray against shapes, where that is common); without, the
+    /// whole test without a branch (a ray a lane, where a branch on the lanes mispredicts).
+    #[inline(always)]
+    fn lanes_hit<const STOPS: bool>(&self, ray: &PacketRay<L>, t_max: L, skip: u32) -> (L::Mask, L) {
         let [row_x, row_y, row_z] = &self.rows;
         let zero = L::splat(0.0);
         let dir_z = dot(row_z, &ray.dir);
@@ -425,15 +421,15 @@ impl<L: Lanes> SquarePacket<L> {
         let facing = distance_z.gt(zero) ^ dir_z.gt(zero);
         let far = distance_z.abs().ge(t_max * dir_z.abs());
         let turned_away = dir_z.eq(zero) | facing | far;
-        if L::bitmask(!turned_away) & !skip == 0 {
-            return (0, zero);
+        if STOPS && L::bitmask(!turned_away) & !skip == 0 {
+            return (zero.lt(zero), zero);
         }
         let t = distance_z / dir_z;
         let in_range = t.gt(zero) & t.lt(t_max);
         let offset: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] + ray.dir[axis] * t - self.origin[axis]);
         let half = L::splat(0.5);
         let outside = dot(row_x, &offset).abs().gt(half) | dot(row_y, &offset).abs().gt(half);
-        (L::bitmask(!turned_away & in_range & !outside) & !skip, t)
+        (!turned_away & in_range & !outside, t)
     }
 }
 
@@ -443,6 +439,13 @@ impl<L: Lanes> SpherePacket<L> {
     /// [`crate::geometry::quadratic_roots`], lane by lane.
     #[inline(always)]
     fn hits(&self, ray: &PacketRay<L>, t_max: L, skip: u32) -> (u32, L) {
+        let (hit, t) = self.lanes_hit::<true>(ray, t_max, skip);
+        (L::bitmask(hit) & !skip, t)
+    }
+
+    /// [`SquarePacket::lanes_hit`] for the spheres.
+    #[inline(always)]
+    fn lanes_hit<const STOPS: bool>(&self, ray: &PacketRay<L>, t_max: L, skip: u32) -> (L::Mask, L) {
         let zero = L::splat(0.0);
         let oc: [L; 3] = std::array::from_fn(|axis| ray.origin[axis] - self.center[axis]);
         let a = ray.dir2;
@@ -451,8 +454,8 @@ impl<L: Lanes> SpherePacket<L> {
         let l: [L; 3] = std::array::from_fn(|axis| oc[axis] - ray.dir[axis] * k);
         let (l2, r2) = (dot(&l, &l), self.radius * self.radius);
         let near = !l2.gt(r2);
-        if L::bitmask(near) & self.used & !skip == 0 {
-            return (0, zero);
+        if STOPS && L::bitmask(near) & self.used & !skip == 0 {
+            return (zero.lt(zero), zero);
         }
         let l_len = l2.sqrt();
         let disc = a * ((self.radius - l_len) * (self.radius + l_len));
@@ -466,7 +469,7 @@ impl<L: Lanes> SpherePacket<L> {
         let t = L::select(lo.gt(zero), lo, hi);
         let in_range = t.gt(zero) & t.lt(t_max);
         // `a == 0` (a zero direction) takes the scalar test's other branch: no lane claims it.
-        (L::bitmask(near & real & in_range & !a.eq(zero)) & !skip, t)
+        (near & real & in_range & !a.eq(zero), t)
     }
 }
 
