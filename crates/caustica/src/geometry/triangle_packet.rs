@@ -166,22 +166,8 @@ fn lane_hits<L: Lanes, const N: usize>(
     ray: &TriangleRay,
     t_max: f32,
 ) -> (u32, LaneHits<N>) {
-    let (xa, ya, za) = sheared(triangles, 0, ray);
-    let (xb, yb, zb) = sheared(triangles, 1, ray);
-    let (xc, yc, zc) = sheared(triangles, 2, ray);
-    // Edge functions: the unnormalised barycentric weights of a, b and c.
-    let wa = xc * yb - yc * xb;
-    let wb = xa * yc - ya * xc;
-    let wc = xb * ya - yb * xa;
-    let zero = L::splat(0.0);
-    let neg = wa.lt(zero) | wb.lt(zero) | wc.lt(zero);
-    let pos = wa.gt(zero) | wb.gt(zero) | wc.gt(zero);
-    let det = wa + wb + wc;
-    let t = (wa * za + wb * zb + wc * zc) * L::splat(ray.inv_dz) / det;
-    // NaN lanes (unused, or det == 0) fail both comparisons.
-    let in_range = t.gt(zero) & t.lt(L::splat(t_max));
-    let hit = !(neg & pos) & in_range;
-    let on_edge = wa.eq(zero) | wb.eq(zero) | wc.eq(zero);
+    let vertices = [0, 1, 2].map(|vertex| sheared(triangles, vertex, ray));
+    let (hit, on_edge, [t, wb, wc, det]) = edge_test(vertices, L::splat(ray.inv_dz), L::splat(t_max));
     let mut lanes = LaneHits {
         t: [0.0; N],
         wb: [0.0; N],
@@ -193,6 +179,29 @@ fn lane_hits<L: Lanes, const N: usize>(
     wc.write_to(&mut lanes.wc);
     det.write_to(&mut lanes.det);
     (L::bitmask(hit) | (L::bitmask(on_edge) << N), lanes)
+}
+
+/// The watertight test on the vertices `a`, `b` and `c` sheared along their lanes' rays
+/// (`inv_dz`: 1 / the ray's largest direction component): the lanes hit with `0 < t < t_max`,
+/// those with an edge function of exactly zero, and per lane `t`, the weights of `b` and `c`
+/// and their sum with `a`'s.
+#[inline(always)]
+fn edge_test<L: Lanes>(vertices: [(L, L, L); 3], inv_dz: L, t_max: L) -> (L::Mask, L::Mask, [L; 4]) {
+    let [(xa, ya, za), (xb, yb, zb), (xc, yc, zc)] = vertices;
+    // Edge functions: the unnormalised barycentric weights of a, b and c.
+    let wa = xc * yb - yc * xb;
+    let wb = xa * yc - ya * xc;
+    let wc = xb * ya - yb * xa;
+    let zero = L::splat(0.0);
+    let neg = wa.lt(zero) | wb.lt(zero) | wc.lt(zero);
+    let pos = wa.gt(zero) | wb.gt(zero) | wc.gt(zero);
+    let det = wa + wb + wc;
+    let t = (wa * za + wb * zb + wc * zc) * inv_dz / det;
+    // NaN lanes (unused, or det == 0) fail both comparisons.
+    let in_range = t.gt(zero) & t.lt(t_max);
+    let hit = !(neg & pos) & in_range;
+    let on_edge = wa.eq(zero) | wb.eq(zero) | wc.eq(zero);
+    (hit, on_edge, [t, wb, wc, det])
 }
 
 /// A vertex's coordinates relative to the ray's origin, sheared so the ray runs along +z.
@@ -409,21 +418,8 @@ impl<L: Lanes> RayLanes<L> {
     /// and per lane `t`, the weights of `b` and `c` and their sum with `a`'s.
     #[inline(always)]
     pub(crate) fn hits(&self, vertices: &[Vec3; 3], t_max: L) -> (u32, u32, [L; 4]) {
-        let (xa, ya, za) = self.sheared(vertices[0]);
-        let (xb, yb, zb) = self.sheared(vertices[1]);
-        let (xc, yc, zc) = self.sheared(vertices[2]);
-        let wa = xc * yb - yc * xb;
-        let wb = xa * yc - ya * xc;
-        let wc = xb * ya - yb * xa;
-        let zero = L::splat(0.0);
-        let neg = wa.lt(zero) | wb.lt(zero) | wc.lt(zero);
-        let pos = wa.gt(zero) | wb.gt(zero) | wc.gt(zero);
-        let det = wa + wb + wc;
-        let t = (wa * za + wb * zb + wc * zc) * self.inv_dz / det;
-        let in_range = t.gt(zero) & t.lt(t_max);
-        let hit = !(neg & pos) & in_range;
-        let on_edge = wa.eq(zero) | wb.eq(zero) | wc.eq(zero);
-        (L::bitmask(hit), L::bitmask(on_edge), [t, wb, wc, det])
+        let (hit, on_edge, lanes) = edge_test(vertices.map(|p| self.sheared(p)), self.inv_dz, t_max);
+        (L::bitmask(hit), L::bitmask(on_edge), lanes)
     }
 }
 
