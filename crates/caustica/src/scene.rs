@@ -994,13 +994,20 @@ impl Scene {
     }
 
     /// The nearest triangle hit in `(0, t_max)` not in a cut-out, given the nearest `hit` of all.
-    #[inline]
+    #[inline(always)]
     fn solid_triangle(&self, ray: &Ray, t_max: f32, hit: Option<TriangleBvhHit>) -> Option<TriangleBvhHit> {
         let hit = hit?;
         if !self.is_hole(ray, &hit) {
             return Some(hit);
         }
-        // Rare: every hit along the ray, the nearest solid one kept.
+        self.solid_behind_hole(ray, t_max)
+    }
+
+    /// The nearest triangle hit in `(0, t_max)` not in a cut-out, where the nearest of all is in
+    /// one. Rare: every hit along the ray, the nearest solid one kept.
+    #[cold]
+    #[inline(never)]
+    fn solid_behind_hole(&self, ray: &Ray, t_max: f32) -> Option<TriangleBvhHit> {
         let mut best: Option<TriangleBvhHit> = None;
         self.triangle_bvh.each_hit(ray, t_max, |h| {
             if best.is_none_or(|b| h.t < b.t) && !self.is_hole(ray, &h) {
@@ -1073,12 +1080,20 @@ impl Scene {
     }
 
     /// The closest hit in `(0, t_max)` of the shapes and `best`, the nearest triangle's.
-    #[inline]
+    #[inline(always)]
     fn closest_shape(&self, ray: &Ray, t_max: f32, best: Option<Intersection>) -> Option<Intersection> {
         let t_max = best.map_or(t_max, |h| h.t);
         match &self.shape_packets {
             Some(packets) => self.picked_shape(ray, t_max, best, packets.closest(ray, t_max)),
-            None => self.hierarchy_shape(ray, t_max, best),
+            None => {
+                let mut best = best;
+                self.shape_bvh.closest_hit(ray, t_max, |prim, t_max| {
+                    let hit = self.intersect_shape(prim, ray, t_max)?;
+                    best = Some(hit);
+                    Some(hit.t)
+                });
+                best
+            }
         }
     }
 
@@ -1102,8 +1117,11 @@ impl Scene {
         }
     }
 
-    /// The closest shape hit in `(0, t_max)` by the shapes' hierarchy, or `best`.
-    #[inline]
+    /// The closest shape hit in `(0, t_max)` by the shapes' hierarchy, or `best`: where the
+    /// packets' pick has no record (rare). Out of line, apart from [`Scene::closest_shape`]'s
+    /// own walk, which stays inlined.
+    #[cold]
+    #[inline(never)]
     fn hierarchy_shape(&self, ray: &Ray, t_max: f32, mut best: Option<Intersection>) -> Option<Intersection> {
         self.shape_bvh.closest_hit(ray, t_max, |prim, t_max| {
             let hit = self.intersect_shape(prim, ray, t_max)?;

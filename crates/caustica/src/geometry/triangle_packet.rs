@@ -166,7 +166,13 @@ fn lane_hits<L: Lanes, const N: usize>(
     ray: &TriangleRay,
     t_max: f32,
 ) -> (u32, LaneHits<N>) {
-    let vertices = [0, 1, 2].map(|vertex| sheared(triangles, vertex, ray));
+    // No closures (an array's `map`): one left out of line would run its lanes outside the AVX
+    // code.
+    let vertices = [
+        sheared(triangles, 0, ray),
+        sheared(triangles, 1, ray),
+        sheared(triangles, 2, ray),
+    ];
     let (hit, on_edge, [t, wb, wc, det]) = edge_test(vertices, L::splat(ray.inv_dz), L::splat(t_max));
     let mut lanes = LaneHits {
         t: [0.0; N],
@@ -418,7 +424,9 @@ impl<L: Lanes> RayLanes<L> {
     /// and per lane `t`, the weights of `b` and `c` and their sum with `a`'s.
     #[inline(always)]
     pub(crate) fn hits(&self, vertices: &[Vec3; 3], t_max: L) -> (u32, u32, [L; 4]) {
-        let (hit, on_edge, lanes) = edge_test(vertices.map(|p| self.sheared(p)), self.inv_dz, t_max);
+        let [a, b, c] = vertices;
+        let sheared = [self.sheared(*a), self.sheared(*b), self.sheared(*c)];
+        let (hit, on_edge, lanes) = edge_test(sheared, self.inv_dz, t_max);
         (L::bitmask(hit), L::bitmask(on_edge), lanes)
     }
 }
