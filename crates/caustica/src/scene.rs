@@ -1118,8 +1118,10 @@ impl Scene {
     }
 
     /// The closest shape hit in `(0, t_max)` by the shapes' hierarchy, or `best`: where the
-    /// packets' pick has no record (rare). Out of line, apart from [`Scene::closest_shape`]'s
-    /// own walk, which stays inlined.
+    /// packets' pick has no record (rare). Out of line, and written apart from
+    /// [`Scene::closest_shape`]'s own walk on purpose: one walk shared by both went out of line
+    /// on the hot path (a 1M-triangle scene's render 1.5% more instructions; 3.4% with it
+    /// always inlined).
     #[cold]
     #[inline(never)]
     fn hierarchy_shape(&self, ray: &Ray, t_max: f32, mut best: Option<Intersection>) -> Option<Intersection> {

@@ -364,7 +364,9 @@ impl<L: Lanes> RayLanes<L> {
     /// on some axis and move away along it.
     #[inline(always)]
     pub(crate) fn new(rays: &[Ray], bounds: &Aabb) -> (RayLanes<L>, u32) {
-        let mut v = [[0.0f32; PAIR_LANES_MAX]; 6];
+        // No closures over lanes: one left out of line would run them outside the AVX code.
+        // (`Lanes::from_fn` here left the whole test out of line: `glass` 25% more instructions.)
+        let mut v = [[0.0f32; 2 * LANES]; 6];
         for lane in 0..L::N {
             let ray = rays.get(lane).unwrap_or(&rays[0]);
             let (o, d) = (ray.origin, ray.dir);
@@ -372,28 +374,20 @@ impl<L: Lanes> RayLanes<L> {
                 row[lane] = value;
             }
         }
-        let [ox, oy, oz, dx, dy, dz] = v.map(|row| L::from_slice(&row));
-        let zero = L::splat(0.0);
+        let (ox, oy, oz) = (L::from_slice(&v[0]), L::from_slice(&v[1]), L::from_slice(&v[2]));
+        let (dx, dy, dz) = (L::from_slice(&v[3]), L::from_slice(&v[4]), L::from_slice(&v[5]));
         let finite =
             ox.is_finite() & oy.is_finite() & oz.is_finite() & dx.is_finite() & dy.is_finite() & dz.is_finite();
         let (min, max) = (bounds.min, bounds.max);
         let away =
-            |o: L, d: L, min: f32, max: f32| (o.lt(L::splat(min)) & d.le(zero)) | (o.gt(L::splat(max)) & d.ge(zero));
-        let away = away(ox, dx, min.x, max.x) | away(oy, dy, min.y, max.y) | away(oz, dz, min.z, max.z);
+            heads_away(ox, dx, min.x, max.x) | heads_away(oy, dy, min.y, max.y) | heads_away(oz, dz, min.z, max.z);
         let live = L::bitmask(finite & !away) & ((1u32 << rays.len().min(L::N)) - 1);
         // The largest axis as `TriangleRay::new` picks it: x if above both, else y if above z.
         let (ax, ay, az) = (dx.abs(), dy.abs(), dz.abs());
         let along_x = ax.gt(ay) & ax.gt(az);
         let along_y = !along_x & ay.gt(az);
-        let permuted = |x: L, y: L, z: L| {
-            [
-                L::select(along_x, y, L::select(along_y, z, x)),
-                L::select(along_x, z, L::select(along_y, x, y)),
-                L::select(along_x, x, L::select(along_y, y, z)),
-            ]
-        };
-        let origin = permuted(ox, oy, oz);
-        let [d_kx, d_ky, d_kz] = permuted(dx, dy, dz);
+        let origin = permuted((along_x, along_y), ox, oy, oz);
+        let [d_kx, d_ky, d_kz] = permuted((along_x, along_y), dx, dy, dz);
         let lanes = RayLanes {
             origin,
             shear: [d_kx / d_kz, d_ky / d_kz],
@@ -404,15 +398,11 @@ impl<L: Lanes> RayLanes<L> {
         (lanes, live)
     }
 
-    /// The vertex `p` relative to each lane's origin, sheared as [`sheared`] shears it. No
-    /// closure: one left out of line would run its lanes outside the AVX code.
+    /// The vertex `p` relative to each lane's origin, sheared as [`sheared`] shears it.
     #[inline(always)]
     fn sheared(&self, p: Vec3) -> (L, L, L) {
         let (px, py, pz) = (L::splat(p.x), L::splat(p.y), L::splat(p.z));
-        // The axes after the largest, then the largest: (y, z, x), (z, x, y) or (x, y, z).
-        let kx = L::select(self.along_x, py, L::select(self.along_y, pz, px));
-        let ky = L::select(self.along_x, pz, L::select(self.along_y, px, py));
-        let kz = L::select(self.along_x, px, L::select(self.along_y, py, pz));
+        let [kx, ky, kz] = permuted((self.along_x, self.along_y), px, py, pz);
         let z = kz - self.origin[2];
         let x = (kx - self.origin[0]) - self.shear[0] * z;
         let y = (ky - self.origin[1]) - self.shear[1] * z;
@@ -431,8 +421,25 @@ impl<L: Lanes> RayLanes<L> {
     }
 }
 
-/// Most lanes of any width.
-const PAIR_LANES_MAX: usize = 2 * LANES;
+/// `(x, y, z)` lane by lane in the order [`TriangleRay`] permutes the axes: the two after the
+/// largest, then the largest — `(y, z, x)` where the ray runs mostly along x (`along.0`),
+/// `(z, x, y)` along y (`along.1`), else `(x, y, z)`.
+#[inline(always)]
+fn permuted<L: Lanes>((along_x, along_y): (L::Mask, L::Mask), x: L, y: L, z: L) -> [L; 3] {
+    [
+        L::select(along_x, y, L::select(along_y, z, x)),
+        L::select(along_x, z, L::select(along_y, x, y)),
+        L::select(along_x, x, L::select(along_y, y, z)),
+    ]
+}
+
+/// Lanes whose ray starts outside `[min, max]` on this axis (origin `o`) and moves away from it
+/// (direction `d`), as the triangle tree's `heads_away` tests.
+#[inline(always)]
+fn heads_away<L: Lanes>(o: L, d: L, min: f32, max: f32) -> L::Mask {
+    let zero = L::splat(0.0);
+    (o.lt(L::splat(min)) & d.le(zero)) | (o.gt(L::splat(max)) & d.ge(zero))
+}
 
 #[cfg(test)]
 mod tests {
