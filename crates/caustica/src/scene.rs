@@ -1042,40 +1042,34 @@ impl Scene {
     /// If `hits` and `rays` differ in length.
     pub fn intersect_stream(&self, rays: &[Ray], hits: &mut [Option<Intersection>]) {
         assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        if !self.triangle_bvh.walks() {
-            // A ray a lane: the triangles, then the shapes within the nearest solid one.
-            let mut triangles = vec![None; rays.len()];
-            if !self.triangle_bvh.is_empty() {
-                self.triangle_bvh.closest_each(rays, &mut triangles);
-                if self.cutouts {
-                    for (ray, triangle) in rays.iter().zip(&mut triangles) {
-                        *triangle = self.solid_triangle(ray, f32::INFINITY, *triangle);
-                    }
-                }
+        // The triangles first, then the shapes within the nearest solid one.
+        let mut triangles = vec![None; rays.len()];
+        if self.triangle_bvh.walks() {
+            self.triangle_bvh.closest_hits(rays, f32::INFINITY, &mut triangles);
+        } else if !self.triangle_bvh.is_empty() {
+            self.triangle_bvh.closest_each(rays, &mut triangles);
+        }
+        if self.cutouts {
+            for (ray, triangle) in rays.iter().zip(&mut triangles) {
+                *triangle = self.solid_triangle(ray, f32::INFINITY, *triangle);
             }
-            let Some(packets) = &self.shape_packets else {
-                for ((ray, hit), triangle) in rays.iter().zip(hits).zip(triangles) {
-                    let triangle = triangle.map(|h| self.triangle_intersection(h));
-                    *hit = self.closest_shape(ray, f32::INFINITY, triangle);
-                }
-                return;
-            };
-            let t_max: Vec<f32> = triangles.iter().map(|h| h.map_or(f32::INFINITY, |h| h.t)).collect();
-            let mut picks = vec![None; rays.len()];
-            packets.closest_each(rays, &t_max, &mut picks);
-            for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
-                let triangle = triangles[i].map(|h| self.triangle_intersection(h));
-                *hit = match picks[i] {
-                    None => triangle,
-                    pick => self.picked_shape(ray, t_max[i], triangle, pick),
-                };
+        }
+        let Some(packets) = &self.shape_packets else {
+            for ((ray, hit), triangle) in rays.iter().zip(hits).zip(triangles) {
+                let triangle = triangle.map(|h| self.triangle_intersection(h));
+                *hit = self.closest_shape(ray, f32::INFINITY, triangle);
             }
             return;
-        }
-        let mut triangles = vec![None; rays.len()];
-        self.triangle_bvh.closest_hits(rays, f32::INFINITY, &mut triangles);
-        for ((ray, hit), triangle) in rays.iter().zip(hits).zip(triangles) {
-            *hit = self.closest_of(ray, f32::INFINITY, triangle);
+        };
+        let t_max: Vec<f32> = triangles.iter().map(|h| h.map_or(f32::INFINITY, |h| h.t)).collect();
+        let mut picks = vec![None; rays.len()];
+        packets.closest_each(rays, &t_max, &mut picks);
+        for (i, (ray, hit)) in rays.iter().zip(hits).enumerate() {
+            let triangle = triangles[i].map(|h| self.triangle_intersection(h));
+            *hit = match picks[i] {
+                None => triangle,
+                pick => self.picked_shape(ray, t_max[i], triangle, pick),
+            };
         }
     }
 
@@ -1677,13 +1671,15 @@ mod tests {
                           translate(0, 0, -0.5, scale(3, square { material = { diffuse = (1,1,1); } }))
                           translate(1, -1, 0.5, rotate(1, 0, 0, 0.7, scale(1.5, square { material = { diffuse = (1,1,1); } })))
                           translate(-1.5, 0, 0.5, rotate(0, 1, 0, 1.2, scale(2, square { material = { diffuse = (1,1,1); } })))";
+        // A lamp alone is in a packet too (a wave's rays test it eight at a time).
+        let lone = "translate(0.5, 0, 0.2, scale(0.6, sphere { material = { diffuse = (1,1,1); } }))";
         for (mesh, walks) in [
             (build::bumpy_sheet(12), true),
             (floor.to_string(), false),
             (String::new(), false),
         ] {
-            for (shapes, packed) in [(in_hierarchy, false), (in_packets, true)] {
-                let scene = build::test_scene(&format!("{mesh}\n{shapes}"));
+            for (shapes, packed) in [(in_hierarchy, false), (in_packets, true), (lone, true)] {
+                let mut scene = build::test_scene(&format!("{mesh}\n{shapes}"));
                 assert_eq!(scene.triangle_bvh.walks(), walks);
                 assert_eq!(scene.shape_packets.is_some(), packed);
                 let mut f = uniform_pm1();
@@ -1699,6 +1695,12 @@ mod tests {
                 scene.intersect_stream(&rays, &mut together);
                 let alone: Vec<Option<Intersection>> = rays.iter().map(|r| scene.intersect(r, f32::INFINITY)).collect();
                 assert_eq!(together, alone);
+                // The packets pick what the shapes' hierarchy picks, with the same records.
+                let packets = scene.shape_packets.take();
+                for (i, (ray, hit)) in rays.iter().zip(&alone).enumerate() {
+                    assert_eq!(*hit, scene.intersect(ray, f32::INFINITY), "ray {i}");
+                }
+                scene.shape_packets = packets;
                 let n_shapes = scene.shapes().len() as u32;
                 let hits = |triangle: bool| {
                     alone
