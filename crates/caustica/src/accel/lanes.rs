@@ -79,7 +79,10 @@ impl Avx {
 }
 
 /// Calls `f` from a function compiled for AVX, so that the eight-lane arithmetic inlined into
-/// it runs as AVX instructions. `f` should be `#[inline(always)]` down to its lanes.
+/// it runs as AVX instructions. `f` should be `#[inline(always)]` down to its lanes, the
+/// closure itself included: one left out of line runs outside the AVX code, each lane operation
+/// a call (a profile-guided build left a walk the profile never ran out of line: +10% of a
+/// scene's instructions, 1.7× its time).
 #[cfg(target_arch = "x86_64")]
 #[allow(unsafe_code)]
 #[inline(always)]

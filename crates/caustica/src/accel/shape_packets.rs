@@ -166,7 +166,14 @@ impl ShapePackets {
         let lanes = match width {
             Width::Four => PacketLanes::Four(Packets::new(&forms)),
             #[cfg(target_arch = "x86_64")]
-            Width::Eight(avx) => PacketLanes::Eight(avx, in_avx(avx, || Packets::new(&forms))),
+            Width::Eight(avx) => PacketLanes::Eight(
+                avx,
+                in_avx(
+                    avx,
+                    #[inline(always)]
+                    || Packets::new(&forms),
+                ),
+            ),
         };
         Some(ShapePackets { lanes })
     }
@@ -178,7 +185,11 @@ impl ShapePackets {
         match &self.lanes {
             PacketLanes::Four(p) => p.closest(ray, t_max),
             #[cfg(target_arch = "x86_64")]
-            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.closest(ray, t_max)),
+            PacketLanes::Eight(avx, p) => in_avx(
+                *avx,
+                #[inline(always)]
+                || p.closest(ray, t_max),
+            ),
         }
     }
 
@@ -196,7 +207,11 @@ impl ShapePackets {
         match &self.lanes {
             PacketLanes::Four(p) => p.closest_each(rays, t_max, out),
             #[cfg(target_arch = "x86_64")]
-            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.closest_each(rays, t_max, out)),
+            PacketLanes::Eight(avx, p) => in_avx(
+                *avx,
+                #[inline(always)]
+                || p.closest_each(rays, t_max, out),
+            ),
         }
     }
 
@@ -207,7 +222,11 @@ impl ShapePackets {
         match &self.lanes {
             PacketLanes::Four(p) => p.each::<false>(ray, t_max, NO_SHAPE, visit),
             #[cfg(target_arch = "x86_64")]
-            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.each::<false>(ray, t_max, NO_SHAPE, visit)),
+            PacketLanes::Eight(avx, p) => in_avx(
+                *avx,
+                #[inline(always)]
+                || p.each::<false>(ray, t_max, NO_SHAPE, visit),
+            ),
         }
     }
 
@@ -220,7 +239,11 @@ impl ShapePackets {
         match &self.lanes {
             PacketLanes::Four(p) => p.each::<true>(ray, t_max, own, visit),
             #[cfg(target_arch = "x86_64")]
-            PacketLanes::Eight(avx, p) => in_avx(*avx, || p.each::<true>(ray, t_max, own, visit)),
+            PacketLanes::Eight(avx, p) => in_avx(
+                *avx,
+                #[inline(always)]
+                || p.each::<true>(ray, t_max, own, visit),
+            ),
         }
     }
 }

@@ -544,14 +544,18 @@ mod tests {
                 });
             }
             let pair = PacketPair(&packets);
-            let (closest, all, any) = crate::accel::lanes::in_avx(avx, || {
-                let mut all = Vec::new();
-                pair.each_hit(&tr, t_max, |lane, h| {
-                    all.push((lane, h));
-                    false
-                });
-                (pair.closest_hit(&tr, t_max), all, pair.any_hit(&tr, t_max))
-            });
+            let (closest, all, any) = crate::accel::lanes::in_avx(
+                avx,
+                #[inline(always)]
+                || {
+                    let mut all = Vec::new();
+                    pair.each_hit(&tr, t_max, |lane, h| {
+                        all.push((lane, h));
+                        false
+                    });
+                    (pair.closest_hit(&tr, t_max), all, pair.any_hit(&tr, t_max))
+                },
+            );
             assert_eq!(closest, expected, "case {case}");
             assert_eq!(all, expected_all, "case {case}");
             assert_eq!(any, !expected_all.is_empty(), "case {case}");

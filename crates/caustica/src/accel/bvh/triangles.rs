@@ -269,7 +269,11 @@ impl TriangleBvh {
         match self.width {
             Width::Four => self.closest_walk_tested::<RayPre>(ray, tr, t_max),
             #[cfg(target_arch = "x86_64")]
-            Width::Eight(avx) => in_avx(avx, || self.closest_walk_tested::<WideRayPre>(ray, tr, t_max)),
+            Width::Eight(avx) => in_avx(
+                avx,
+                #[inline(always)]
+                || self.closest_walk_tested::<WideRayPre>(ray, tr, t_max),
+            ),
         }
     }
 
@@ -384,8 +388,16 @@ impl TriangleBvh {
                     Width::Four => self.walk::<N, RayPre>(),
                     #[cfg(target_arch = "x86_64")]
                     Width::Eight(avx) => match avx.avx2() {
-                        Some(avx2) => in_avx2(avx2, || self.walk::<N, SortingRayPre>()),
-                        None => in_avx(avx, || self.walk::<N, WideRayPre>()),
+                        Some(avx2) => in_avx2(
+                            avx2,
+                            #[inline(always)]
+                            || self.walk::<N, SortingRayPre>(),
+                        ),
+                        None => in_avx(
+                            avx,
+                            #[inline(always)]
+                            || self.walk::<N, WideRayPre>(),
+                        ),
                     },
                 }
             }
@@ -541,7 +553,11 @@ impl TriangleBvh {
         let first = leaf & !(PAIR as usize);
         #[cfg(target_arch = "x86_64")]
         if let Some((avx, pair)) = self.leaf_pair(leaf) {
-            if let Some((lane, h)) = in_avx(avx, || pair.closest_hit(tr, *t_max)) {
+            if let Some((lane, h)) = in_avx(
+                avx,
+                #[inline(always)]
+                || pair.closest_hit(tr, *t_max),
+            ) {
                 self.record(first + lane / LANES, lane % LANES, h, t_max, best);
             }
             return;
@@ -606,11 +622,15 @@ impl TriangleBvh {
         let first = leaf & !(PAIR as usize);
         #[cfg(target_arch = "x86_64")]
         if let Some((avx, pair)) = self.leaf_pair(leaf) {
-            return in_avx(avx, || {
-                pair.each_hit(tr, t_max, |lane, h| {
-                    visit(public_hit(self.ids[first + lane / LANES][lane % LANES], h))
-                })
-            });
+            return in_avx(
+                avx,
+                #[inline(always)]
+                || {
+                    pair.each_hit(tr, t_max, |lane, h| {
+                        visit(public_hit(self.ids[first + lane / LANES][lane % LANES], h))
+                    })
+                },
+            );
         }
         let mut i = first;
         loop {
@@ -632,7 +652,11 @@ impl TriangleBvh {
         let first = leaf & !(PAIR as usize);
         #[cfg(target_arch = "x86_64")]
         if let Some((avx, pair)) = self.leaf_pair(leaf) {
-            return in_avx(avx, || pair.any_hit(tr, t_max));
+            return in_avx(
+                avx,
+                #[inline(always)]
+                || pair.any_hit(tr, t_max),
+            );
         }
         let mut i = first;
         loop {
@@ -673,7 +697,11 @@ impl TriangleBvh {
         match self.width {
             Width::Four => self.closest_each_in::<glam::Vec4>(rays, out),
             #[cfg(target_arch = "x86_64")]
-            Width::Eight(avx) => in_avx(avx, || self.closest_each_in::<F32x8>(rays, out)),
+            Width::Eight(avx) => in_avx(
+                avx,
+                #[inline(always)]
+                || self.closest_each_in::<F32x8>(rays, out),
+            ),
         }
     }
 
@@ -784,7 +812,11 @@ impl TriangleBvh {
         match self.width {
             Width::Four => self.each_walk_tested::<RayPre>(ray, tr, t_max, visit),
             #[cfg(target_arch = "x86_64")]
-            Width::Eight(avx) => in_avx(avx, || self.each_walk_tested::<WideRayPre>(ray, tr, t_max, visit)),
+            Width::Eight(avx) => in_avx(
+                avx,
+                #[inline(always)]
+                || self.each_walk_tested::<WideRayPre>(ray, tr, t_max, visit),
+            ),
         }
     }
 
