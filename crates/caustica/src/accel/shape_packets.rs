@@ -70,6 +70,9 @@ struct Packets<L> {
 #[derive(Clone, Debug)]
 pub struct ShapePackets {
     lanes: PacketLanes,
+    /// The one shape packed, where there is one (a lamp over a mesh): a shadow ray that ends on
+    /// it meets nothing else here.
+    lone: Option<u32>,
 }
 
 #[derive(Clone, Debug)]
@@ -175,7 +178,11 @@ impl ShapePackets {
                 ),
             ),
         };
-        Some(ShapePackets { lanes })
+        let lone = match (forms.squares.as_slice(), forms.spheres.as_slice()) {
+            ([(id, ..)], []) | ([], [(id, ..)]) => Some(*id),
+            _ => None,
+        };
+        Some(ShapePackets { lanes, lone })
     }
 
     /// The shape whose own test finds the nearest hit with `0 < t < t_max`, and that `t`.
@@ -236,6 +243,9 @@ impl ShapePackets {
     /// [`ShapePackets::each`] keeps one without the skipping.)
     #[inline]
     pub fn each_except(&self, ray: &Ray, t_max: f32, own: u32, visit: impl FnMut(u32) -> bool) -> bool {
+        if self.lone == Some(own) {
+            return false;
+        }
         match &self.lanes {
             PacketLanes::Four(p) => p.each::<true>(ray, t_max, own, visit),
             #[cfg(target_arch = "x86_64")]
@@ -652,6 +662,30 @@ mod tests {
             hits > 100_000 && several > 50_000,
             "{hits} hits, {several} with several"
         );
+    }
+
+    /// A shadow ray ending on a lone packed shape (a lamp over a mesh) meets nothing; one ending
+    /// elsewhere still meets it, and so does every test that passes over nothing.
+    #[test]
+    fn a_lone_shape_passed_over_leaves_nothing() {
+        let lamp = Shape::new(ShapeKind::Sphere, Mat4::from_translation(Vec3::new(0.0, 2.0, 0.0))).unwrap();
+        let floor = Shape::new(ShapeKind::Square, Mat4::from_scale(Vec3::splat(4.0))).unwrap();
+        let ray = Ray::new(Vec3::ZERO, Vec3::Y);
+        for width in Width::on_host() {
+            let lone = ShapePackets::with_width(std::slice::from_ref(&lamp), width).expect("a round sphere");
+            assert_eq!(lone.lone, Some(0));
+            let mut met = vec![];
+            assert!(!lone.each_except(&ray, 10.0, 0, |id| {
+                met.push(id);
+                true
+            }));
+            assert!(met.is_empty(), "{width:?}");
+            assert!(lone.each_except(&ray, 10.0, NO_SHAPE, |_| true), "{width:?}");
+            assert!(lone.each(&ray, 10.0, |_| true), "{width:?}");
+            let two = ShapePackets::with_width(&[lamp.clone(), floor.clone()], width).expect("packed");
+            assert_eq!(two.lone, None);
+            assert!(two.each_except(&ray, 10.0, 1, |_| true), "{width:?}");
+        }
     }
 
     /// Other shapes, and more than [`MAX_SHAPES`] or fewer than [`MIN_SHAPES`], keep the
